@@ -1,0 +1,1 @@
+"""The latency rig application: devices (real and simulated), renderers, sessions, the `rig` CLI."""

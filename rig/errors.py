@@ -1,0 +1,9 @@
+"""The error a rig user can cause. The command line prints its message and exits with status 2."""
+
+
+class RigError(Exception):
+    """A problem with the user's input or setup; the message says what was wrong and what to do."""
+
+
+class ConfigError(RigError, ValueError):
+    """An option or configuration value outside its allowed range."""

@@ -1,0 +1,99 @@
+"""The renderer plug-in protocol.
+
+A renderer is the system under test: it turns predicted poses into display images. The session
+drives it on the rig clock (virtual in simulation) and never looks inside it.
+
+Two kinds of frames exist, as in the seed papers' display-layer architecture:
+
+* **application frames** are rendered at the renderer's own pace. The session calls
+  `render_app_frame` when the previous one has been handed to the display; the renderer asks the
+  predictor (through `request.predict`) for the pose it wants, draws, and reports what that cost.
+* **display frames** happen at every vertical blank. A renderer with `per_display_frame = True`
+  (a warp renderer) composes a new image for each of them in `render_display_frame`; a renderer
+  with `per_display_frame = False` (the direct renderer) returns its image with the application
+  frame, and the display repeats that image until the next application frame is ready.
+
+Images are RGB, uint8, shape (height, width, 3), row 0 at the top of the display (the row that is
+scanned out first). Costs are seconds on the rig clock: either modelled (a configured number,
+deterministic) or measured (the real render time on this machine); `cost_source` says which, so a
+run never pretends a cost it neither modelled nor measured.
+
+Third-party renderers are classes registered under the entry-point group `rig.renderers`; the
+class is constructed without arguments and then `open`ed with a `RenderSetup`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Literal, Protocol, runtime_checkable
+
+import numpy as np
+
+from predictors import Pose
+
+CostSource = Literal["modelled", "measured"]
+PredictFn = Callable[[float], Pose]
+
+
+@dataclass(frozen=True)
+class RenderSetup:
+    """What a renderer needs to know once, before the first frame.
+
+    world_to_clip maps homogeneous world coordinates (metres) to OpenGL clip space; the display
+    shows clip x, y in [-1, 1] with +y at the top row.
+    """
+
+    width: int
+    height: int
+    world_to_clip: np.ndarray
+    sphere_radius_m: float
+    scene_triangles: int = 0
+    app_frame_ms: float | None = None
+    warp_ms: float | None = None
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class AppFrameRequest:
+    index: int
+    t_start: float
+    t_photon: float
+    predict: PredictFn
+
+
+@dataclass(frozen=True)
+class AppFrameResult:
+    cost_s: float
+    cost_source: CostSource
+    pose: Pose
+    image: np.ndarray | None
+
+
+@dataclass(frozen=True)
+class DisplayFrameRequest:
+    index: int
+    t_vblank: float
+    t_photon: float
+    predict: PredictFn
+
+
+@dataclass(frozen=True)
+class DisplayFrameResult:
+    image: np.ndarray
+    cost_s: float
+    cost_source: CostSource
+    pose: Pose
+
+
+@runtime_checkable
+class Renderer(Protocol):
+    name: str
+    per_display_frame: bool
+
+    def open(self, setup: RenderSetup) -> None: ...
+
+    def render_app_frame(self, request: AppFrameRequest) -> AppFrameResult: ...
+
+    def render_display_frame(self, request: DisplayFrameRequest) -> DisplayFrameResult: ...
+
+    def close(self) -> None: ...
