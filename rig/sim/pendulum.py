@@ -1,0 +1,184 @@
+"""The simulated pendulum: the ground-truth motion of the LED and the tracker sensor.
+
+World frame: x to the right, y up, z towards the camera. The pendulum swings in the x-y plane
+about the z axis through `pivot`. The bob, which carries both the LED and the tracker sensor, is at
+
+    pivot + L * (sin(theta), -cos(theta), 0),
+
+so theta > 0 puts the bob to the right (+x). The sensor's orientation is the rotation about +z by
+theta: it is the identity at rest and turns the body's -y axis onto the pivot-to-bob direction.
+
+The angle obeys the nonlinear pendulum with linear viscous damping,
+
+    theta'' = -(g / L) sin(theta) - (omega0 / Q) theta',    omega0 = sqrt(g / L),
+
+so for small swings the amplitude decays as exp(-omega0 t / (2 Q)). Q = inf means no damping.
+The equation is integrated once, accurately (DOP853, rtol 1e-11, atol 1e-12), over the whole time
+window; every query afterwards is a vectorised evaluation of the integrator's dense output.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.integrate import OdeSolution, solve_ivp
+from scipy.special import ellipk
+
+from rig.errors import ConfigError
+
+MAX_AMPLITUDE_DEG = 45.0
+_RTOL = 1e-11
+_ATOL = 1e-12
+
+
+def _positive_finite(value: float | None, name: str) -> None:
+    if value is None or not math.isfinite(value) or value <= 0.0:
+        raise ConfigError(f"PendulumConfig.{name} must be a positive finite number, got {value!r}")
+
+
+@dataclass(frozen=True)
+class PendulumConfig:
+    """A pendulum, given by its small-angle period or its length (exactly one of the two).
+
+    amplitude_deg is the angle the pendulum is released from, at rest. phase_deg says where in
+    the swing the simulation starts: the release happens phase_deg / 360 of a period (the exact
+    period at that amplitude) before the start time, so 0 starts at the release and 90 starts near
+    the first downward zero crossing. quality is the Q factor of the viscous damping; math.inf
+    means undamped.
+    """
+
+    period_s: float | None = 1.0
+    length_m: float | None = None
+    amplitude_deg: float = 20.0
+    quality: float = 200.0
+    g: float = 9.80665
+    phase_deg: float = 0.0
+    pivot: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if (self.period_s is None) == (self.length_m is None):
+            raise ConfigError(
+                "PendulumConfig needs exactly one of period_s and length_m; "
+                f"got period_s={self.period_s!r}, length_m={self.length_m!r}"
+            )
+        if self.period_s is not None:
+            _positive_finite(self.period_s, "period_s")
+        else:
+            _positive_finite(self.length_m, "length_m")
+        _positive_finite(self.g, "g")
+        if not (0.0 < self.amplitude_deg <= MAX_AMPLITUDE_DEG):
+            raise ConfigError(
+                f"PendulumConfig.amplitude_deg must be in (0, {MAX_AMPLITUDE_DEG:g}] degrees, "
+                f"got {self.amplitude_deg!r}"
+            )
+        if math.isnan(self.quality) or self.quality <= 0.0:
+            raise ConfigError(
+                f"PendulumConfig.quality must be a positive Q factor (math.inf for no damping), "
+                f"got {self.quality!r}"
+            )
+        if not (0.0 <= self.phase_deg < 360.0):
+            raise ConfigError(f"PendulumConfig.phase_deg must be in [0, 360) degrees, got {self.phase_deg!r}")
+        pivot = np.asarray(self.pivot, dtype=np.float64)
+        if pivot.shape != (3,) or not np.isfinite(pivot).all():
+            raise ConfigError(
+                f"PendulumConfig.pivot must be three finite coordinates in metres, got {self.pivot!r}"
+            )
+
+    @property
+    def resolved_length_m(self) -> float:
+        """The length in metres, from length_m or from the small-angle period."""
+        if self.length_m is not None:
+            return float(self.length_m)
+        assert self.period_s is not None
+        return self.g * (self.period_s / (2.0 * math.pi)) ** 2
+
+
+class Pendulum:
+    """The pendulum's motion over [t_start, t_end], integrated once at construction."""
+
+    def __init__(self, config: PendulumConfig, t_end: float, t_start: float = 0.0) -> None:
+        if not (math.isfinite(t_start) and math.isfinite(t_end) and t_end > t_start):
+            raise ConfigError(
+                f"Pendulum needs finite times with t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}"
+            )
+        self.config = config
+        self.t_start = float(t_start)
+        self.t_end = float(t_end)
+        self.length_m = config.resolved_length_m
+        self.omega0 = math.sqrt(config.g / self.length_m)
+        self.pivot = np.asarray(config.pivot, dtype=np.float64)
+        self.amplitude_rad = math.radians(config.amplitude_deg)
+        self.t_release = self.t_start - config.phase_deg / 360.0 * self.period_s
+        self._solution = self._integrate()
+
+    @property
+    def small_angle_period_s(self) -> float:
+        """2 pi sqrt(L / g): the period of an infinitesimal, undamped swing."""
+        return 2.0 * math.pi / self.omega0
+
+    @property
+    def period_s(self) -> float:
+        """The exact undamped period at the release amplitude A: 4 sqrt(L / g) K(sin^2(A / 2))."""
+        m = math.sin(self.amplitude_rad / 2.0) ** 2
+        return 4.0 / self.omega0 * float(ellipk(m))
+
+    def _integrate(self) -> OdeSolution:
+        w0_squared = self.omega0**2
+        damping = 0.0 if math.isinf(self.config.quality) else self.omega0 / self.config.quality
+
+        def rate(_t: float, y: np.ndarray) -> list[float]:
+            theta, omega = y
+            return [omega, -w0_squared * math.sin(theta) - damping * omega]
+
+        result = solve_ivp(
+            rate,
+            (self.t_release, self.t_end),
+            [self.amplitude_rad, 0.0],
+            method="DOP853",
+            rtol=_RTOL,
+            atol=_ATOL,
+            dense_output=True,
+        )
+        if not result.success:
+            raise ConfigError(f"the pendulum could not be integrated: {result.message}")
+        return result.sol
+
+    def _state(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        times = np.asarray(t, dtype=np.float64)
+        if not (np.all(times >= self.t_start) and np.all(times <= self.t_end)):
+            bad = times[~((times >= self.t_start) & (times <= self.t_end))].ravel()[0]
+            raise ConfigError(
+                f"time {bad!r} s is outside the simulated window [{self.t_start!r}, {self.t_end!r}] s; "
+                "build the Pendulum with a window that covers every time you ask for"
+            )
+        if times.size == 0:
+            return np.empty(times.shape), np.empty(times.shape)
+        state = self._solution(times.ravel())
+        return state[0].reshape(times.shape), state[1].reshape(times.shape)
+
+    def angle(self, t: ArrayLike) -> np.ndarray:
+        """theta(t) in radians, the shape of t."""
+        return self._state(t)[0]
+
+    def angular_velocity(self, t: ArrayLike) -> np.ndarray:
+        """theta'(t) in radians per second, the shape of t."""
+        return self._state(t)[1]
+
+    def led_position(self, t: ArrayLike) -> np.ndarray:
+        """The bob's position in metres, shape t.shape + (3,)."""
+        return self._bob_position(self.angle(t))
+
+    def sensor_pose(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """The sensor's positions, shape t.shape + (3,), and orientations (w, x, y, z), t.shape + (4,)."""
+        theta = self.angle(t)
+        half = theta / 2.0
+        zeros = np.zeros_like(theta)
+        orientation = np.stack([np.cos(half), zeros, zeros, np.sin(half)], axis=-1)
+        return self._bob_position(theta), orientation
+
+    def _bob_position(self, theta: np.ndarray) -> np.ndarray:
+        offset = np.stack([np.sin(theta), -np.cos(theta), np.zeros_like(theta)], axis=-1)
+        return self.pivot + self.length_m * offset

@@ -1,0 +1,248 @@
+"""The simulated tracker against its configuration, and the tracker CSV format."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from predictors import PoseSample
+from rig.errors import ConfigError, RigError
+from rig.sim.pendulum import Pendulum, PendulumConfig
+from rig.sim.tracker import (
+    CSV_HEADER,
+    TrackerConfig,
+    TrackerCsvWriter,
+    read_tracker_csv,
+    simulate_tracker,
+    write_tracker_csv,
+)
+
+QUIET = dict(position_noise_m=0.0, orientation_noise_deg=0.0, jitter_s=0.0)
+
+
+@pytest.fixture(scope="module")
+def pendulum() -> Pendulum:
+    return Pendulum(PendulumConfig(amplitude_deg=30.0, pivot=(0.0, 1.0, 0.0)), 30.0)
+
+
+def _columns(samples: list[PoseSample]) -> dict[str, np.ndarray]:
+    return {
+        "t_sensor": np.array([s.t_sensor for s in samples]),
+        "t_arrival": np.array([s.t_arrival for s in samples]),
+        "position": np.array([s.position for s in samples]).reshape(-1, 3),
+        "orientation": np.array([s.orientation for s in samples]).reshape(-1, 4),
+    }
+
+
+def _body_frame_rotation_vector(truth: np.ndarray, measured: np.ndarray) -> np.ndarray:
+    """Rotation vector of conj(truth) * measured, for truths that rotate about z only."""
+    c, s = truth[:, 0], truth[:, 3]
+    w, x, y, z = measured.T
+    relative = np.stack([c * w + s * z, c * x + s * y, c * y - s * x, c * z - s * w], axis=1)
+    relative *= np.sign(relative[:, :1])
+    vector = relative[:, 1:]
+    norm = np.linalg.norm(vector, axis=1, keepdims=True)
+    return 2.0 * np.arctan2(norm, relative[:, :1]) * vector / norm
+
+
+def test_same_seed_gives_the_same_samples_and_another_seed_does_not(pendulum):
+    config = TrackerConfig(dropout=0.1)
+    first = _columns(simulate_tracker(pendulum, config, 0.0, 2.0, seed=7))
+    again = _columns(simulate_tracker(pendulum, config, 0.0, 2.0, seed=7))
+    other = _columns(simulate_tracker(pendulum, config, 0.0, 2.0, seed=8))
+    for name in first:
+        np.testing.assert_array_equal(first[name], again[name])
+    assert not np.array_equal(first["position"], other["position"][: len(first["position"])])
+    assert not np.array_equal(first["t_sensor"], other["t_sensor"])
+
+
+def test_samples_come_at_the_configured_rate_and_phase(pendulum):
+    config = TrackerConfig(rate_hz=100.0, phase_s=0.003, **QUIET)
+    t_sensor = _columns(simulate_tracker(pendulum, config, 1.0, 3.0, seed=0))["t_sensor"]
+    assert t_sensor.size == 200
+    np.testing.assert_allclose(t_sensor, 1.003 + np.arange(200) / 100.0, rtol=0, atol=1e-12)
+
+
+def test_last_sample_is_before_the_window_end(pendulum):
+    t_sensor = _columns(simulate_tracker(pendulum, TrackerConfig(rate_hz=10.0), 0.0, 1.0, seed=0))["t_sensor"]
+    assert t_sensor.size == 10
+    assert t_sensor[-1] < 1.0
+
+
+def test_noise_has_the_configured_spread(pendulum):
+    config = TrackerConfig(position_noise_m=0.001, orientation_noise_deg=0.5, dropout=0.0)
+    columns = _columns(simulate_tracker(pendulum, config, 0.0, 25.0, seed=3))
+    n = columns["t_sensor"].size
+    assert n == 3000
+    true_positions, true_orientations = pendulum.sensor_pose(columns["t_sensor"])
+    rotation_error = _body_frame_rotation_vector(true_orientations, columns["orientation"])
+    # The standard error of a sample std-dev is about 1 / sqrt(2 n) = 1.3 %: allow 5 of them.
+    for error, sigma in [
+        (columns["position"] - true_positions, 0.001),
+        (rotation_error, math.radians(0.5)),
+    ]:
+        np.testing.assert_allclose(np.std(error, axis=0), sigma, rtol=0.065)
+        np.testing.assert_allclose(np.mean(error, axis=0), 0.0, atol=5 * sigma / math.sqrt(n))
+    np.testing.assert_allclose(np.linalg.norm(columns["orientation"], axis=1), 1.0, atol=1e-15)
+
+
+def test_arrival_is_late_by_the_delay_plus_the_mean_jitter(pendulum):
+    config = TrackerConfig(transport_delay_s=0.004, jitter_s=0.0005)
+    columns = _columns(simulate_tracker(pendulum, config, 0.0, 25.0, seed=4))
+    lateness = columns["t_arrival"] - columns["t_sensor"]
+    assert np.all(lateness >= 0.004 - 1e-12)
+    n = lateness.size
+    # Exponential jitter: its std-dev equals its mean.
+    assert np.mean(lateness) == pytest.approx(0.0045, abs=5 * 0.0005 / math.sqrt(n))
+    assert np.std(lateness) == pytest.approx(0.0005, rel=0.1)
+
+
+def test_transport_never_reorders_samples(pendulum):
+    config = TrackerConfig(rate_hz=120.0, transport_delay_s=0.002, jitter_s=0.02)
+    columns = _columns(simulate_tracker(pendulum, config, 0.0, 5.0, seed=5))
+    steps = np.diff(columns["t_arrival"])
+    assert np.all(steps >= 0.0)
+    assert np.count_nonzero(steps == 0.0) > 10, "jitter this large must make samples queue behind late ones"
+    assert np.all(np.diff(columns["t_sensor"]) > 0.0)
+    assert np.all(columns["t_arrival"] - columns["t_sensor"] >= 0.002 - 1e-12)
+
+
+def test_dropout_removes_the_configured_fraction_and_keeps_the_rest_unchanged(pendulum):
+    full = _columns(simulate_tracker(pendulum, TrackerConfig(jitter_s=0.0), 0.0, 25.0, seed=6))
+    thinned_config = TrackerConfig(jitter_s=0.0, dropout=0.3)
+    thinned = _columns(simulate_tracker(pendulum, thinned_config, 0.0, 25.0, seed=6))
+    n = full["t_sensor"].size
+    kept = thinned["t_sensor"].size / n
+    assert kept == pytest.approx(0.7, abs=5 * math.sqrt(0.3 * 0.7 / n))
+    index = np.searchsorted(full["t_sensor"], thinned["t_sensor"])
+    np.testing.assert_array_equal(full["t_sensor"][index], thinned["t_sensor"])
+    np.testing.assert_array_equal(full["position"][index], thinned["position"])
+    np.testing.assert_array_equal(full["orientation"][index], thinned["orientation"])
+
+
+def test_zero_noise_gives_the_exact_truth(pendulum):
+    config = TrackerConfig(transport_delay_s=0.004, **QUIET)
+    columns = _columns(simulate_tracker(pendulum, config, 0.0, 3.0, seed=1))
+    positions, orientations = pendulum.sensor_pose(columns["t_sensor"])
+    np.testing.assert_array_equal(columns["position"], positions)
+    np.testing.assert_allclose(columns["orientation"], orientations, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(columns["t_arrival"], columns["t_sensor"] + 0.004)
+
+
+def test_a_window_too_short_for_one_sample_gives_none(pendulum):
+    assert simulate_tracker(pendulum, TrackerConfig(phase_s=0.005), 0.0, 0.004, seed=0) == []
+
+
+@pytest.mark.parametrize("t_start, t_end", [(-0.1, 1.0), (0.0, 30.5)])
+def test_a_window_outside_the_pendulum_raises(pendulum, t_start, t_end):
+    with pytest.raises(ConfigError, match="not inside the pendulum"):
+        simulate_tracker(pendulum, TrackerConfig(), t_start, t_end, seed=0)
+
+
+def test_an_empty_window_raises(pendulum):
+    with pytest.raises(ConfigError, match="t_end > t_start"):
+        simulate_tracker(pendulum, TrackerConfig(), 1.0, 1.0, seed=0)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(rate_hz=0.0), "rate_hz must be a positive finite"),
+        (dict(rate_hz=math.inf), "rate_hz must be a positive finite"),
+        (dict(position_noise_m=-1e-3), "position_noise_m must be a finite number >= 0"),
+        (dict(orientation_noise_deg=math.nan), "orientation_noise_deg must be a finite number >= 0"),
+        (dict(transport_delay_s=-0.001), "transport_delay_s must be a finite number >= 0"),
+        (dict(jitter_s=math.inf), "jitter_s must be a finite number >= 0"),
+        (dict(dropout=1.0), r"dropout must be a probability in \[0, 1\)"),
+        (dict(dropout=-0.1), r"dropout must be a probability in \[0, 1\)"),
+        (dict(rate_hz=100.0, phase_s=0.01), r"phase_s must be in \[0, 1 / rate_hz\)"),
+        (dict(phase_s=-0.001), r"phase_s must be in \[0, 1 / rate_hz\)"),
+    ],
+)
+def test_config_rejects_bad_values(kwargs, message):
+    with pytest.raises(ConfigError, match=message):
+        TrackerConfig(**kwargs)
+
+
+def _assert_same_samples(read: list[PoseSample], written: list[PoseSample]) -> None:
+    assert len(read) == len(written)
+    for a, b in zip(read, written):
+        assert a.t_sensor == b.t_sensor
+        assert a.t_arrival == b.t_arrival
+        np.testing.assert_array_equal(a.position, b.position)
+        np.testing.assert_array_equal(a.orientation, b.orientation)
+
+
+def test_csv_round_trip_is_exact(pendulum, tmp_path):
+    samples = simulate_tracker(pendulum, TrackerConfig(dropout=0.1), 0.0, 2.0, seed=2)
+    path = tmp_path / "tracker.csv"
+    write_tracker_csv(path, samples)
+    assert path.read_text().splitlines()[0] == CSV_HEADER
+    _assert_same_samples(read_tracker_csv(path), samples)
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    times=st.lists(st.floats(allow_nan=False, allow_infinity=False), min_size=2, max_size=2),
+    position=st.lists(st.floats(allow_nan=False, allow_infinity=False), min_size=3, max_size=3),
+)
+def test_csv_round_trip_is_exact_for_any_finite_values(tmp_path_factory, times, position):
+    sample = PoseSample(times[0], times[1], np.array(position), np.array([0.5, -0.5, 0.5, 0.5]))
+    path = tmp_path_factory.mktemp("csv") / "tracker.csv"
+    write_tracker_csv(path, [sample])
+    _assert_same_samples(read_tracker_csv(path), [sample])
+
+
+def test_abandoned_writer_leaves_a_readable_file(pendulum, tmp_path):
+    samples = simulate_tracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=3)
+    path = tmp_path / "tracker.csv"
+    writer = TrackerCsvWriter(path)
+    try:
+        for sample in samples[:5]:
+            writer.write(sample)
+        _assert_same_samples(read_tracker_csv(path), samples[:5])
+    finally:
+        writer.close()
+
+
+def test_a_row_cut_short_at_the_end_is_skipped(pendulum, tmp_path):
+    samples = simulate_tracker(pendulum, TrackerConfig(), 0.0, 0.1, seed=3)
+    path = tmp_path / "tracker.csv"
+    write_tracker_csv(path, samples)
+    text = path.read_text()
+    path.write_text(text[: text.rindex("\n", 0, -1) + 12])
+    _assert_same_samples(read_tracker_csv(path), samples[:-1])
+
+
+def test_writer_refuses_to_replace_a_file_unless_told(pendulum, tmp_path):
+    samples = simulate_tracker(pendulum, TrackerConfig(), 0.0, 0.1, seed=3)
+    path = tmp_path / "tracker.csv"
+    write_tracker_csv(path, samples)
+    with pytest.raises(RigError, match="already exists"):
+        write_tracker_csv(path, samples[:2])
+    write_tracker_csv(path, samples[:2], overwrite=True)
+    _assert_same_samples(read_tracker_csv(path), samples[:2])
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("t,x,y\n", "not a tracker CSV file"),
+        ("", "not a tracker CSV file"),
+        (CSV_HEADER + "\n0,0,0,0,0,1,0,0\n", "line 2: expected 9 comma-separated numbers, got 8"),
+        (CSV_HEADER + "\n0,0,0,0,0,1,0,0,0\n0,0,0,0,zero,1,0,0,0\n", "line 3: could not convert"),
+        (CSV_HEADER + "\n0,0,0,0,0,2,0,0,0\n", "line 2: .*unit quaternion"),
+    ],
+)
+def test_reading_a_malformed_file_names_the_problem(tmp_path, text, message):
+    path = tmp_path / "tracker.csv"
+    path.write_text(text)
+    with pytest.raises(RigError, match=message):
+        read_tracker_csv(path)
+
+
+def test_reading_a_missing_file_raises(tmp_path):
+    with pytest.raises(RigError, match="cannot read tracker samples"):
+        read_tracker_csv(tmp_path / "absent.csv")
