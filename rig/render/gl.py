@@ -1,0 +1,233 @@
+"""OpenGL helpers shared by the rig's renderers: context, meshes, load geometry, shaders, readback.
+
+Depth is partitioned so that the tracked sphere is always in front of the load geometry: the
+sphere's vertex shader squeezes clip-space depth into the front half of the depth range
+(NDC z in [-1, 0]) and the load triangles live in the back half (NDC z in (0, 1)). The load
+therefore costs real rasterisation and depth testing but never occludes the sphere, whatever
+`world_to_clip` is.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from rig.errors import ConfigError, RigError
+from rig.render.protocol import RenderSetup
+
+GL_VERSION = 330
+
+LOAD_TRIANGLE_HALF_SIZE = 0.04
+"""Half-extent (NDC units) of the box each load triangle's vertices are drawn from."""
+
+LOAD_DEPTH_RANGE = (0.2, 0.95)
+"""NDC depth of the load triangles: inside the back half of the range, which the sphere never uses."""
+
+LOAD_MAX_INTENSITY = 0.1
+"""Brightest a load triangle gets (the farthest are darkest): dim beside the sphere's >= 0.6."""
+
+SPHERE_AMBIENT = 0.6
+SPHERE_DIFFUSE = 0.4
+
+
+def create_context() -> moderngl.Context:
+    """A headless OpenGL 3.3 context through EGL.
+
+    The same EGL path uses a real GPU where its driver provides EGL (NVIDIA, Mesa hardware
+    drivers) and Mesa's llvmpipe software rasteriser elsewhere. On a machine with several EGL
+    devices, the environment variable GLCONTEXT_DEVICE_INDEX (read by glcontext, moderngl's context
+    loader) chooses which one.
+
+    Each renderer owns its context, so several may exist in one thread: wrap GL work on one in
+    `with ctx:`, which makes it current and restores the previous one afterwards.
+    """
+    try:
+        return moderngl.create_standalone_context(backend="egl", require=GL_VERSION)
+    except Exception as exc:
+        raise RigError(
+            f"could not create a headless OpenGL {GL_VERSION // 100}.{GL_VERSION % 100 // 10} context "
+            f"through EGL ({type(exc).__name__}: {exc}); install an EGL driver (e.g. Mesa's libegl1 "
+            "and libgl1-mesa-dri for software rendering) or set GLCONTEXT_DEVICE_INDEX to a working "
+            "EGL device"
+        ) from exc
+
+
+def check_setup(setup: RenderSetup, ctx: moderngl.Context) -> None:
+    """Raise ConfigError if `setup` asks for something invalid or more than `ctx` can draw."""
+    for what, value in (("width", setup.width), ("height", setup.height)):
+        if not isinstance(value, (int, np.integer)) or value < 1:
+            raise ConfigError(f"render {what} must be a positive whole number of pixels, got {value!r}")
+    max_size = int(ctx.info["GL_MAX_RENDERBUFFER_SIZE"])
+    if setup.width > max_size or setup.height > max_size:
+        raise ConfigError(
+            f"render size {setup.width}x{setup.height} exceeds this OpenGL's limit of {max_size} pixels a side"
+        )
+    m = np.asarray(setup.world_to_clip)
+    if m.shape != (4, 4) or not np.issubdtype(m.dtype, np.number) or not np.isfinite(m).all():
+        raise ConfigError(f"world_to_clip must be a finite 4x4 matrix, got shape {m.shape}")
+    if not (np.isfinite(setup.sphere_radius_m) and setup.sphere_radius_m > 0):
+        raise ConfigError(f"sphere_radius_m must be a positive number of metres, got {setup.sphere_radius_m!r}")
+    if not isinstance(setup.scene_triangles, (int, np.integer)) or setup.scene_triangles < 0:
+        raise ConfigError(
+            f"scene_triangles must be a whole number >= 0, got {setup.scene_triangles!r}"
+        )
+    for what, value in (("app_frame_ms", setup.app_frame_ms), ("warp_ms", setup.warp_ms)):
+        if value is not None and not (np.isfinite(value) and value >= 0):
+            raise ConfigError(f"{what} must be a time >= 0 in milliseconds or None to measure it, got {value!r}")
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """An indexed triangle mesh: float32 vertices and unit normals (V, 3), uint32 indices (T, 3)."""
+
+    vertices: np.ndarray
+    normals: np.ndarray
+    indices: np.ndarray
+
+
+def sphere_mesh(radius: float, stacks: int = 32, slices: int = 64) -> Mesh:
+    """A UV sphere of `radius` centred at the origin, with `stacks` latitude bands of `slices` quads.
+
+    Poles are rows of coincident vertices, so every band is `slices` quads (two triangles each,
+    degenerate at the poles). The silhouette is a regular polygon, symmetric about the centre.
+    """
+    if stacks < 2 or slices < 3:
+        raise ConfigError(f"a sphere mesh needs stacks >= 2 and slices >= 3, got {stacks} and {slices}")
+    polar = np.linspace(0.0, np.pi, stacks + 1)
+    azimuth = np.linspace(0.0, 2.0 * np.pi, slices + 1)
+    p, a = np.meshgrid(polar, azimuth, indexing="ij")
+    normals = np.stack([np.sin(p) * np.cos(a), np.cos(p), np.sin(p) * np.sin(a)], axis=-1).reshape(-1, 3)
+    row = slices + 1
+    i, j = np.meshgrid(np.arange(stacks), np.arange(slices), indexing="ij")
+    corner = (i * row + j).ravel()
+    quads = np.stack([corner, corner + row, corner + row + 1, corner + 1], axis=-1)
+    indices = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    return Mesh(
+        vertices=(radius * normals).astype(np.float32),
+        normals=normals.astype(np.float32),
+        indices=indices.astype(np.uint32),
+    )
+
+
+def load_triangles(count: int, seed: int) -> np.ndarray:
+    """`count` small random triangles in NDC, shape (count, 3, 3) float32, deterministic for `seed`.
+
+    Centres are uniform over the screen, vertices within LOAD_TRIANGLE_HALF_SIZE of their centre,
+    and each triangle is flat at a depth drawn from LOAD_DEPTH_RANGE. Triangles come far to near,
+    so every fragment passes the depth test and is shaded and written: the GL cost grows linearly
+    with `count` instead of levelling off as early depth rejection would make it. Memory is 36
+    bytes a triangle (5 million: 180 MB, plus the GL driver's copy).
+    """
+    if count < 0:
+        raise ConfigError(f"the load triangle count must be >= 0, got {count}")
+    rng = np.random.default_rng(seed)
+    triangles = np.empty((count, 3, 3), dtype=np.float32)
+    centres = rng.uniform(-1.0, 1.0, size=(count, 1, 2)).astype(np.float32)
+    offsets = rng.uniform(-LOAD_TRIANGLE_HALF_SIZE, LOAD_TRIANGLE_HALF_SIZE, size=(count, 3, 2)).astype(np.float32)
+    triangles[:, :, :2] = centres + offsets
+    depth = np.sort(rng.uniform(*LOAD_DEPTH_RANGE, size=count).astype(np.float32))[::-1]
+    triangles[:, :, 2] = depth[:, np.newaxis]
+    return triangles
+
+
+def headlight_direction(world_to_clip: np.ndarray) -> np.ndarray:
+    """The projection centre of `world_to_clip` in homogeneous world coordinates, shape (4,) float64.
+
+    It is the point that clip x, y and w all send to zero: the eye (w = 1) for a perspective
+    matrix, a direction (w = 0) towards the viewer for an orthographic one. Lighting from it
+    shades the sphere symmetrically about its centre in the image.
+    """
+    m = np.asarray(world_to_clip, dtype=np.float64)
+    _, _, vt = np.linalg.svd(m[[0, 1, 3]])
+    eye = vt[-1]
+    if abs(eye[3]) > 1e-12 * np.abs(eye[:3]).max():
+        return eye / eye[3]
+    # Towards the viewer is where NDC depth falls (clip w does not change along this direction).
+    toward_viewer = -1.0 if m[2] @ eye > 0 else 1.0
+    return toward_viewer * eye / np.linalg.norm(eye[:3])
+
+
+SPHERE_VERTEX_SHADER = """
+#version 330
+uniform mat4 world_to_clip;
+uniform vec3 centre;
+in vec3 in_vertex;
+in vec3 in_normal;
+out vec3 v_world;
+out vec3 v_normal;
+void main() {
+    v_world = centre + in_vertex;
+    v_normal = in_normal;
+    gl_Position = world_to_clip * vec4(v_world, 1.0);
+    // front half of the depth range: NDC z in [-1, 0] (near clipping unchanged; the far plane
+    // moves out, which a sphere inside the view never notices)
+    gl_Position.z = 0.5 * (gl_Position.z - gl_Position.w);
+}
+"""
+
+SPHERE_FRAGMENT_SHADER = """
+#version 330
+uniform vec4 eye;
+uniform float ambient;
+uniform float diffuse;
+in vec3 v_world;
+in vec3 v_normal;
+out vec4 f_colour;
+void main() {
+    vec3 to_eye = normalize(eye.xyz - eye.w * v_world);
+    float lit = ambient + diffuse * max(dot(normalize(v_normal), to_eye), 0.0);
+    f_colour = vec4(vec3(lit), 1.0);
+}
+"""
+
+LOAD_VERTEX_SHADER = """
+#version 330
+uniform float max_intensity;
+uniform vec2 depth_range;
+in vec3 in_ndc;
+out float v_intensity;
+void main() {
+    v_intensity = max_intensity * (depth_range.y - in_ndc.z) / (depth_range.y - depth_range.x);
+    gl_Position = vec4(in_ndc, 1.0);
+}
+"""
+
+LOAD_FRAGMENT_SHADER = """
+#version 330
+in float v_intensity;
+out vec4 f_colour;
+void main() {
+    f_colour = vec4(vec3(v_intensity), 1.0);
+}
+"""
+
+
+def sphere_program(ctx: moderngl.Context, world_to_clip: np.ndarray) -> moderngl.Program:
+    """The sphere's shader program, lit from the projection centre of `world_to_clip`."""
+    program = ctx.program(vertex_shader=SPHERE_VERTEX_SHADER, fragment_shader=SPHERE_FRAGMENT_SHADER)
+    # moderngl takes matrices column-major; numpy holds them row-major.
+    program["world_to_clip"].write(np.asarray(world_to_clip, dtype=np.float64).T.astype(np.float32).tobytes())
+    program["eye"].value = tuple(headlight_direction(world_to_clip))
+    program["ambient"].value = SPHERE_AMBIENT
+    program["diffuse"].value = SPHERE_DIFFUSE
+    return program
+
+
+def load_program(ctx: moderngl.Context) -> moderngl.Program:
+    """The load triangles' shader program: positions already in NDC, dimmer with depth."""
+    program = ctx.program(vertex_shader=LOAD_VERTEX_SHADER, fragment_shader=LOAD_FRAGMENT_SHADER)
+    program["max_intensity"].value = LOAD_MAX_INTENSITY
+    program["depth_range"].value = LOAD_DEPTH_RANGE
+    return program
+
+
+def read_rgb(framebuffer: moderngl.Framebuffer) -> np.ndarray:
+    """The framebuffer's colour as RGB uint8, shape (height, width, 3), row 0 at the top.
+
+    OpenGL returns rows bottom-up; this flips them into display (scan-out) order.
+    """
+    width, height = framebuffer.size
+    data = framebuffer.read(components=3, alignment=1)
+    return np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3)[::-1].copy()
