@@ -1,0 +1,145 @@
+"""Predictors that extrapolate from the newest samples: hold-last and slerp extrapolation.
+
+Both order samples by sensor time (`PoseSample.t_sensor`), the time the pose was true:
+
+* a sample older than the newest one is ignored, because it says nothing about where the pose is
+  going that the newer sample has not already said (a late packet, a re-sent measurement);
+* a sample at the newest one's time replaces it, because it arrived later.
+
+Both answer any finite time, before or after the newest sample.
+"""
+
+from __future__ import annotations
+
+import math
+
+from predictors import quaternion
+from predictors.errors import PredictorError
+from predictors.pose import Pose, PoseSample
+
+
+def _newest_or_raise(newest: PoseSample | None, name: str) -> PoseSample:
+    if newest is None:
+        raise PredictorError(f"predictor {name!r} has no sample yet; call update(sample) before predict(t)")
+    return newest
+
+
+def _finite_time(t: float, name: str) -> float:
+    try:
+        seconds = float(t)
+    except (TypeError, ValueError):
+        seconds = math.nan
+    if not math.isfinite(seconds):
+        raise PredictorError(f"predictor {name!r} was asked for time {t!r}; pass a finite time in seconds")
+    return seconds
+
+
+class HoldLast:
+    """No prediction: every answer is the newest sample's pose, stamped with the asked time.
+
+    The baseline every other predictor must beat. Parameters: none.
+    """
+
+    name = "hold"
+
+    def __init__(self) -> None:
+        self._newest: PoseSample | None = None
+
+    def update(self, sample: PoseSample) -> None:
+        if self._newest is None or sample.t_sensor >= self._newest.t_sensor:
+            self._newest = sample
+
+    def predict(self, t: float) -> Pose:
+        newest = _newest_or_raise(self._newest, self.name)
+        return Pose(_finite_time(t, self.name), newest.position, newest.orientation)
+
+    def reset(self) -> None:
+        self._newest = None
+
+
+class _Motion:
+    """Constant-velocity motion through two samples, anchored at the newer one (time t1).
+
+    At t the pose is p1 + (t - t1) v and the orientation is cos(phi) q1 + sin(phi) tangent with
+    phi = (t - t1) * rate: the great circle through q1 and q0, i.e. slerp(q0, q1, u) with
+    u = (t - t0) / (t1 - t0), taken the short way. Anchoring at the newer sample makes t = t1
+    return it exactly.
+    """
+
+    __slots__ = ("t1", "position", "velocity", "orientation", "tangent", "rate")
+
+    def __init__(self, older: PoseSample, newer: PoseSample) -> None:
+        dt = newer.t_sensor - older.t_sensor
+        # The great circle runs from q1 towards q0, so the future lies at negative phase.
+        half_angle, tangent = quaternion.great_circle(newer.orientation, older.orientation)
+        self.t1 = newer.t_sensor
+        self.position = newer.position
+        self.velocity = (newer.position - older.position) / dt
+        self.orientation = newer.orientation
+        self.tangent = tangent
+        self.rate = -float(half_angle) / dt
+
+    def at(self, t: float) -> Pose:
+        dt = t - self.t1
+        phase = dt * self.rate
+        orientation = math.cos(phase) * self.orientation + math.sin(phase) * self.tangent
+        return Pose(t, self.position + dt * self.velocity, orientation)
+
+
+class SlerpExtrapolator:
+    """Linear prediction from the two newest samples (Smit et al. 2010, section 3.2).
+
+    With samples (t0, p0, q0) and (t1, p1, q1), t0 < t1 by sensor time, the prediction for t is
+    position p0 + u (p1 - p0) and orientation slerp(q0, q1, u), u = (t - t0) / (t1 - t0): constant
+    linear and angular velocity, the rotation taken the short way (so q1 and -q1 predict alike).
+    With a single sample it holds that sample.
+
+    Parameters:
+        min_interval: seconds (> 0, default 1 microsecond). A sample less than this after the
+            newest one counts as a duplicate: it replaces the newest and the older, distinct
+            sample is kept, so the two samples used are always at least this far apart and a
+            repeated timestamp never divides by zero or amplifies jitter into a wild velocity.
+    """
+
+    name = "slerp"
+    _older: PoseSample | None
+    _newest: PoseSample | None
+    _motion: _Motion | None
+
+    def __init__(self, min_interval: float = 1e-6) -> None:
+        try:
+            min_interval = float(min_interval)
+        except (TypeError, ValueError):
+            raise PredictorError(f"slerp: min_interval must be seconds, got {min_interval!r}") from None
+        if not (math.isfinite(min_interval) and min_interval > 0.0):
+            raise PredictorError(
+                f"slerp: min_interval must be a positive number of seconds, got {min_interval!r}"
+            )
+        self.min_interval = min_interval
+        self.reset()
+
+    def update(self, sample: PoseSample) -> None:
+        newest = self._newest
+        if newest is not None:
+            step = sample.t_sensor - newest.t_sensor
+            if step < 0.0:
+                return
+            if step >= self.min_interval:
+                self._older = newest
+        self._newest = sample
+        self._motion = None
+
+    def predict(self, t: float) -> Pose:
+        newest = _newest_or_raise(self._newest, self.name)
+        t = _finite_time(t, self.name)
+        if self._older is None:
+            return Pose(t, newest.position, newest.orientation)
+        if self._motion is None:
+            self._motion = _Motion(self._older, newest)
+        return self._motion.at(t)
+
+    def reset(self) -> None:
+        self._older = None
+        self._newest = None
+        self._motion = None
+

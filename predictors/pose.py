@@ -1,0 +1,100 @@
+"""Pose types: the plain values that flow from tracker to predictor to renderer.
+
+Units and conventions (DESIGN.md): time in seconds on the rig clock, position in metres with shape
+(3,), orientation a unit quaternion (w, x, y, z), Hamilton convention, rotating body into world.
+
+Both types validate on construction and keep their own read-only float64 copies of the arrays, so
+a pose handed on cannot change under its receiver.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence, Union
+
+import numpy as np
+
+from predictors.errors import PredictorError
+
+FloatVector = Union[np.ndarray, Sequence[float]]
+
+_UNIT_TOLERANCE = 1e-6
+
+
+def _float_array(value: FloatVector, what: str) -> np.ndarray:
+    """A float64 copy of value, owned by the pose."""
+    try:
+        return np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise PredictorError(f"{what} must be numbers, got {value!r}") from None
+
+
+def _position(value: FloatVector, what: str) -> np.ndarray:
+    p = _float_array(value, f"{what}: position")
+    if p.shape != (3,):
+        raise PredictorError(f"{what}: position must have shape (3,), got {p.shape}")
+    if not np.isfinite(p).all():
+        raise PredictorError(f"{what}: position must be finite, got {p.tolist()}")
+    p.flags.writeable = False
+    return p
+
+
+def _orientation(value: FloatVector, what: str) -> np.ndarray:
+    q = _float_array(value, f"{what}: orientation")
+    if q.shape != (4,):
+        raise PredictorError(f"{what}: orientation must be a (w, x, y, z) quaternion, got shape {q.shape}")
+    if not np.isfinite(q).all():
+        raise PredictorError(f"{what}: orientation must be finite, got {q.tolist()}")
+    norm = math.sqrt(q @ q)
+    if abs(norm - 1.0) > _UNIT_TOLERANCE:
+        raise PredictorError(
+            f"{what}: orientation must be a unit quaternion, got norm {norm:.9g}; normalise it first"
+        )
+    q /= norm
+    q.flags.writeable = False
+    return q
+
+
+def _time(value: float, what: str) -> float:
+    try:
+        t = float(value)
+    except (TypeError, ValueError):
+        raise PredictorError(f"{what} must be a time in seconds, got {value!r}") from None
+    if not math.isfinite(t):
+        raise PredictorError(f"{what} must be a finite time in seconds, got {value!r}")
+    return t
+
+
+@dataclass(frozen=True, eq=False)
+class Pose:
+    """A pose at time `t` (s): position (m) and unit orientation quaternion (w, x, y, z)."""
+
+    t: float
+    position: np.ndarray
+    orientation: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "t", _time(self.t, "Pose.t"))
+        object.__setattr__(self, "position", _position(self.position, "Pose"))
+        object.__setattr__(self, "orientation", _orientation(self.orientation, "Pose"))
+
+
+@dataclass(frozen=True, eq=False)
+class PoseSample:
+    """A tracker measurement: when the sensor took it, when the host received it, and the pose."""
+
+    t_sensor: float
+    t_arrival: float
+    position: np.ndarray
+    orientation: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "t_sensor", _time(self.t_sensor, "PoseSample.t_sensor"))
+        object.__setattr__(self, "t_arrival", _time(self.t_arrival, "PoseSample.t_arrival"))
+        object.__setattr__(self, "position", _position(self.position, "PoseSample"))
+        object.__setattr__(self, "orientation", _orientation(self.orientation, "PoseSample"))
+
+    def pose(self) -> Pose:
+        """The measured pose, stamped with the sensor time."""
+        return Pose(self.t_sensor, self.position, self.orientation)

@@ -1,0 +1,48 @@
+"""predictors.make: predictors by name, with checked parameters; the package's public names."""
+
+import math
+
+import pytest
+
+import predictors
+from predictors import Predictor, PredictorError, make, names
+
+
+def test_public_names_import_from_the_package():
+    from predictors import Pose, PoseSample, PredictorError, make  # noqa: F401
+
+    assert predictors.quaternion.slerp is not None
+
+
+def test_known_names():
+    assert names() == ("hold", "slerp")
+
+
+@pytest.mark.parametrize("name", names())
+def test_make_returns_fresh_predictors(name):
+    first, second = make(name), make(name)
+    assert isinstance(first, Predictor)
+    assert first is not second
+
+
+def test_unknown_name_lists_the_known_ones():
+    with pytest.raises(PredictorError, match="unknown predictor 'kalman'; known predictors: hold, slerp"):
+        make("kalman")
+
+
+def test_unknown_parameter_lists_the_accepted_ones():
+    with pytest.raises(PredictorError, match="'slerp' has no parameter gain; it takes: min_interval"):
+        make("slerp", gain=2.0)
+    with pytest.raises(PredictorError, match="'hold' has no parameter min_interval; it takes: no parameters"):
+        make("hold", min_interval=1e-3)
+
+
+def test_parameters_reach_the_predictor():
+    assert make("slerp", min_interval=0.004).min_interval == 0.004
+    assert make("slerp").min_interval == 1e-6
+
+
+@pytest.mark.parametrize("bad", [0.0, -1e-3, math.nan, math.inf, "fast", None])
+def test_bad_min_interval_is_an_error(bad):
+    with pytest.raises(PredictorError, match="min_interval must be"):
+        make("slerp", min_interval=bad)
