@@ -6,8 +6,10 @@ drives it on the rig clock (virtual in simulation) and never looks inside it.
 Two kinds of frames exist, as in the seed papers' display-layer architecture:
 
 * **application frames** are rendered at the renderer's own pace. The session calls
-  `render_app_frame` when the previous one has been handed to the display; the renderer asks the
-  predictor (through `request.predict`) for the pose it wants, draws, and reports what that cost.
+  `render_app_frame` when the renderer is ready for the next one (a direct renderer: when the
+  previous frame has been shown; a warp client: as soon as the previous frame is finished); the
+  renderer asks the predictor (through `request.predict`) for the pose it wants, draws, and
+  reports what that cost. The frame counts as finished at `t_start + cost_s`.
 * **display frames** happen at every vertical blank. A renderer with `per_display_frame = True`
   (a warp renderer) composes a new image for each of them in `render_display_frame`; a renderer
   with `per_display_frame = False` (the direct renderer) returns its image with the application
@@ -71,10 +73,14 @@ class AppFrameResult:
 
 @dataclass(frozen=True)
 class DisplayFrameRequest:
+    """`app_frame` is the index of the newest application frame finished by now (-1: none yet);
+    a renderer must not show a newer one, even if it has already drawn it."""
+
     index: int
     t_vblank: float
     t_photon: float
     predict: PredictFn
+    app_frame: int
 
 
 @dataclass(frozen=True)

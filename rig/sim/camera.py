@@ -1,0 +1,140 @@
+"""A simulated high-speed camera filming the LED and the display.
+
+Each frame integrates the scene over its exposure by averaging `subsamples` instants (motion blur),
+adds a dark level and read noise, and saturates at 255 like an 8-bit sensor. The LED is a bright
+Gaussian spot whose core saturates; the display panel shows whatever each of its rows emits at
+each instant (the session works that out from the display's scan-out).
+
+Read noise is drawn from a bank of precomputed noise fields at random offsets: full per-pixel
+Gaussian draws would dominate the simulation's cost, and the analyser cannot tell the difference.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from rig.errors import ConfigError, RigError
+
+LED_SIGMA_PX = 2.2
+_NOISE_BANK_SIZE = 8
+_NOISE_PAD = 64
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    fps: float = 240.0
+    exposure_s: float | None = None
+    width: int = 640
+    height: int = 480
+    noise_dn: float = 2.0
+    dark_dn: float = 8.0
+    led_peak_dn: float = 900.0
+    display_black_dn: float = 6.0
+    display_white_dn: float = 190.0
+    subsamples: int = 8
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.fps) and 1.0 <= self.fps <= 10000.0):
+            raise ConfigError(f"camera frame rate must be 1-10000 fps, got {self.fps}")
+        if self.exposure_s is not None and not 0.0 < self.exposure_s <= 1.0 / self.fps:
+            raise ConfigError(
+                f"camera exposure must be positive and at most one frame interval ({1e3 / self.fps:.3f} ms), "
+                f"got {self.exposure_s * 1e3:.3f} ms"
+            )
+        if self.width < 64 or self.height < 48:
+            raise ConfigError(f"camera resolution must be at least 64x48, got {self.width}x{self.height}")
+        if self.noise_dn < 0 or self.subsamples < 1:
+            raise ConfigError("camera noise must be >= 0 and subsamples >= 1")
+
+    @property
+    def exposure(self) -> float:
+        """Exposure time (s); the whole frame interval unless set.
+
+        A full-interval exposure (a 360-degree shutter) is what the video method needs: the
+        display's staircase has components at multiples of the camera rate that a shorter exposure
+        aliases onto the swing frequency, biasing the measured phase by up to a millisecond when
+        camera and display rates are commensurate (240 fps filming 60 Hz).
+        """
+        return self.exposure_s if self.exposure_s is not None else 1.0 / self.fps
+
+    def subsample_offsets(self) -> np.ndarray:
+        """Instants within the exposure (s from the frame's start) that are averaged."""
+        return (np.arange(self.subsamples) + 0.5) / self.subsamples * self.exposure
+
+
+class CameraSensor:
+    """Turns the light arriving during one exposure into an 8-bit image."""
+
+    def __init__(self, config: CameraConfig, seed: int) -> None:
+        self.config = config
+        self._rng = np.random.default_rng(seed)
+        shape = (_NOISE_BANK_SIZE, config.height + _NOISE_PAD, config.width + _NOISE_PAD)
+        self._noise = (self._rng.standard_normal(shape, dtype=np.float32) * config.noise_dn).astype(np.float32)
+
+    def expose(
+        self,
+        led_px: np.ndarray,
+        panel: np.ndarray,
+        panel_rect: tuple[int, int, int, int],
+    ) -> np.ndarray:
+        """One frame: LED positions (S, 2) in pixels at each sub-instant, and the panel's mean light.
+
+        `panel` is the display's light averaged over the exposure, in camera digital numbers,
+        shape (h, w) of `panel_rect` = (x, y, w, h).
+        """
+        c = self.config
+        image = np.full((c.height, c.width), c.dark_dn, dtype=np.float32)
+        px, py, pw, ph = panel_rect
+        image[py : py + ph, px : px + pw] += panel
+        self._add_led(image, led_px)
+        k = self._rng.integers(_NOISE_BANK_SIZE)
+        oy, ox = self._rng.integers(_NOISE_PAD, size=2)
+        image += self._noise[k, oy : oy + c.height, ox : ox + c.width]
+        return np.clip(np.rint(image), 0, 255).astype(np.uint8)
+
+    def _add_led(self, image: np.ndarray, led_px: np.ndarray) -> None:
+        reach = 5.0 * LED_SIGMA_PX
+        x0 = int(max(0, np.floor(led_px[:, 0].min() - reach)))
+        x1 = int(min(image.shape[1], np.ceil(led_px[:, 0].max() + reach)))
+        y0 = int(max(0, np.floor(led_px[:, 1].min() - reach)))
+        y1 = int(min(image.shape[0], np.ceil(led_px[:, 1].max() + reach)))
+        if x1 <= x0 or y1 <= y0:
+            return
+        xs = np.arange(x0, x1, dtype=np.float32) + 0.5
+        ys = np.arange(y0, y1, dtype=np.float32) + 0.5
+        gx = np.exp(-0.5 * ((xs[None, :] - led_px[:, 0:1]) / LED_SIGMA_PX) ** 2)
+        gy = np.exp(-0.5 * ((ys[None, :] - led_px[:, 1:2]) / LED_SIGMA_PX) ** 2)
+        spot = np.einsum("sy,sx->yx", gy, gx) * (self.config.led_peak_dn / len(led_px))
+        image[y0:y1, x0:x1] += spot.astype(np.float32)
+
+
+class VideoFileWriter:
+    """Writes 8-bit grey frames to an MJPEG AVI: a codec every OpenCV build reads back."""
+
+    FOURCC = "MJPG"
+    QUALITY = 95
+
+    def __init__(self, path: Path, fps: float, width: int, height: int) -> None:
+        self.path = Path(path)
+        self._writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*self.FOURCC), fps, (width, height), True)
+        if not self._writer.isOpened():
+            raise RigError(f"cannot write video {self.path}: OpenCV has no {self.FOURCC} writer here")
+        self._writer.set(cv2.VIDEOWRITER_PROP_QUALITY, self.QUALITY)
+        self.frames = 0
+
+    def write(self, grey: np.ndarray) -> None:
+        self._writer.write(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR))
+        self.frames += 1
+
+    def close(self) -> None:
+        self._writer.release()
+
+    def __enter__(self) -> "VideoFileWriter":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
