@@ -1,24 +1,28 @@
-# Two entry points for a newcomer: `make demo` and `make test`. Both build the virtual
-# environment from the pinned constraints first, so a fresh machine gets the same packages.
+# Two entry points for a newcomer: `make demo` and `make test`. Both first install what is missing:
+# Debian packages (as root; otherwise the command to run is printed) and a virtual environment
+# with the pinned Python packages of constraints.txt.
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+SYSTEM_PACKAGE_LISTS := system-packages.txt $(wildcard firmware/system-packages.txt)
 
-.PHONY: demo test venv clean
+.PHONY: demo test system venv clean
+
+system:
+	@scripts/install-system-packages.sh $(SYSTEM_PACKAGE_LISTS)
 
 venv: $(STAMP)
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -c constraints.txt -e '.[test]'
 	touch $(STAMP)
 
-demo: $(STAMP)
+demo: system $(STAMP)
 	$(BIN)/rig demo --out out/demo
 
-test: $(STAMP)
+test: system $(STAMP)
 	$(BIN)/python -m pytest -q
 
 clean:
