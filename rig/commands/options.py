@@ -1,0 +1,94 @@
+"""Option parsers shared by the subcommands: each rejects bad values with a message naming the range."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+
+def positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
+    return value
+
+
+def non_negative_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"must be zero or a positive number, got {text}")
+    return value
+
+
+def non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
+    return value
+
+
+def roi(text: str) -> tuple[int, int, int, int]:
+    """X,Y,W,H in pixels."""
+    parts = text.split(",")
+    try:
+        x, y, w, h = (int(p) for p in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected X,Y,W,H as four whole numbers of pixels, got {text!r}") from None
+    if x < 0 or y < 0 or w <= 0 or h <= 0:
+        raise argparse.ArgumentTypeError(f"X and Y must be >= 0 and W, H > 0, got {text}")
+    return (x, y, w, h)
+
+
+def _scalar(text: str) -> Any:
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    return text
+
+
+def predictor_spec(text: str) -> tuple[str, dict[str, Any]]:
+    """NAME[:key=value,...] or NAME:FILE.json (parameters from a file, such as `rig tune` writes)."""
+    name, _, rest = text.partition(":")
+    if not name:
+        raise argparse.ArgumentTypeError(f"expected NAME[:key=value,...], got {text!r}")
+    if not rest:
+        return name, {}
+    if rest.endswith(".json"):
+        path = Path(rest)
+        try:
+            params = json.loads(path.read_text())
+        except (OSError, ValueError) as error:
+            raise argparse.ArgumentTypeError(f"cannot read predictor parameters from {path}: {error}") from None
+        if not isinstance(params, dict):
+            raise argparse.ArgumentTypeError(f"{path} must hold a JSON object of parameters")
+        return name, params.get("params", params)
+    params: dict[str, Any] = {}
+    for item in rest.split(","):
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            raise argparse.ArgumentTypeError(f"predictor parameters must be key=value, got {item!r} in {text!r}")
+        params[key.strip()] = _scalar(value.strip())
+    return name, params
+
+
+def app_frame_cost(text: str) -> float | None:
+    """A modelled cost in ms, or 'measured' for the real GL render time."""
+    if text == "measured":
+        return None
+    return positive_float(text)

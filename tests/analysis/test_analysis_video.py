@@ -1,0 +1,107 @@
+"""Opening videos and frame arrays: frames, frame rates, and the errors a user can cause."""
+
+import cv2
+import numpy as np
+import pytest
+
+from analysis import AnalysisError, analyse
+from analysis.video import FrameArray, VideoFile, open_frames
+
+
+def moving_squares(count: int = 12, width: int = 48, height: int = 32) -> np.ndarray:
+    frames = np.full((count, height, width), 20, dtype=np.uint8)
+    for i in range(count):
+        frames[i, 8:16, 2 + 3 * i : 10 + 3 * i] = 200
+    return frames
+
+
+def write_video(path, frames: np.ndarray, fourcc: str, fps: float = 240.0):
+    writer = cv2.VideoWriter(
+        str(path), cv2.VideoWriter_fourcc(*fourcc), fps, (frames.shape[2], frames.shape[1])
+    )
+    for frame in frames:
+        writer.write(cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR))
+    writer.release()
+    return path
+
+
+def test_mjpg_file_gives_grey_frames_and_its_frame_rate(tmp_path):
+    frames = moving_squares()
+    video = open_frames(write_video(tmp_path / "clip.avi", frames, "MJPG"))
+    decoded = np.stack(list(video.frames()))
+    assert video.fps == 240.0
+    assert video.frame_size == (48, 32)
+    assert video.frame_count == 12
+    assert decoded.dtype == np.uint8 and decoded.shape == frames.shape
+    assert np.abs(decoded.astype(int) - frames).mean() < 2.0
+
+
+def test_lossless_file_read_the_ordinary_way_is_exact(tmp_path):
+    frames = moving_squares()
+    video = VideoFile(write_video(tmp_path / "clip.avi", frames, "FFV1", fps=90.0))
+    assert video.fps == 90.0
+    assert np.array_equal(np.stack(list(video.frames())), frames)
+
+
+def test_explicit_frame_rate_wins_over_the_container(tmp_path):
+    video = open_frames(write_video(tmp_path / "clip.avi", moving_squares(), "MJPG"), fps=120.0)
+    assert video.fps == 120.0
+
+
+def test_missing_file_raises(tmp_path):
+    with pytest.raises(AnalysisError, match="does not exist"):
+        analyse(tmp_path / "nowhere.avi")
+
+
+def test_file_that_is_not_a_video_raises(tmp_path):
+    path = tmp_path / "notes.avi"
+    path.write_text("these are my notes, not a video\n" * 20)
+    with pytest.raises(AnalysisError, match="cannot be read as a video"):
+        analyse(path)
+
+
+def test_video_without_frames_raises(tmp_path):
+    path = tmp_path / "empty.avi"
+    cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 240.0, (48, 32)).release()
+    with pytest.raises(AnalysisError, match="no frames"):
+        analyse(path)
+
+
+def test_empty_array_raises():
+    with pytest.raises(AnalysisError, match="empty"):
+        analyse(np.zeros((0, 32, 48), dtype=np.uint8), fps=240.0)
+
+
+@pytest.mark.parametrize("shape", [(32, 48), (4, 32, 48, 2)], ids=["one frame", "two channels"])
+def test_array_of_the_wrong_shape_raises(shape):
+    with pytest.raises(AnalysisError, match="shape"):
+        open_frames(np.zeros(shape, dtype=np.uint8), fps=240.0)
+
+
+def test_array_without_frame_rate_raises():
+    with pytest.raises(AnalysisError, match="fps"):
+        analyse(moving_squares())
+
+
+@pytest.mark.parametrize("fps", [0.0, -30.0, float("nan"), float("inf")])
+def test_frame_rate_that_is_not_positive_raises(fps):
+    with pytest.raises(AnalysisError, match="frame rate"):
+        open_frames(moving_squares(), fps=fps)
+
+
+def test_source_of_another_kind_raises():
+    with pytest.raises(AnalysisError, match="video file path or a numpy array"):
+        open_frames([[1, 2], [3, 4]], fps=30.0)
+
+
+def test_bgr_array_frames_are_made_grey():
+    grey = moving_squares()
+    frames = list(FrameArray(np.repeat(grey[..., None], 3, axis=3), 30.0).frames())
+    assert np.array_equal(np.stack(frames), grey)
+
+
+def test_float_array_frames_stay_float():
+    grey = moving_squares().astype(np.float64) / 255
+    frames = list(FrameArray(grey, 30.0).frames())
+    assert frames[0].dtype == np.float32
+    assert np.allclose(np.stack(frames), grey, atol=1e-7)
