@@ -1,17 +1,41 @@
-"""Pose prediction: pose types, quaternion maths and the predictors that hide latency.
+"""Pose prediction: pose types, quaternion maths, the predictors that hide latency, and their scoring.
 
     from predictors import Pose, PoseSample, make
 
-    predictor = make("slerp")
+    predictor = make("kalman-cv")
     predictor.update(PoseSample(t_sensor=0.0, t_arrival=0.002, position=p, orientation=q))
     pose = predictor.predict(0.016)
 
-`predictors.quaternion` holds the vectorised quaternion maths, (w, x, y, z) Hamilton.
+Predictors (`names()`): hold, slerp, kalman-cv, kalman-ca, desp, auto; each class documents its
+parameters and their units. `evaluate` scores one on a `Trace` (`read_trace` reads CSV files).
+`predictors.quaternion` holds the vectorised quaternion maths, (w, x, y, z) Hamilton;
+`predictors.synthetic` generates head motion. Tuning (`predictors.tuning`) and the JAX twins of the
+filters (`predictors.jax_filters`) import JAX, so they are imported only by name, never from here:
+the real-time path stays free of it.
 """
 
 from predictors import quaternion
 from predictors.errors import PredictorError
+from predictors.evaluation import Evaluation, HorizonScore, evaluate
+from predictors.params_file import read_params, write_params
 from predictors.pose import Pose, PoseSample
 from predictors.registry import Predictor, make, names
+from predictors.trace import Trace, read_trace, write_trace
 
-__all__ = ["Pose", "PoseSample", "Predictor", "PredictorError", "make", "names", "quaternion"]
+__all__ = [
+    "Evaluation",
+    "HorizonScore",
+    "Pose",
+    "PoseSample",
+    "Predictor",
+    "PredictorError",
+    "Trace",
+    "evaluate",
+    "make",
+    "names",
+    "quaternion",
+    "read_params",
+    "read_trace",
+    "write_params",
+    "write_trace",
+]

@@ -13,25 +13,10 @@ from __future__ import annotations
 
 import math
 
-from predictors import quaternion
+from predictors import scalar_quaternion as squat
+from predictors.checks import finite_time, no_sample_yet, read_sample
 from predictors.errors import PredictorError
 from predictors.pose import Pose, PoseSample
-
-
-def _newest_or_raise(newest: PoseSample | None, name: str) -> PoseSample:
-    if newest is None:
-        raise PredictorError(f"predictor {name!r} has no sample yet; call update(sample) before predict(t)")
-    return newest
-
-
-def _finite_time(t: float, name: str) -> float:
-    try:
-        seconds = float(t)
-    except (TypeError, ValueError):
-        seconds = math.nan
-    if not math.isfinite(seconds):
-        raise PredictorError(f"predictor {name!r} was asked for time {t!r}; pass a finite time in seconds")
-    return seconds
 
 
 class HoldLast:
@@ -44,17 +29,26 @@ class HoldLast:
 
     def __init__(self) -> None:
         self._newest: PoseSample | None = None
+        self._t = 0.0
 
     def update(self, sample: PoseSample) -> None:
-        if self._newest is None or sample.t_sensor >= self._newest.t_sensor:
+        t, _, _ = read_sample(sample, self.name)
+        if self._newest is None or t >= self._t:
             self._newest = sample
+            self._t = t
 
     def predict(self, t: float) -> Pose:
-        newest = _newest_or_raise(self._newest, self.name)
-        return Pose(_finite_time(t, self.name), newest.position, newest.orientation)
+        newest = self._newest
+        if newest is None:
+            raise no_sample_yet(self.name)
+        return Pose(finite_time(t, self.name), newest.position, newest.orientation)
 
     def reset(self) -> None:
         self._newest = None
+
+
+# (t_sensor, position, orientation) of a sample, as floats.
+_Reading = tuple[float, tuple[float, float, float], squat.Quaternion]
 
 
 class _Motion:
@@ -63,27 +57,36 @@ class _Motion:
     At t the pose is p1 + (t - t1) v and the orientation is cos(phi) q1 + sin(phi) tangent with
     phi = (t - t1) * rate: the great circle through q1 and q0, i.e. slerp(q0, q1, u) with
     u = (t - t0) / (t1 - t0), taken the short way. Anchoring at the newer sample makes t = t1
-    return it exactly.
+    return it exactly. Plain floats (`predictors.scalar_quaternion`): this runs once per display
+    frame.
     """
 
     __slots__ = ("t1", "position", "velocity", "orientation", "tangent", "rate")
 
-    def __init__(self, older: PoseSample, newer: PoseSample) -> None:
-        dt = newer.t_sensor - older.t_sensor
+    def __init__(self, older: _Reading, newer: _Reading) -> None:
+        t0, p0, q0 = older
+        t1, p1, q1 = newer
+        dt = t1 - t0
         # The great circle runs from q1 towards q0, so the future lies at negative phase.
-        half_angle, tangent = quaternion.great_circle(newer.orientation, older.orientation)
-        self.t1 = newer.t_sensor
-        self.position = newer.position
-        self.velocity = (newer.position - older.position) / dt
-        self.orientation = newer.orientation
+        half_angle, tangent = squat.great_circle(q1, q0)
+        self.t1 = t1
+        self.position = p1
+        self.velocity = ((p1[0] - p0[0]) / dt, (p1[1] - p0[1]) / dt, (p1[2] - p0[2]) / dt)
+        self.orientation = q1
         self.tangent = tangent
-        self.rate = -float(half_angle) / dt
+        self.rate = -half_angle / dt
 
     def at(self, t: float) -> Pose:
         dt = t - self.t1
         phase = dt * self.rate
-        orientation = math.cos(phase) * self.orientation + math.sin(phase) * self.tangent
-        return Pose(t, self.position + dt * self.velocity, orientation)
+        c, s = math.cos(phase), math.sin(phase)
+        (w, x, y, z), (tw, tx, ty, tz) = self.orientation, self.tangent
+        (px, py, pz), (vx, vy, vz) = self.position, self.velocity
+        return Pose(
+            t,
+            (px + dt * vx, py + dt * vy, pz + dt * vz),
+            (c * w + s * tw, c * x + s * tx, c * y + s * ty, c * z + s * tz),
+        )
 
 
 class SlerpExtrapolator:
@@ -102,8 +105,8 @@ class SlerpExtrapolator:
     """
 
     name = "slerp"
-    _older: PoseSample | None
-    _newest: PoseSample | None
+    _older: _Reading | None
+    _newest: _Reading | None
     _motion: _Motion | None
 
     def __init__(self, min_interval: float = 1e-6) -> None:
@@ -119,21 +122,24 @@ class SlerpExtrapolator:
         self.reset()
 
     def update(self, sample: PoseSample) -> None:
+        reading = read_sample(sample, self.name)
         newest = self._newest
         if newest is not None:
-            step = sample.t_sensor - newest.t_sensor
+            step = reading[0] - newest[0]
             if step < 0.0:
                 return
             if step >= self.min_interval:
                 self._older = newest
-        self._newest = sample
+        self._newest = reading
         self._motion = None
 
     def predict(self, t: float) -> Pose:
-        newest = _newest_or_raise(self._newest, self.name)
-        t = _finite_time(t, self.name)
+        newest = self._newest
+        if newest is None:
+            raise no_sample_yet(self.name)
+        t = finite_time(t, self.name)
         if self._older is None:
-            return Pose(t, newest.position, newest.orientation)
+            return Pose(t, newest[1], newest[2])
         if self._motion is None:
             self._motion = _Motion(self._older, newest)
         return self._motion.at(t)
@@ -142,4 +148,3 @@ class SlerpExtrapolator:
         self._older = None
         self._newest = None
         self._motion = None
-

@@ -4,12 +4,15 @@ Units and conventions (DESIGN.md): time in seconds on the rig clock, position in
 (3,), orientation a unit quaternion (w, x, y, z), Hamilton convention, rotating body into world.
 
 Both types validate on construction and keep their own read-only float64 copies of the arrays, so
-a pose handed on cannot change under its receiver.
+a pose handed on cannot change under its receiver. Validation reads the few components as Python
+floats rather than calling numpy reductions: a pose is built once per display frame inside the
+real-time budget, and numpy's per-call overhead on 3- and 4-vectors would be most of its cost.
 """
 
 from __future__ import annotations
 
 import math
+from math import isfinite
 from dataclasses import dataclass
 from typing import Sequence, Union
 
@@ -34,8 +37,9 @@ def _position(value: FloatVector, what: str) -> np.ndarray:
     p = _float_array(value, f"{what}: position")
     if p.shape != (3,):
         raise PredictorError(f"{what}: position must have shape (3,), got {p.shape}")
-    if not np.isfinite(p).all():
-        raise PredictorError(f"{what}: position must be finite, got {p.tolist()}")
+    x, y, z = p.tolist()
+    if not (isfinite(x) and isfinite(y) and isfinite(z)):
+        raise PredictorError(f"{what}: position must be finite, got {[x, y, z]}")
     p.flags.writeable = False
     return p
 
@@ -44,14 +48,16 @@ def _orientation(value: FloatVector, what: str) -> np.ndarray:
     q = _float_array(value, f"{what}: orientation")
     if q.shape != (4,):
         raise PredictorError(f"{what}: orientation must be a (w, x, y, z) quaternion, got shape {q.shape}")
-    if not np.isfinite(q).all():
-        raise PredictorError(f"{what}: orientation must be finite, got {q.tolist()}")
-    norm = math.sqrt(q @ q)
+    w, x, y, z = q.tolist()
+    if not (isfinite(w) and isfinite(x) and isfinite(y) and isfinite(z)):
+        raise PredictorError(f"{what}: orientation must be finite, got {[w, x, y, z]}")
+    norm = math.sqrt(w * w + x * x + y * y + z * z)
     if abs(norm - 1.0) > _UNIT_TOLERANCE:
         raise PredictorError(
             f"{what}: orientation must be a unit quaternion, got norm {norm:.9g}; normalise it first"
         )
-    q /= norm
+    if norm != 1.0:
+        q /= norm
     q.flags.writeable = False
     return q
 

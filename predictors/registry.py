@@ -16,8 +16,11 @@ import inspect
 from types import MappingProxyType
 from typing import Callable, Mapping, Protocol, runtime_checkable
 
+from predictors.auto import Auto
+from predictors.desp import DoubleExponentialSmoothing
 from predictors.errors import PredictorError
 from predictors.extrapolators import HoldLast, SlerpExtrapolator
+from predictors.kalman import KalmanCA, KalmanCV
 from predictors.pose import Pose, PoseSample
 
 
@@ -26,10 +29,12 @@ class Predictor(Protocol):
     """Turns timestamped tracker samples into a pose for any requested time."""
 
     def update(self, sample: PoseSample) -> None:
-        """Take one tracker sample (ordered by its sensor time)."""
+        """Take one tracker sample (ordered by its sensor time); PredictorError, with the state
+        unchanged, if it holds a non-finite value or a non-unit quaternion."""
 
     def predict(self, t: float) -> Pose:
-        """The pose expected at time `t` (s); PredictorError before the first sample."""
+        """The pose expected at time `t` (s), also before the newest sample; PredictorError before
+        the first sample."""
 
     def reset(self) -> None:
         """Forget every sample, as if newly made."""
@@ -39,6 +44,10 @@ _PREDICTORS: Mapping[str, Callable[..., Predictor]] = MappingProxyType(
     {
         "hold": HoldLast,
         "slerp": SlerpExtrapolator,
+        "kalman-cv": KalmanCV,
+        "kalman-ca": KalmanCA,
+        "desp": DoubleExponentialSmoothing,
+        "auto": Auto,
     }
 )
 

@@ -15,7 +15,7 @@ def test_public_names_import_from_the_package():
 
 
 def test_known_names():
-    assert names() == ("hold", "slerp")
+    assert names() == ("hold", "slerp", "kalman-cv", "kalman-ca", "desp", "auto")
 
 
 @pytest.mark.parametrize("name", names())
@@ -26,7 +26,7 @@ def test_make_returns_fresh_predictors(name):
 
 
 def test_unknown_name_lists_the_known_ones():
-    with pytest.raises(PredictorError, match="unknown predictor 'kalman'; known predictors: hold, slerp"):
+    with pytest.raises(PredictorError, match="unknown predictor 'kalman'; known predictors: hold, slerp, kalman-cv"):
         make("kalman")
 
 
@@ -46,3 +46,19 @@ def test_parameters_reach_the_predictor():
 def test_bad_min_interval_is_an_error(bad):
     with pytest.raises(PredictorError, match="min_interval must be"):
         make("slerp", min_interval=bad)
+
+
+@pytest.mark.parametrize(
+    ("name", "params", "message"),
+    [
+        ("kalman-cv", {"position_noise": 0.0}, "position_noise must be a positive number of metres"),
+        ("kalman-ca", {"jerk_noise": -1.0}, "jerk_noise must be a positive number of m/s"),
+        ("kalman-cv", {"max_gap": math.nan}, "max_gap must be a positive number of seconds"),
+        ("desp", {"position_alpha": 1.0}, "position_alpha must be a number between 0 and 1"),
+        ("desp", {"sample_interval": 0.0}, "sample_interval must be a positive number of seconds"),
+        ("auto", {"margin": "wide"}, "margin must be a positive number"),
+    ],
+)
+def test_bad_filter_parameters_name_the_parameter_and_unit(name, params, message):
+    with pytest.raises(PredictorError, match=message):
+        make(name, **params)

@@ -7,10 +7,10 @@ import pytest
 
 from rig.cli import build_parser, main
 
-COMMANDS = ["demo", "simulate", "analyse"]
+COMMANDS = ["demo", "simulate", "analyse", "bench", "tune"]
 
 
-@pytest.mark.parametrize("command", [[]] + [[c] for c in COMMANDS])
+@pytest.mark.parametrize("command", [[]] + [[c] for c in COMMANDS] + [["bench", "predictors"]])
 def test_every_command_has_help(command: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as exit_:
         main([*command, "--help"])

@@ -1,0 +1,145 @@
+"""Double exponential smoothing prediction (`desp`), after LaViola (2003).
+
+Per sample, with smoothing factor a in (0, 1), position p and orientation q:
+
+    S1 <- a p + (1 - a) S1,              S2 <- a S1 + (1 - a) S2
+    Q1 <- slerp(Q1, q, a),               Q2 <- slerp(Q2, Q1, a)
+
+and the prediction tau samples ahead, k = a tau / (1 - a):
+
+    p(tau) = (2 + k) S1 - (1 + k) S2 = S1 + (1 + k) (S1 - S2)
+    q(tau) = slerp(Q2, Q1, 2 + k)
+
+(the quaternion form is the linear one with a + u (b - a) read as slerp(a, b, u), taken the short
+way, so sign flips between samples do no harm). Smoothing counts samples, not seconds, as in the
+paper; the horizon is turned into samples with the tracker's sample interval, given as
+`sample_interval` or estimated online as a running mean of the intervals seen.
+
+Samples are taken in sensor-time order: an older sample than the newest is dropped; a sample at
+the newest one's time replaces it (the step is redone with the later arrival); a gap longer than
+`max_gap` restarts the smoothing from the new sample.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from predictors import scalar_quaternion as squat
+from predictors.checks import finite_time, fraction_parameter, no_sample_yet, positive_parameter, read_sample
+from predictors.pose import Pose, PoseSample
+
+# Weight of the newest interval in the running mean of the sample interval (about 20 samples).
+INTERVAL_RATE = 0.05
+
+Vector = tuple[float, float, float]
+
+
+class _Smoothed:
+    """The two smoothing stages of position and orientation after one sample (immutable)."""
+
+    __slots__ = ("s1", "s2", "q1", "q2")
+
+    def __init__(self, s1: Vector, s2: Vector, q1: squat.Quaternion, q2: squat.Quaternion) -> None:
+        self.s1, self.s2, self.q1, self.q2 = s1, s2, q1, q2
+
+
+class DoubleExponentialSmoothing:
+    """LaViola's double exponential smoothing predictor (`desp`).
+
+    Parameters:
+        position_alpha: smoothing factor for position, in (0, 1); larger follows faster.
+        orientation_alpha: smoothing factor for orientation, in (0, 1).
+        sample_interval: s, the tracker's sample interval, which turns a horizon into samples;
+            None (default) estimates it from the samples.
+        max_gap: s, a longer gap between samples restarts the smoothing.
+        max_horizon: s, predictions further than this from the newest sample are made for this
+            horizon.
+    """
+
+    name = "desp"
+
+    def __init__(
+        self,
+        position_alpha: float = 0.5,
+        orientation_alpha: float = 0.5,
+        sample_interval: float | None = None,
+        max_gap: float = 1.0,
+        max_horizon: float = 0.5,
+    ) -> None:
+        self.position_alpha = fraction_parameter(position_alpha, self.name, "position_alpha")
+        self.orientation_alpha = fraction_parameter(orientation_alpha, self.name, "orientation_alpha")
+        self.sample_interval = (
+            None if sample_interval is None else positive_parameter(sample_interval, self.name, "sample_interval", "seconds")
+        )
+        self.max_gap = positive_parameter(max_gap, self.name, "max_gap", "seconds")
+        self.max_horizon = positive_parameter(max_horizon, self.name, "max_horizon", "seconds")
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every sample."""
+        self._t: float | None = None
+        self._state: _Smoothed | None = None
+        self._before: _Smoothed | None = None  # the state before the newest sample, to redo it
+        self._interval: float | None = self.sample_interval
+        self._measured_interval: float | None = None
+
+    def update(self, sample: PoseSample) -> None:
+        """Take one tracker sample (see the module docstring for the order rules)."""
+        t, position, orientation = read_sample(sample, self.name)
+        last = self._t
+        if last is None or t - last > self.max_gap:
+            self._state = _Smoothed(position, position, orientation, orientation)
+            self._before = None
+            self._t = t
+            return
+        dt = t - last
+        if dt < 0.0:
+            return
+        if dt == 0.0:
+            if self._before is None:
+                self._state = _Smoothed(position, position, orientation, orientation)
+            else:
+                self._state = self._smoothed(self._before, position, orientation)
+            return
+        self._note_interval(dt)
+        self._before = self._state
+        self._state = self._smoothed(self._state, position, orientation)  # type: ignore[arg-type]
+        self._t = t
+
+    def _note_interval(self, dt: float) -> None:
+        measured = self._measured_interval
+        measured = dt if measured is None else measured + INTERVAL_RATE * (dt - measured)
+        self._measured_interval = measured
+        if self.sample_interval is None:
+            self._interval = measured
+
+    def _smoothed(self, state: _Smoothed, p: Vector, q: squat.Quaternion) -> _Smoothed:
+        a = self.position_alpha
+        b = 1.0 - a
+        (x1, y1, z1), (x2, y2, z2) = state.s1, state.s2
+        x1, y1, z1 = a * p[0] + b * x1, a * p[1] + b * y1, a * p[2] + b * z1
+        x2, y2, z2 = a * x1 + b * x2, a * y1 + b * y2, a * z1 + b * z2
+        ao = self.orientation_alpha
+        q1 = squat.slerp(state.q1, q, ao)
+        q2 = squat.slerp(state.q2, q1, ao)
+        return _Smoothed((x1, y1, z1), (x2, y2, z2), q1, q2)
+
+    def predict(self, t: float) -> Pose:
+        """The pose at t (s), extrapolated (t - newest sample time) / sample interval samples ahead."""
+        last = self._t
+        if last is None:
+            raise no_sample_yet(self.name)
+        t = finite_time(t, self.name)
+        state: Any = self._state
+        interval = self._interval
+        h = t - last
+        limit = self.max_horizon
+        h = limit if h > limit else -limit if h < -limit else h
+        tau = 0.0 if interval is None else h / interval
+        a = self.position_alpha
+        gain = 1.0 + a * tau / (1.0 - a)
+        (x1, y1, z1), (x2, y2, z2) = state.s1, state.s2
+        position = (x1 + gain * (x1 - x2), y1 + gain * (y1 - y2), z1 + gain * (z1 - z2))
+        ao = self.orientation_alpha
+        orientation = squat.slerp(state.q2, state.q1, 2.0 + ao * tau / (1.0 - ao))
+        return Pose(t, position, orientation)

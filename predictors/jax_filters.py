@@ -1,0 +1,311 @@
+"""The Kalman and DESP predictors as pure JAX functions over `lax.scan`, for batched tuning.
+
+Importing this module switches JAX to float64 (`jax_enable_x64`): the twins must agree with the
+real-time predictors to 1e-9 and the filters' variances span many decades. Nothing else in
+`predictors` imports JAX, so the real-time path never pays for it; a program that needs float32
+JAX elsewhere should not import this module.
+
+Each function takes parameters (a NamedTuple of scalars, in natural units) and one trace as arrays
+in arrival order, and returns the pose predicted at `query_times[k]` after taking sample k, exactly
+what `predictors.evaluation.replay` records for the real-time predictor. Everything is jittable,
+differentiable in the parameters and vmappable over parameter sets and (equal-length) traces; pad
+shorter traces with `valid` False, which makes a step a no-op.
+
+They implement the same models and sample rules as the real-time classes (see `predictors.kalman`
+and `predictors.desp`), with the covariance in the textbook form P <- F P F^T + Q and
+P <- P - K H P instead of the factored form: the two agree to rounding, which the tests check.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+from jax import lax
+
+from predictors.desp import INTERVAL_RATE
+from predictors.kalman import INITIAL_ACCELERATION_STD, INITIAL_ANGULAR_SPEED_STD, INITIAL_SPEED_STD
+
+jax.config.update("jax_enable_x64", True)
+
+Array = jax.Array
+
+_SMALL = 1e-8  # below this angle (rad) the series forms of sin(x)/x and x/sin(x) are exact in float64
+
+
+class KalmanParams(NamedTuple):
+    """Parameters of `kalman-cv` (order 2) or `kalman-ca` (order 3); see those classes for units.
+
+    position_drive is acceleration_noise (order 2) or jerk_noise (order 3).
+    """
+
+    position_noise: Array
+    position_drive: Array
+    orientation_noise: Array
+    angular_acceleration_noise: Array
+    max_gap: Array
+    max_horizon: Array
+
+
+class DespParams(NamedTuple):
+    """Parameters of `desp`; sample_interval <= 0 means estimate it from the samples."""
+
+    position_alpha: Array
+    orientation_alpha: Array
+    sample_interval: Array
+    max_gap: Array
+    max_horizon: Array
+
+
+class TraceArrays(NamedTuple):
+    """One trace in arrival order: times (N,), positions (N, 3), orientations (N, 4), query
+    times (N,) and valid (N,) (False for padding)."""
+
+    times: Array
+    positions: Array
+    orientations: Array
+    query_times: Array
+    valid: Array
+
+
+# --- quaternion helpers, safe to differentiate at zero rotation ------------------------------
+
+
+def _multiply(a: Array, b: Array) -> Array:
+    aw, ax, ay, az = a[0], a[1], a[2], a[3]
+    bw, bx, by, bz = b[0], b[1], b[2], b[3]
+    return jnp.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ]
+    )
+
+
+def _rotated_by(r: Array, q: Array) -> Array:
+    """exp(r / 2) q, renormalised: q followed by the world rotation vector r."""
+    squared = jnp.dot(r, r)
+    small = squared < _SMALL**2
+    half = 0.5 * jnp.sqrt(jnp.where(small, 1.0, squared))
+    sinc = jnp.where(small, 0.5 - squared / 48.0, 0.5 * jnp.sin(half) / half)
+    cos = jnp.where(small, 1.0 - squared / 8.0, jnp.cos(half))
+    turned = _multiply(jnp.concatenate([cos[None], sinc * r]), q)
+    return turned / jnp.linalg.norm(turned)
+
+
+def _rotation_vector_between(a: Array, b: Array) -> Array:
+    """World rotation vector r, |r| <= pi, with b = +-exp(r / 2) a."""
+    d = _multiply(b, a * jnp.array([1.0, -1.0, -1.0, -1.0]))
+    d = jnp.where(d[0] < 0.0, -d, d)
+    squared = jnp.dot(d[1:], d[1:])
+    small = squared < _SMALL**2
+    sin_half = jnp.sqrt(jnp.where(small, 1.0, squared))
+    scale = jnp.where(small, 2.0 / d[0], 2.0 * jnp.arctan2(sin_half, d[0]) / sin_half)
+    return scale * d[1:]
+
+
+def slerp(q0: Array, q1: Array, u: Array) -> Array:
+    """q0 exp(u log(q0* q1)), the short way, renormalised: the real-time `slerp`."""
+    relative = _multiply(q0 * jnp.array([1.0, -1.0, -1.0, -1.0]), q1)
+    relative = jnp.where(relative[0] < 0.0, -relative, relative)
+    squared = jnp.dot(relative[1:], relative[1:])
+    still = (squared == 0.0) | jnp.all(q0 == q1)
+    sin_half = jnp.sqrt(jnp.where(still, 1.0, squared))
+    half_angle = jnp.arctan2(sin_half, relative[0])
+    axis = relative[1:] / sin_half
+    tangent = _multiply(q0, jnp.concatenate([jnp.zeros(1), axis]))
+    phase = u * half_angle
+    moved = jnp.cos(phase) * q0 + jnp.sin(phase) * tangent
+    moved = moved / jnp.linalg.norm(moved)
+    # No rotation between them: q0 itself, as the real-time slerp returns.
+    return jnp.where(still, q0, moved)
+
+
+# --- Kalman ------------------------------------------------------------------------------------
+
+
+def _transition(order: int, dt: Array) -> tuple[Array, Array]:
+    """F and Q / density of the order-n continuous white-noise model over dt."""
+    if order == 2:
+        f = jnp.array([[1.0, dt], [0.0, 1.0]])
+        q = jnp.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]])
+    else:
+        f = jnp.array([[1.0, dt, dt * dt / 2.0], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
+        q = jnp.array(
+            [
+                [dt**5 / 20.0, dt**4 / 8.0, dt**3 / 6.0],
+                [dt**4 / 8.0, dt**3 / 3.0, dt**2 / 2.0],
+                [dt**3 / 6.0, dt**2 / 2.0, dt],
+            ]
+        )
+    return f, q
+
+
+def _covariance_step(p: Array, f: Array, q: Array, density: Array, variance: Array) -> tuple[Array, Array]:
+    """Time then measurement update of a shared per-axis covariance; returns (P, gain)."""
+    p = f @ p @ f.T + density * q
+    gain = p[:, 0] / (p[0, 0] + variance)
+    return p - jnp.outer(gain, p[0]), gain
+
+
+class _KalmanState(NamedTuple):
+    started: Array
+    t: Array
+    state: Array  # (order, 3): position, velocity (, acceleration) per axis
+    covariance: Array  # (order, order)
+    q: Array
+    w: Array
+    orientation_covariance: Array  # (2, 2)
+
+
+def _kalman_start(order: int, params: KalmanParams, t: Array, z: Array, zq: Array) -> _KalmanState:
+    initial = [params.position_noise**2, jnp.asarray(INITIAL_SPEED_STD**2), jnp.asarray(INITIAL_ACCELERATION_STD**2)]
+    state = jnp.zeros((order, 3)).at[0].set(z)
+    orientation_initial = jnp.stack([params.orientation_noise**2, jnp.asarray(INITIAL_ANGULAR_SPEED_STD**2)])
+    return _KalmanState(
+        jnp.asarray(True),
+        t,
+        state,
+        jnp.diag(jnp.stack(initial[:order])),
+        zq,
+        jnp.zeros(3),
+        jnp.diag(orientation_initial),
+    )
+
+
+def _kalman_step(order: int, params: KalmanParams, s: _KalmanState, t: Array, z: Array, zq: Array) -> _KalmanState:
+    dt = t - s.t
+    f, q = _transition(order, dt)
+    covariance, gain = _covariance_step(s.covariance, f, q, params.position_drive**2, params.position_noise**2)
+    predicted = f @ s.state
+    state = predicted + gain[:, None] * (z - predicted[0])[None, :]
+    f2, q2 = _transition(2, dt)
+    orientation_covariance, (k0, k1) = _covariance_step(
+        s.orientation_covariance, f2, q2, params.angular_acceleration_noise**2, params.orientation_noise**2
+    )
+    q_predicted = _rotated_by(dt * s.w, s.q)
+    residual = _rotation_vector_between(q_predicted, zq)
+    return _KalmanState(
+        s.started,
+        t,
+        state,
+        covariance,
+        _rotated_by(k0 * residual, q_predicted),
+        s.w + k1 * residual,
+        orientation_covariance,
+    )
+
+
+def _select(condition: Array, a: NamedTuple, b: NamedTuple) -> NamedTuple:
+    return jax.tree_util.tree_map(lambda x, y: jnp.where(condition, x, y), a, b)
+
+
+def kalman_predictions(order: int, params: KalmanParams, trace: TraceArrays) -> tuple[Array, Array]:
+    """Predicted positions (N, 3) and orientations (N, 4) of `kalman-cv` (order 2) or `kalman-ca`
+    (order 3) at trace.query_times, sample by sample. `order` is static."""
+    if order not in (2, 3):
+        raise ValueError(f"order must be 2 or 3, got {order!r}")
+    n = trace.times.shape[0]
+    empty = _KalmanState(
+        jnp.asarray(False), jnp.asarray(0.0), jnp.zeros((order, 3)), jnp.eye(order), jnp.array([1.0, 0.0, 0.0, 0.0]),
+        jnp.zeros(3), jnp.eye(2),
+    )
+
+    def step(s: _KalmanState, k: Array) -> tuple[_KalmanState, tuple[Array, Array]]:
+        t, z, zq = trace.times[k], trace.positions[k], trace.orientations[k]
+        valid = trace.valid[k]
+        start = ~s.started | (t - s.t > params.max_gap)
+        dropped = ~start & (t < s.t)
+        # Evaluate the step on a harmless time step where its result is thrown away, so that
+        # neither the value nor the gradient of the discarded branch can be inf or NaN.
+        stepping = valid & ~start & ~dropped
+        safe = s._replace(t=jnp.where(stepping, s.t, t))
+        stepped = _kalman_step(order, params, safe, t, z, zq)
+        fresh = _kalman_start(order, params, t, z, zq)
+        new = _select(valid & start, fresh, _select(stepping, stepped, s))
+        h = jnp.clip(trace.query_times[k] - new.t, -params.max_horizon, params.max_horizon)
+        powers = jnp.array([1.0, h, 0.5 * h * h])[:order]
+        return new, (powers @ new.state, _rotated_by(h * new.w, new.q))
+
+    _, (positions, orientations) = lax.scan(step, empty, jnp.arange(n))
+    return positions, orientations
+
+
+# --- DESP --------------------------------------------------------------------------------------
+
+
+class _DespState(NamedTuple):
+    started: Array
+    t: Array
+    s1: Array
+    s2: Array
+    q1: Array
+    q2: Array
+    before_s1: Array
+    before_s2: Array
+    before_q1: Array
+    before_q2: Array
+    has_before: Array
+    measured_interval: Array
+    has_interval: Array
+
+
+def _desp_smoothed(params: DespParams, s1: Array, s2: Array, q1: Array, q2: Array, z: Array, zq: Array) -> tuple[Array, ...]:
+    a = params.position_alpha
+    s1 = a * z + (1.0 - a) * s1
+    s2 = a * s1 + (1.0 - a) * s2
+    q1 = slerp(q1, zq, params.orientation_alpha)
+    q2 = slerp(q2, q1, params.orientation_alpha)
+    return s1, s2, q1, q2
+
+
+def desp_predictions(params: DespParams, trace: TraceArrays) -> tuple[Array, Array]:
+    """Predicted positions (N, 3) and orientations (N, 4) of `desp` at trace.query_times."""
+    n = trace.times.shape[0]
+    zero3, identity = jnp.zeros(3), jnp.array([1.0, 0.0, 0.0, 0.0])
+    false = jnp.asarray(False)
+    empty = _DespState(false, jnp.asarray(0.0), zero3, zero3, identity, identity, zero3, zero3, identity, identity,
+                       false, jnp.asarray(1.0), false)
+
+    def step(s: _DespState, k: Array) -> tuple[_DespState, tuple[Array, Array]]:
+        t, z, zq = trace.times[k], trace.positions[k], trace.orientations[k]
+        valid = trace.valid[k]
+        start = ~s.started | (t - s.t > params.max_gap)
+        dt = t - s.t
+        dropped = ~start & (dt < 0.0)
+        repeat = ~start & (dt == 0.0)
+        advance = valid & ~start & ~dropped & ~repeat
+        fresh = _DespState(jnp.asarray(True), t, z, z, zq, zq, z, z, zq, zq, false, s.measured_interval, s.has_interval)
+        # A repeated time redoes the newest step from the state before it (or restarts).
+        base = (
+            jnp.where(repeat, s.before_s1, s.s1), jnp.where(repeat, s.before_s2, s.s2),
+            jnp.where(repeat, s.before_q1, s.q1), jnp.where(repeat, s.before_q2, s.q2),
+        )
+        s1, s2, q1, q2 = _desp_smoothed(params, *base, z, zq)
+        safe_dt = jnp.where(advance, dt, s.measured_interval)
+        measured = jnp.where(s.has_interval, s.measured_interval + INTERVAL_RATE * (safe_dt - s.measured_interval), safe_dt)
+        advanced = _DespState(jnp.asarray(True), t, s1, s2, q1, q2, s.s1, s.s2, s.q1, s.q2, jnp.asarray(True),
+                              measured, jnp.asarray(True))
+        redone = s._replace(s1=s1, s2=s2, q1=q1, q2=q2)
+        restarted = fresh._replace(t=s.t)
+        new = _select(
+            valid & start, fresh,
+            _select(advance, advanced,
+                    _select(valid & repeat, _select(s.has_before, redone, restarted), s)),
+        )
+        given = params.sample_interval > 0.0
+        interval = jnp.where(given, params.sample_interval, new.measured_interval)
+        known = given | new.has_interval
+        h = jnp.clip(trace.query_times[k] - new.t, -params.max_horizon, params.max_horizon)
+        tau = jnp.where(known, h / jnp.where(known, interval, 1.0), 0.0)
+        a = params.position_alpha
+        position = new.s1 + (1.0 + a * tau / (1.0 - a)) * (new.s1 - new.s2)
+        ao = params.orientation_alpha
+        orientation = slerp(new.q2, new.q1, 2.0 + ao * tau / (1.0 - ao))
+        return new, (position, orientation)
+
+    _, (positions, orientations) = lax.scan(step, empty, jnp.arange(n))
+    return positions, orientations

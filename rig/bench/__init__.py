@@ -1,0 +1,1 @@
+"""Benchmarks behind `rig bench`: speed against error, one module per subject."""
