@@ -23,6 +23,7 @@ demo: system $(STAMP)
 	$(BIN)/rig demo --out out/demo
 
 test: system $(STAMP)
+	$(MAKE) -C firmware all test
 	$(BIN)/python -m pytest -q
 
 clean:

@@ -8,7 +8,7 @@ from typing import Sequence
 
 from analysis.errors import AnalysisError
 from predictors import PredictorError
-from rig.commands import analyse, bench, demo, simulate, tune
+from rig.commands import analyse, bench, board, demo, simulate, tune
 from rig.errors import RigError
 
 USER_ERRORS = (RigError, PredictorError, AnalysisError)
@@ -22,7 +22,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Measure motion-to-photon latency with a pendulum, an LED and a camera; simulate the rig.",
     )
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for command in (demo, simulate, analyse, bench, tune):
+    for command in (demo, simulate, analyse, bench, tune, board):
         command.add_parser(subparsers)
     return parser
 

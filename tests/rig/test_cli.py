@@ -7,7 +7,7 @@ import pytest
 
 from rig.cli import build_parser, main
 
-COMMANDS = ["demo", "simulate", "analyse", "bench", "tune"]
+COMMANDS = ["demo", "simulate", "analyse", "bench", "tune", "board"]
 
 
 @pytest.mark.parametrize("command", [[]] + [[c] for c in COMMANDS] + [["bench", "predictors"]])

@@ -1,0 +1,225 @@
+"""`rig board ...`: the rig's microcontroller from the command line.
+
+    rig board info                  who the board is, its counters and the clock offset
+    rig board sync                  measure the clock offset (and, repeated, its drift)
+    rig board record --out DIR --duration S
+                                    record encoder, photodiode and LED events as CSV (rig/devices/recording.py)
+    rig board blink                 play the LED blink code (to align a camera to the board)
+    rig board latency DIR           the latency from a recording's photodiode passages and encoder
+
+The port is --port (a /dev/tty... path, an emulated board's pty, or any pyserial URL) or the
+RIG_BOARD_PORT environment variable.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import threading
+import time
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+from rig.commands.options import non_negative_float, non_negative_int, positive_float
+from rig.devices.clock_sync import OffsetInterval
+from rig.devices.microcontroller import Microcontroller
+from rig.devices.photodiode_latency import estimate_from_recording, plot_board_latency
+from rig.devices.recording import BoardRecorder
+from rig.errors import RigError
+from rig.progress import ProgressBar
+
+PORT_VARIABLE = "RIG_BOARD_PORT"
+# How often the waiting commands look at the link and redraw their progress.
+POLL_S = 0.2
+BLINK_LEAD_S = 0.2
+# Waited after the last bit, for the LED's switch-off to arrive.
+BLINK_TAIL_S = 0.1
+DEFAULT_RISE = 512
+DEFAULT_FALL = 256
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Registers `board info|sync|record|blink|latency`; each sets func(args) -> exit code."""
+    board = subparsers.add_parser("board", help="the rig's microcontroller: identity, clock sync, recording, blink, latency")
+    commands = board.add_subparsers(dest="board_command", required=True, metavar="BOARD_COMMAND")
+
+    info = commands.add_parser("info", help="identify the board; show its counters and the clock offset")
+    _add_port(info)
+    info.add_argument("--json", action="store_true", help="print one JSON object")
+    info.set_defaults(func=run_info)
+
+    sync = commands.add_parser("sync", help="measure the host-board clock offset, and its drift when repeated")
+    _add_port(sync)
+    sync.add_argument("--round-trips", type=non_negative_int, default=48, help="round trips per measurement (default 48)")
+    sync.add_argument("--repeat", type=non_negative_int, default=1, help="measurements to make (default 1)")
+    sync.add_argument("--every", type=positive_float, default=2.0, help="seconds between measurements (default 2)")
+    sync.add_argument("--json", action="store_true", help="print one JSON object")
+    sync.set_defaults(func=run_sync)
+
+    record = commands.add_parser("record", help="record encoder, photodiode and LED events as CSV files")
+    _add_port(record)
+    record.add_argument("--out", type=Path, required=True, help="folder for the CSV files (must not hold a recording)")
+    record.add_argument("--duration", type=positive_float, required=True, help="seconds to record")
+    record.add_argument("--encoder-rate", type=non_negative_float, default=0.0, help="encoder reports per second; 0 (default) reports every edge")
+    record.add_argument("--rise", type=non_negative_int, default=DEFAULT_RISE, help=f"photodiode rising threshold, ADC counts (default {DEFAULT_RISE})")
+    record.add_argument("--fall", type=non_negative_int, default=DEFAULT_FALL, help=f"photodiode falling threshold, below --rise (default {DEFAULT_FALL})")
+    record.add_argument("--raw-every", type=non_negative_int, default=0, help="also record every n-th raw ADC sample (0, the default: none)")
+    record.add_argument("--resync-every", type=positive_float, default=5.0, help="seconds between clock syncs while recording (default 5)")
+    record.set_defaults(func=run_record)
+
+    blink = commands.add_parser("blink", help="play the LED blink code, to align a camera's video to the board's clock")
+    _add_port(blink)
+    blink.add_argument("--bits", type=non_negative_int, default=64, help="bits of code (default 64)")
+    blink.add_argument("--bit-ms", type=positive_float, default=50.0, help="duration of one bit, ms (default 50)")
+    blink.add_argument("--seed", type=non_negative_int, default=0xACE1, help="code seed, 1..65535 (default 44257)")
+    blink.add_argument("--level", type=non_negative_int, default=255, help="LED level of a 1 bit, 1..255 (default 255)")
+    blink.add_argument("--out", type=Path, help="also record the LED changes (led.csv) and the schedule (blink.json) here")
+    blink.add_argument("--json", action="store_true", help="print the schedule as one JSON object")
+    blink.set_defaults(func=run_blink)
+
+    latency = commands.add_parser("latency", help="latency from a recording: photodiode passages against the encoder")
+    latency.add_argument("recording", type=Path, help="a `rig board record` folder")
+    latency.add_argument("--max-latency-ms", type=positive_float, help="largest latency to consider (default 0.45 pendulum periods)")
+    latency.add_argument("--json", action="store_true", help="print one JSON object")
+    latency.add_argument("--plot", type=Path, help="also draw the fit into this PNG file")
+    latency.set_defaults(func=run_latency)
+
+
+def _add_port(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--port", default=os.environ.get(PORT_VARIABLE), help=f"serial port or pyserial URL of the board (default ${PORT_VARIABLE})")
+
+
+def _board(args: argparse.Namespace, **options: Any) -> Microcontroller:
+    if not args.port:
+        raise RigError(f"no board port: pass --port /dev/ttyACM0 (or your board's port), or set {PORT_VARIABLE}")
+    return Microcontroller(args.port, **options)
+
+
+def _interval_dict(interval: OffsetInterval) -> dict[str, float]:
+    return {"offset_s": interval.midpoint, "low_s": interval.low, "high_s": interval.high, "width_s": interval.width, "rig_time_s": interval.at}
+
+
+def _wait(board: Microcontroller, seconds: float, progress: ProgressBar | None = None) -> None:
+    """Waits `seconds` of wall time, watching the link and drawing progress."""
+    start = time.monotonic()
+    pause = threading.Event()
+    while (elapsed := time.monotonic() - start) < seconds:
+        board.check()
+        if progress is not None:
+            progress(elapsed, seconds)
+        pause.wait(min(POLL_S, seconds - elapsed))
+    board.check()
+    if progress is not None:
+        progress(seconds, seconds)
+
+
+def run_info(args: argparse.Namespace) -> int:
+    with _board(args) as board:
+        status = board.status()
+        interval = board.clock_model.latest
+    report = {"identity": asdict(board.identity), "status": asdict(status), "clock": _interval_dict(interval), "link": board.counters}
+    if args.json:
+        print(json.dumps(report))
+        return 0
+    identity = board.identity
+    print(f"{identity.name} firmware {identity.firmware}, protocol {identity.protocol}, {identity.cpu_hz / 1e6:g} MHz, clock {identity.tick_hz / 1e6:g} MHz")
+    print(f"board time {status.board_time:.6f} s; clock offset {interval.midpoint:+.6f} s, known within {interval.width * 1e6:.0f} us")
+    counters = {name: value for name, value in asdict(status).items() if name not in ("board_tick", "board_time", "stream")}
+    print("board counters: " + ", ".join(f"{name} {value}" for name, value in counters.items()))
+    return 0
+
+
+def run_sync(args: argparse.Namespace) -> int:
+    if args.round_trips < 4 or args.repeat < 1:
+        raise RigError("--round-trips must be at least 4 and --repeat at least 1")
+    with _board(args, sync_round_trips=args.round_trips) as board:
+        for _ in range(args.repeat - 1):
+            _wait(board, args.every)
+            board.sync()
+        intervals = board.clock_model.intervals
+        drift = board.clock_model.drift()
+    if args.json:
+        report = {"intervals": [_interval_dict(i) for i in intervals], "drift": asdict(drift) if drift else None, "link": board.counters}
+        print(json.dumps(report))
+        return 0
+    for interval in intervals:
+        print(f"at {interval.at:.3f} s: board - rig = {interval.midpoint:+.6f} s, within +-{interval.width * 5e5:.0f} us ({interval.round_trips} round trips)")
+    if drift is not None:
+        print(f"drift {drift.rate * 1e6:+.2f} ppm +- {drift.uncertainty * 1e6:.2f} ppm over {drift.baseline_s:.1f} s")
+    return 0
+
+
+def run_record(args: argparse.Namespace) -> int:
+    board = _board(args, resync_every_s=args.resync_every)
+    recorder = BoardRecorder(args.out)
+    board.add_listener(recorder)
+    try:
+        with board:
+            board.configure_encoder(args.encoder_rate)
+            board.configure_photodiode(args.rise, args.fall, args.raw_every)
+            board.stream(encoder=True, photodiode=True, samples=args.raw_every > 0)
+            _wait(board, args.duration, ProgressBar(f"recording {args.out}"))
+            board.stream()
+            board.sync()
+            status = board.status()
+            recorder.write_metadata(
+                {
+                    "identity": asdict(board.identity),
+                    "options": {
+                        "duration_s": args.duration,
+                        "encoder_rate_hz": args.encoder_rate,
+                        "rise": args.rise,
+                        "fall": args.fall,
+                        "raw_every": args.raw_every,
+                    },
+                    "events": recorder.counts,
+                    "link": board.counters,
+                    "board_status": asdict(status),
+                    "drift": asdict(drift) if (drift := board.clock_model.drift()) else None,
+                }
+            )
+    finally:
+        recorder.close()
+    print(f"recorded {args.duration:g} s in {args.out}: " + ", ".join(f"{count} {name}" for name, count in recorder.counts.items() if count))
+    return 0
+
+
+def run_blink(args: argparse.Namespace) -> int:
+    board = _board(args)
+    recorder = BoardRecorder(args.out) if args.out else None
+    if recorder is not None:
+        board.add_listener(recorder)
+    try:
+        with board:
+            schedule = board.blink(bits=args.bits, bit_s=args.bit_ms / 1e3, seed=args.seed, level=args.level, start_in_s=BLINK_LEAD_S)
+            report = asdict(schedule) | {"start_rig_time": board.to_rig_time(schedule.start_board_time)}
+            if recorder is not None:
+                (args.out / "blink.json").write_text(json.dumps(report, indent=2) + "\n")
+            _wait(board, BLINK_LEAD_S + schedule.bits * schedule.bit_s + BLINK_TAIL_S, ProgressBar("blinking"))
+    finally:
+        if recorder is not None:
+            recorder.close()
+    if args.json:
+        print(json.dumps(report))
+    else:
+        print(f"blinked {schedule.bits} bits of {schedule.bit_s * 1e3:g} ms from board time {schedule.start_board_time:.6f} s (seed {schedule.seed})")
+    return 0
+
+
+def run_latency(args: argparse.Namespace) -> int:
+    max_latency = args.max_latency_ms / 1e3 if args.max_latency_ms else None
+    latency = estimate_from_recording(args.recording, max_latency_s=max_latency)
+    if args.plot:
+        plot_board_latency(args.recording, latency, args.plot)
+    if args.json:
+        print(json.dumps(latency.as_dict()))
+        return 0
+    print(
+        f"board latency {latency.latency_s * 1e3:.3f} ms +- {latency.uncertainty_s * 1e3:.3f} ms "
+        f"({latency.passages_used} of {latency.passages_seen} passages; photodiode at encoder count "
+        f"{latency.photodiode_counts:.2f}; residuals {latency.rms_residual_s * 1e6:.0f} us rms; "
+        f"pendulum period {latency.period_s:.3f} s)"
+    )
+    return 0

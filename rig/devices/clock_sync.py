@@ -1,0 +1,195 @@
+"""Host and board clocks reconciled as an interval of possible offsets (after google/walt).
+
+One round trip: the host notes its time `sent` just before writing a request; the board notes its
+time `board_rx` when the request's last byte arrived, answers, and notes `board_tx` when the last
+byte of its answer went into its UART (reported in a second message); the host notes `received`
+once that answer is in. With offset = board time - rig time,
+
+    board_rx - offset >= sent + request_bytes * byte_time      the request cannot arrive sooner
+    board_tx - offset <= received                              nor the answer before it is sent
+
+so the offset lies in [board_tx - received, board_rx - sent - request_bytes byte_time]: bounds,
+not estimates, whatever the delays of the USB-serial bridge, the operating system or the
+emulator. Intersecting many round trips narrows the interval; measuring again later shows drift.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+# Offsets measured this far apart (rig seconds) give a drift rate; closer ones only noise.
+MIN_DRIFT_BASELINE_S = 1.0
+# A new interval this far from the offset predicted for it means the board clock restarted.
+CLOCK_RESTART_S = 0.01
+
+
+@dataclass(frozen=True)
+class OffsetInterval:
+    """Board time minus rig time, in seconds, known to lie in [low, high] around rig time `at`."""
+
+    low: float
+    high: float
+    at: float
+    round_trips: int = 1
+
+    @property
+    def width(self) -> float:
+        return self.high - self.low
+
+    @property
+    def midpoint(self) -> float:
+        return 0.5 * (self.low + self.high)
+
+    def intersect(self, other: OffsetInterval) -> OffsetInterval | None:
+        low = max(self.low, other.low)
+        high = min(self.high, other.high)
+        if low > high:
+            return None
+        return OffsetInterval(low, high, max(self.at, other.at), self.round_trips + other.round_trips)
+
+
+@dataclass(frozen=True)
+class RoundTrip:
+    """One request and reply, in rig seconds (sent, received) and board seconds (board_rx, board_tx)."""
+
+    sent: float
+    received: float
+    board_rx: float
+    board_tx: float
+
+    def bounds(self, request_bytes: int, byte_time: float) -> OffsetInterval:
+        """The offsets this round trip allows (see the module docstring)."""
+        high = self.board_rx - self.sent - request_bytes * byte_time
+        low = self.board_tx - self.received
+        return OffsetInterval(low, high, 0.5 * (self.sent + self.received))
+
+
+def consistent_intersection(lows: Sequence[float], highs: Sequence[float]) -> tuple[float, float, list[int]]:
+    """The intersection of the largest set of intervals [lows[i], highs[i]] that share a point,
+    and the indices of that set. An interval that misses the others (a round trip during which
+    an emulated clock stalled, a misread frame) is left out instead of emptying the intersection."""
+    if not lows or len(lows) != len(highs):
+        raise ValueError("need as many lows as highs, and at least one")
+    best: list[int] = []
+    for point in (*lows, *highs):
+        members = [i for i, (low, high) in enumerate(zip(lows, highs)) if low <= point <= high]
+        if len(members) > len(best):
+            best = members
+    if not best:
+        raise ValueError("every interval is empty (low above high)")
+    return max(lows[i] for i in best), min(highs[i] for i in best), best
+
+
+def narrow(intervals: Sequence[OffsetInterval]) -> tuple[OffsetInterval, int]:
+    """Intersects the round trips of one measurement (a fraction of a second, over which the
+    offset cannot move by more than a microsecond): returns the intersection of the largest set
+    that agrees (see consistent_intersection) and how many round trips were left out. Raises
+    ValueError when every interval is empty: the round trips contradict the byte times."""
+    low, high, members = consistent_intersection([i.low for i in intervals], [i.high for i in intervals])
+    at = float(np.mean([intervals[i].at for i in members]))
+    return OffsetInterval(low, high, at, len(members)), len(intervals) - len(members)
+
+
+@dataclass(frozen=True)
+class Drift:
+    """How fast the offset changes: board seconds gained per rig second (1e-6 is 1 ppm)."""
+
+    rate: float
+    uncertainty: float
+    baseline_s: float
+
+
+class ClockModel:
+    """Converts board time to rig time from the offset intervals measured so far.
+
+    Between two measurements the offset is interpolated linearly; after the latest it is
+    extrapolated with the drift measured over the current run of the board's clock. A measurement
+    far from its prediction means the board's clock restarted (a reset): earlier measurements no
+    longer apply and a new run starts.
+    """
+
+    def __init__(self) -> None:
+        self._history: list[OffsetInterval] = []
+        self._run: list[OffsetInterval] = []
+
+    @property
+    def intervals(self) -> tuple[OffsetInterval, ...]:
+        """Every interval added, oldest first."""
+        return tuple(self._history)
+
+    @property
+    def latest(self) -> OffsetInterval | None:
+        return self._run[-1] if self._run else None
+
+    def add(self, interval: OffsetInterval) -> None:
+        if self._run and abs(interval.midpoint - self.offset_at(interval.at)) > CLOCK_RESTART_S:
+            self._run = []
+        self._history.append(interval)
+        self._run.append(interval)
+
+    def drift(self) -> Drift | None:
+        """Drift over the current run, once its measurements span MIN_DRIFT_BASELINE_S."""
+        if len(self._run) < 2:
+            return None
+        first, last = self._run[0], self._run[-1]
+        baseline = last.at - first.at
+        if baseline < MIN_DRIFT_BASELINE_S:
+            return None
+        rate = (last.midpoint - first.midpoint) / baseline
+        return Drift(rate=rate, uncertainty=0.5 * (first.width + last.width) / baseline, baseline_s=baseline)
+
+    def offset_at(self, rig_time: float) -> float:
+        """The best offset for an event at `rig_time`."""
+        if not self._run:
+            raise ValueError("the clock has not been synchronised")
+        run = self._run
+        for before, after in zip(run, run[1:]):
+            if before.at <= rig_time <= after.at and after.at > before.at:
+                fraction = (rig_time - before.at) / (after.at - before.at)
+                return before.midpoint + fraction * (after.midpoint - before.midpoint)
+        drift = self.drift()
+        anchor = run[-1] if rig_time > run[-1].at else run[0]
+        return anchor.midpoint + (drift.rate * (rig_time - anchor.at) if drift else 0.0)
+
+    def to_rig_time(self, board_time: float) -> float:
+        """The rig time of a board time: solves rig = board - offset(rig) (two steps suffice, the
+        offset changing by parts per million)."""
+        latest = self.latest
+        if latest is None:
+            raise ValueError("the clock has not been synchronised")
+        rig_time = board_time - latest.midpoint
+        for _ in range(2):
+            rig_time = board_time - self.offset_at(rig_time)
+        return rig_time
+
+
+class TickUnwrapper:
+    """Places the board's 32-bit ticks on its 48-bit time line, using full times from SYNC and
+    STATUS messages as anchors and the latest tick as the reference for the next."""
+
+    WRAP = 1 << 32
+
+    def __init__(self) -> None:
+        self._reference: int | None = None
+
+    def reset(self) -> None:
+        self._reference = None
+
+    def anchor(self, epoch: int, tick: int) -> int:
+        self._reference = (epoch << 32) | tick
+        return self._reference
+
+    def unwrap(self, tick: int) -> int:
+        if self._reference is None:
+            self._reference = tick
+            return tick
+        full = self._reference - self._reference % self.WRAP + tick
+        if full - self._reference > self.WRAP // 2:
+            full -= self.WRAP
+        elif self._reference - full > self.WRAP // 2:
+            full += self.WRAP
+        self._reference = full
+        return full
