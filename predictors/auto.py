@@ -26,7 +26,7 @@ import math
 from dataclasses import dataclass
 
 from predictors import scalar_quaternion as squat
-from predictors.checks import finite_time, no_sample_yet, positive_parameter, read_sample
+from predictors.checks import finite_time, no_sample_yet, non_negative_parameter, positive_parameter, read_sample
 from predictors.kalman import ConstantAccelerationPosition, ConstantVelocityPosition, OrientationFilter
 from predictors.pose import Pose, PoseSample
 
@@ -44,8 +44,15 @@ class AutoChoice:
 
 
 def _simplest_within(mean_squares: list[float], margin: float, noise: float) -> int:
-    bound = ((1.0 + margin) * math.sqrt(min(mean_squares)) + noise) ** 2
-    return next(i for i, score in enumerate(mean_squares) if score <= bound)
+    """Index of the simplest score within the bound: the best one is always within it, so when no
+    simpler one is, the last is the best. A plain loop, as this runs per sample."""
+    bound = (1.0 + margin) * math.sqrt(min(mean_squares)) + noise
+    bound *= bound
+    last = len(mean_squares) - 1
+    for i in range(last):
+        if mean_squares[i] <= bound:
+            return i
+    return last
 
 
 class Auto:
@@ -53,8 +60,8 @@ class Auto:
     position, and whether to filter orientation at all (`auto`).
 
     Parameters:
-        position_noise, acceleration_noise, orientation_noise, angular_acceleration_noise: as
-            `kalman-cv` (m, m/s^1.5, rad, rad/s^1.5).
+        position_noise, acceleration_noise, orientation_noise, angular_acceleration_noise,
+        angular_velocity_damping: as `kalman-cv` (m, m/s^1.5, rad, rad/s^1.5, 1/s).
         jerk_noise: m/s^2.5, as `kalman-ca`.
         margin: fraction (> 0); a simpler model is used while its RMS error is at most
             (1 + margin) times the best one's plus the tracker's noise.
@@ -72,6 +79,7 @@ class Auto:
         jerk_noise: float = 20.0,
         orientation_noise: float = 0.002,
         angular_acceleration_noise: float = 5.0,
+        angular_velocity_damping: float = 0.0,
         margin: float = 0.1,
         memory: float = 2.0,
         max_gap: float = 1.0,
@@ -83,6 +91,9 @@ class Auto:
         self.orientation_noise = positive_parameter(orientation_noise, self.name, "orientation_noise", "radians")
         self.angular_acceleration_noise = positive_parameter(
             angular_acceleration_noise, self.name, "angular_acceleration_noise", "rad/s^1.5"
+        )
+        self.angular_velocity_damping = non_negative_parameter(
+            angular_velocity_damping, self.name, "angular_velocity_damping", "1/s"
         )
         self.margin = positive_parameter(margin, self.name, "margin", "fractions of the best error")
         self.memory = positive_parameter(memory, self.name, "memory", "seconds")
@@ -112,7 +123,9 @@ class Auto:
             self.reset()
             self._cv = ConstantVelocityPosition(self.position_noise, self.acceleration_noise, position)
             self._ca = ConstantAccelerationPosition(self.position_noise, self.jerk_noise, position)
-            self._filter = OrientationFilter(self.orientation_noise, self.angular_acceleration_noise, orientation)
+            self._filter = OrientationFilter(
+                self.orientation_noise, self.angular_acceleration_noise, orientation, self.angular_velocity_damping
+            )
             self._t = self._start = t
             self._position, self._orientation = position, orientation
             return

@@ -82,6 +82,17 @@ def positive_parameter(value: Any, predictor: str, parameter: str, unit: str) ->
     return number
 
 
+def non_negative_parameter(value: Any, predictor: str, parameter: str, unit: str) -> float:
+    """value as a finite float >= 0, or PredictorError naming the parameter and its unit."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if not (isfinite(number) and number >= 0.0):
+        raise PredictorError(f"{predictor}: {parameter} must be zero or a positive number of {unit}, got {value!r}")
+    return number
+
+
 def fraction_parameter(value: Any, predictor: str, parameter: str) -> float:
     """value as a float strictly between 0 and 1, or PredictorError naming the parameter."""
     try:

@@ -26,6 +26,7 @@ from jax import lax
 
 from predictors.desp import INTERVAL_RATE
 from predictors.kalman import INITIAL_ACCELERATION_STD, INITIAL_ANGULAR_SPEED_STD, INITIAL_SPEED_STD
+from predictors.kinematic_covariance import SERIES_BELOW
 
 jax.config.update("jax_enable_x64", True)
 
@@ -37,7 +38,9 @@ _SMALL = 1e-8  # below this angle (rad) the series forms of sin(x)/x and x/sin(x
 class KalmanParams(NamedTuple):
     """Parameters of `kalman-cv` (order 2) or `kalman-ca` (order 3); see those classes for units.
 
-    position_drive is acceleration_noise (order 2) or jerk_noise (order 3).
+    position_drive is acceleration_noise (order 2) or jerk_noise (order 3). angular_velocity_damping
+    None (the default, so that parameter sets built before it existed still work) is the undamped
+    model, as is 0.
     """
 
     position_noise: Array
@@ -46,6 +49,7 @@ class KalmanParams(NamedTuple):
     angular_acceleration_noise: Array
     max_gap: Array
     max_horizon: Array
+    angular_velocity_damping: Array | None = None
 
 
 class DespParams(NamedTuple):
@@ -144,6 +148,39 @@ def _transition(order: int, dt: Array) -> tuple[Array, Array]:
     return f, q
 
 
+def _damped_transition(dt: Array, damping: Array) -> tuple[Array, Array, Array, Array]:
+    """(reach, decay, F, Q / density) of the damped-velocity model over dt, as
+    `predictors.kinematic_covariance.damped_step`, with the branch not taken kept finite (and its
+    gradient too) by evaluating it at a harmless argument."""
+    x = damping * dt
+    decay = jnp.exp(-x)
+    moving = x > 0.0
+    safe_x = jnp.where(moving, x, 1.0)
+    h = jnp.where(moving, -jnp.expm1(-safe_x) / safe_x, 1.0)
+    series = x < SERIES_BELOW
+    wide = jnp.where(series, 1.0, x)
+    a = -jnp.expm1(-wide)
+    closed = (wide - a - 0.5 * a * a) / (wide * wide * wide)
+    g = jnp.where(
+        series, 1.0 / 3.0 + x * (-0.25 + x * (7.0 / 60.0 + x * (-1.0 / 24.0 + x * (31.0 / 2520.0 - x / 320.0)))), closed
+    )
+    reach = dt * h
+    f = jnp.array([[1.0, reach], [0.0, decay]])
+    q01 = 0.5 * dt * dt * h * h
+    q = jnp.array([[dt * dt * dt * g, q01], [q01, 0.5 * dt * h * (1.0 + decay)]])
+    return reach, decay, f, q
+
+
+def _damped_reach(h: Array, damping: Array | None) -> Array:
+    """(1 - e^(-damping h)) / damping, or h without damping: `kinematic_covariance.damped_reach`."""
+    if damping is None:
+        return h
+    x = damping * h
+    moving = x != 0.0
+    safe_x = jnp.where(moving, x, 1.0)
+    return jnp.where(moving, h * (-jnp.expm1(-safe_x) / safe_x), h)
+
+
 def _covariance_step(p: Array, f: Array, q: Array, density: Array, variance: Array) -> tuple[Array, Array]:
     """Time then measurement update of a shared per-axis covariance; returns (P, gain)."""
     p = f @ p @ f.T + density * q
@@ -182,11 +219,15 @@ def _kalman_step(order: int, params: KalmanParams, s: _KalmanState, t: Array, z:
     covariance, gain = _covariance_step(s.covariance, f, q, params.position_drive**2, params.position_noise**2)
     predicted = f @ s.state
     state = predicted + gain[:, None] * (z - predicted[0])[None, :]
-    f2, q2 = _transition(2, dt)
+    if params.angular_velocity_damping is None:
+        f2, q2 = _transition(2, dt)
+        reach, decay = dt, 1.0
+    else:
+        reach, decay, f2, q2 = _damped_transition(dt, params.angular_velocity_damping)
     orientation_covariance, (k0, k1) = _covariance_step(
         s.orientation_covariance, f2, q2, params.angular_acceleration_noise**2, params.orientation_noise**2
     )
-    q_predicted = _rotated_by(dt * s.w, s.q)
+    q_predicted = _rotated_by(reach * s.w, s.q)
     residual = _rotation_vector_between(q_predicted, zq)
     return _KalmanState(
         s.started,
@@ -194,7 +235,7 @@ def _kalman_step(order: int, params: KalmanParams, s: _KalmanState, t: Array, z:
         state,
         covariance,
         _rotated_by(k0 * residual, q_predicted),
-        s.w + k1 * residual,
+        decay * s.w + k1 * residual,
         orientation_covariance,
     )
 
@@ -228,7 +269,8 @@ def kalman_predictions(order: int, params: KalmanParams, trace: TraceArrays) -> 
         new = _select(valid & start, fresh, _select(stepping, stepped, s))
         h = jnp.clip(trace.query_times[k] - new.t, -params.max_horizon, params.max_horizon)
         powers = jnp.array([1.0, h, 0.5 * h * h])[:order]
-        return new, (powers @ new.state, _rotated_by(h * new.w, new.q))
+        reach = _damped_reach(h, params.angular_velocity_damping)
+        return new, (powers @ new.state, _rotated_by(reach * new.w, new.q))
 
     _, (positions, orientations) = lax.scan(step, empty, jnp.arange(n))
     return positions, orientations

@@ -31,9 +31,24 @@ update here; re-symmetrising a stored P fixes symmetry but not definiteness.
 
 Q's factors are closed forms: Q = density * dt * S C S with S = diag(dt^(n-1), ..., dt, 1) and C a
 constant matrix whose L D L^T factors are tabulated below.
+
+Damped velocity (order 2 only, `predict_damped`): the velocity decays towards zero at `damping`
+(1/s, beta) between its random kicks, dv = -beta v dt + dW, an Ornstein-Uhlenbeck velocity
+(Singer's manoeuvring-target model). With x = beta dt, one step is
+
+    F = [[1, reach], [0, decay]],  reach = (1 - e^-x) / beta,  decay = e^-x,
+    Q = density * [[dt^3 g(x), dt^2 h(x)^2 / 2], [dt^2 h(x)^2 / 2, dt h(x) (1 + e^-x) / 2]]
+
+with h(x) = (1 - e^-x) / x and g(x) = (x - 3/2 + 2 e^-x - e^-2x / 2) / x^3, both 1 and 1/3 at x = 0,
+where the model is the constant-velocity one exactly. `damped_step` evaluates them; g cancels to
+x^3 / 3 from terms of size x, so below `SERIES_BELOW` it is summed as its power series instead.
+Its factors are no longer constants: the 2 x 2 L D L^T of Q is taken per step, which is safe, since
+det Q / Q11 is a quarter of Q22 or more (no cancellation beyond two bits).
 """
 
 from __future__ import annotations
+
+from math import exp, expm1
 
 import numpy as np
 
@@ -43,6 +58,38 @@ import numpy as np
 #          L = [[1], [5/2, 1], [10/3, 4, 1]],  D = (1/20, 1/48, 1/9).
 # With S, L_Q = S L S^-1 (entry i, j divided by dt^(i - j)) and D_Q = density * dt * D * S^2.
 _ORDERS = (2, 3)
+
+# Below this x = beta dt, g(x) is summed as its series 1/3 - x/4 + 7x^2/60 - x^3/24 + 31x^4/2520 -
+# x^5/320, whose first dropped term is below 1e-13 relative there; above it the closed form loses at
+# most 3e-16 / x^2 < 1e-12 relative to cancellation.
+SERIES_BELOW = 0.02
+
+
+# One step of the damped-velocity model: (reach, decay, Q00, Q01, Q11), F = [[1, reach], [0, decay]]
+# and Q / density. A plain tuple: a NamedTuple would cost a third of a microsecond per sample.
+DampedStep = tuple[float, float, float, float, float]
+
+
+def damped_reach(h: float, damping: float) -> float:
+    """How far (in s of the current velocity) a damped velocity carries in h seconds (h may be
+    negative): (1 - e^(-damping h)) / damping, and h itself without damping. Written as h times
+    (1 - e^-x) / x, x = damping h, as in `damped_step`: dividing by a subnormal damping instead
+    would round to a reach beyond h."""
+    x = damping * h
+    return h if x == 0.0 else h * (-expm1(-x) / x)
+
+
+def damped_step(dt: float, damping: float) -> DampedStep:
+    """F and Q / density of the damped-velocity model (see the module docstring) over dt > 0 s."""
+    x = damping * dt
+    a = -expm1(-x)  # 1 - e^-x, to full relative precision for small x
+    decay = exp(-x)
+    h = a / x if x > 0.0 else 1.0
+    if x < SERIES_BELOW:
+        g = 1.0 / 3.0 + x * (-0.25 + x * (7.0 / 60.0 + x * (-1.0 / 24.0 + x * (31.0 / 2520.0 - x / 320.0))))
+    else:
+        g = (x - a - 0.5 * a * a) / (x * x * x)
+    return (dt * h, decay, dt * dt * dt * g, 0.5 * dt * dt * h * h, 0.5 * dt * h * (1.0 + decay))
 
 
 class KinematicCovariance:
@@ -116,6 +163,25 @@ class KinematicCovariance:
         lower = self._l
         lower[1][0], lower[2][0], lower[2][1] = m10, m20, m21
         self._d[0], self._d[1], self._d[2] = n0, n1, n2
+
+    def predict_damped(self, step: DampedStep) -> None:
+        """Time update of an order-2 covariance over one step of the damped-velocity model
+        (`damped_step`): P <- F P F^T + density Q, by weighted Gram-Schmidt as `predict`."""
+        l10 = self._l[1][0]
+        d0, d1 = self._d
+        reach, decay, s00, s01, s11 = step
+        # Q = Lq Dq Lq^T per step; then the columns of A = [F L | Lq], weights (d0, d1, q0, q1).
+        lq = s01 / s00
+        q0 = self.density * s00
+        q1 = self.density * (s11 - s01 * lq)
+        a00, a01 = 1.0 + reach * l10, reach
+        a10, a11 = decay * l10, decay
+        new_d0 = d0 * a00 * a00 + d1 * a01 * a01 + q0
+        new_l10 = (d0 * a10 * a00 + d1 * a11 * a01 + q0 * lq) / new_d0
+        b0, b1, b2 = a10 - new_l10 * a00, a11 - new_l10 * a01, lq - new_l10
+        new_d1 = d0 * b0 * b0 + d1 * b1 * b1 + q0 * b2 * b2 + q1
+        self._l[1][0] = new_l10
+        self._d[0], self._d[1] = new_d0, new_d1
 
     def update(self) -> tuple[float, ...]:
         """Measurement update for an observation of state 0; returns the Kalman gain (n,)."""

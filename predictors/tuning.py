@@ -8,10 +8,19 @@ computed by the JAX twins (`predictors.jax_filters`), vmapped over the traces, a
 `predictors.optimizer` in unconstrained coordinates:
 
 * `kalman-cv` / `kalman-ca`: the logarithms of the process noises (acceleration_noise or
-  jerk_noise, and angular_acceleration_noise). The predicted means depend on process and
-  measurement noise only through their ratio, so the measurement noises stay as given (the
-  tracker's datasheet values, or the defaults) and only the process noises are fitted;
-* `desp`: the logits of position_alpha and orientation_alpha.
+  jerk_noise, and angular_acceleration_noise) and of angular_velocity_damping. The predicted
+  means depend on process and measurement noise only through their ratio, so the measurement
+  noises stay as given (the tracker's datasheet values, or the defaults) and only the process
+  noises are fitted. The damping is a rate, not a noise: it shapes how far a velocity carries,
+  which no noise ratio can, and is fitted beside them (from `DAMPING_START` when the start has no
+  damping: log 0 is no starting point, and a one-second time constant predicts almost as the
+  undamped model at the horizons tuned for while giving the loss a slope in it);
+* `desp`: the logits of position_alpha and orientation_alpha;
+* `auto`: its filters' parameters as `kalman-cv` (jerk_noise stays as given: tune `kalman-ca`
+  for it), then `memory` and `margin`, which choose between models and so move the loss in steps
+  that no gradient sees, by the same loss (scaled as the filters' fit scaled it) over a grid
+  (`AUTO_MEMORY_GRID_S` x `AUTO_MARGIN_GRID` and the starting values), each point scored by
+  replaying the real-time `auto`.
 
 Importing this module imports JAX and switches it to float64 (see `predictors.jax_filters`).
 """
@@ -28,16 +37,30 @@ import numpy as np
 
 from predictors import jax_filters
 from predictors.errors import PredictorError
+from predictors.evaluation import replay
 from predictors.optimizer import minimise
 from predictors.registry import make
 from predictors.trace import Trace
 
-TUNABLE = ("kalman-cv", "kalman-ca", "desp")
+TUNABLE = ("kalman-cv", "kalman-ca", "desp", "auto")
+
+# Where the damping search starts when the starting parameters have none (1/s).
+DAMPING_START = 1.0
+# The parameters `auto` shares with `kalman-cv`, fitted as kalman-cv's.
+AUTO_FILTER_PARAMS = (
+    "position_noise", "acceleration_noise", "orientation_noise", "angular_acceleration_noise",
+    "angular_velocity_damping", "max_gap", "max_horizon",
+)
+# auto's score time constant (s) and margin (fraction), searched on this grid (log-spaced: both act
+# multiplicatively) plus the starting values.
+AUTO_MEMORY_GRID_S = (0.1, 0.2, 0.5, 1.0, 2.0)
+AUTO_MARGIN_GRID = (0.05, 0.1, 0.2, 0.4)
 
 
 @dataclass(frozen=True)
 class TuneResult:
-    """Fitted parameters (all of them, ready for `make`), which ones were fitted, and the loss."""
+    """Fitted parameters (all of them, ready for `make`), which ones were fitted, and the loss at
+    the start of the search and at its end (iterations: the gradient search's)."""
 
     predictor: str
     params: dict[str, Any]
@@ -85,12 +108,13 @@ class _Parameterisation:
             self.names: tuple[str, ...] = ("position_alpha", "orientation_alpha")
         else:
             drive = "acceleration_noise" if predictor == "kalman-cv" else "jerk_noise"
-            self.names = (drive, "angular_acceleration_noise")
+            self.names = (drive, "angular_acceleration_noise", "angular_velocity_damping")
 
     def start(self) -> np.ndarray:
         values = np.array([getattr(self.instance, name) for name in self.names])
         if self.predictor == "desp":
             return np.log(values / (1.0 - values))
+        values[-1] = values[-1] or DAMPING_START
         return np.log(values)
 
     def natural(self, x: np.ndarray) -> dict[str, float]:
@@ -112,32 +136,29 @@ class _Parameterisation:
         order = 2 if self.predictor == "kalman-cv" else 3
 
         def run_kalman(x: jax.Array, trace: jax_filters.TraceArrays) -> tuple[jax.Array, jax.Array]:
-            noises = jnp.exp(x)
+            values = jnp.exp(x)
             params = jax_filters.KalmanParams(
-                jnp.asarray(p.position_noise), noises[0], jnp.asarray(p.orientation_noise), noises[1],
-                jnp.asarray(p.max_gap), jnp.asarray(p.max_horizon),
+                jnp.asarray(p.position_noise), values[0], jnp.asarray(p.orientation_noise), values[1],
+                jnp.asarray(p.max_gap), jnp.asarray(p.max_horizon), values[2],
             )
             return jax_filters.kalman_predictions(order, params, trace)
 
         return run_kalman
 
 
-def tune(
-    predictor: str,
-    traces: Sequence[Trace],
-    horizon_s: float,
-    params: Mapping[str, Any] | None = None,
-    max_iterations: int = 40,
-) -> TuneResult:
-    """Fit `predictor`'s parameters (starting from `params`, else its defaults) to predict the
-    training `traces` `horizon_s` seconds ahead."""
-    if predictor not in TUNABLE:
-        raise PredictorError(f"cannot tune {predictor!r}; tunable predictors: {', '.join(TUNABLE)}")
-    if not traces:
-        raise PredictorError("tuning needs at least one training trace")
-    if not (math.isfinite(horizon_s) and horizon_s >= 0.0):
-        raise PredictorError(f"the horizon must be zero or a positive number of seconds, got {horizon_s!r}")
-    model = _Parameterisation(predictor, params or {})
+@dataclass(frozen=True)
+class _Fit:
+    """A gradient fit, and the scales that make its loss unitless (1 / each term at the start)."""
+
+    result: TuneResult
+    position_scale: float
+    angular_scale: float
+
+
+def _fit(predictor: str, traces: Sequence[Trace], horizon_s: float, params: Mapping[str, Any],
+         max_iterations: int) -> _Fit:
+    """Fit a JAX-twinned predictor's parameters (see the module docstring) by gradient."""
+    model = _Parameterisation(predictor, params)
     arrays, true_p, true_q, scored = _stacked(traces, horizon_s)
     weight = jnp.asarray(scored, dtype=jnp.float64) / max(int(scored.sum()), 1)
     true_p, true_q = jnp.asarray(true_p), jnp.asarray(true_q)
@@ -166,5 +187,64 @@ def tune(
         if (position_scale if name in ("acceleration_noise", "jerk_noise", "position_alpha") else angular_scale) > 0.0
     )
     values = {**model.base, **{name: fitted[name] for name in informed}}
-    return TuneResult(predictor, values, informed, float(horizon_s), float(position_scale * position0 + angular_scale * angular0),
-                      best.value, best.iterations)
+    result = TuneResult(predictor, values, informed, float(horizon_s),
+                        float(position_scale * position0 + angular_scale * angular0), best.value, best.iterations)
+    return _Fit(result, position_scale, angular_scale)
+
+
+def _replayed_loss(predictor: str, params: Mapping[str, Any], traces: Sequence[Trace], horizon_s: float,
+                   position_scale: float, angular_scale: float) -> float:
+    """The tuning loss of the real-time predictor, replayed on the traces (for what JAX cannot
+    differentiate)."""
+    instance = make(predictor, **params)
+    position = angular = 0.0
+    count = 0
+    for trace in traces:
+        queries, positions, orientations = replay(instance, trace, [horizon_s])
+        scored = trace.covers(queries[0])
+        true_p, true_q = trace.truth_at(queries[0][scored])
+        position += float(np.sum((positions[0][scored] - true_p) ** 2))
+        dot = np.sum(orientations[0][scored] * true_q, axis=-1)
+        angular += float(np.sum(4.0 * (1.0 - dot * dot)))
+        count += int(scored.sum())
+    return (position_scale * position + angular_scale * angular) / max(count, 1)
+
+
+def _tune_auto(traces: Sequence[Trace], horizon_s: float, params: Mapping[str, Any], max_iterations: int) -> TuneResult:
+    """auto's filters as kalman-cv's by gradient, then memory and margin on a grid (module docstring)."""
+    start = make("auto", **params)
+    shared = {name: value for name, value in params.items() if name in AUTO_FILTER_PARAMS}
+    filters = _fit("kalman-cv", traces, horizon_s, shared, max_iterations)
+    scales = (filters.position_scale, filters.angular_scale)
+    fitted = {name: filters.result.params[name] for name in filters.result.fitted}
+    candidates = [
+        {**params, **fitted, "memory": memory, "margin": margin}
+        for memory in sorted({*AUTO_MEMORY_GRID_S, start.memory})
+        for margin in sorted({*AUTO_MARGIN_GRID, start.margin})
+    ]
+    losses = [_replayed_loss("auto", candidate, traces, horizon_s, *scales) for candidate in candidates]
+    best = int(np.argmin(losses))
+    return TuneResult(
+        "auto", candidates[best], (*filters.result.fitted, "memory", "margin"), float(horizon_s),
+        _replayed_loss("auto", params, traces, horizon_s, *scales), losses[best], filters.result.iterations,
+    )
+
+
+def tune(
+    predictor: str,
+    traces: Sequence[Trace],
+    horizon_s: float,
+    params: Mapping[str, Any] | None = None,
+    max_iterations: int = 40,
+) -> TuneResult:
+    """Fit `predictor`'s parameters (starting from `params`, else its defaults) to predict the
+    training `traces` `horizon_s` seconds ahead."""
+    if predictor not in TUNABLE:
+        raise PredictorError(f"cannot tune {predictor!r}; tunable predictors: {', '.join(TUNABLE)}")
+    if not traces:
+        raise PredictorError("tuning needs at least one training trace")
+    if not (math.isfinite(horizon_s) and horizon_s >= 0.0):
+        raise PredictorError(f"the horizon must be zero or a positive number of seconds, got {horizon_s!r}")
+    if predictor == "auto":
+        return _tune_auto(traces, horizon_s, params or {}, max_iterations)
+    return _fit(predictor, traces, horizon_s, params or {}, max_iterations).result

@@ -66,8 +66,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `tune`."""
     parser = subparsers.add_parser(
         "tune",
-        help="fit a predictor's noise parameters (or DESP's smoothing) to recorded motion",
-        description=__doc__.split("\n\n")[0] + " Tunable: kalman-cv, kalman-ca, desp.",
+        help="fit a predictor's parameters (Kalman noise ratios and damping, DESP's smoothing, auto's "
+        "choice) to recorded motion",
+        description=__doc__.split("\n\n")[0] + " Tunable: kalman-cv, kalman-ca, desp, auto.",
     )
     parser.add_argument("predictor", type=options.predictor_spec, metavar="PREDICTOR[:key=value,...]",
                         help="predictor to tune, with starting or fixed parameters (e.g. the tracker's noise)")

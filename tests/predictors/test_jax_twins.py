@@ -62,3 +62,37 @@ def test_desp_twin_agrees_with_the_real_time_smoother(awkward, interval):
     params = DespParams(*map(jnp.asarray, (0.6, 0.7, interval or 0.0, predictor.max_gap, predictor.max_horizon)))
     positions, orientations = jax.jit(desp_predictions)(params, arrays(awkward))
     assert_agree(awkward, predictor, positions, orientations)
+
+
+def test_damped_kalman_twin_agrees_on_both_sides_of_the_series_switch(awkward):
+    """At 60 Hz a damping of 0.5/s steps with x = 0.008 (series) and 8/s with x = 0.13 (closed form).
+    The orientation filter is the same in kalman-ca, so kalman-cv stands for both."""
+    predictors = [make("kalman-cv", angular_velocity_damping=damping) for damping in (0.5, 8.0)]
+    stacked = KalmanParams(*[
+        jnp.array([getattr(p, field) for p in predictors])
+        for field in ("position_noise", "acceleration_noise", "orientation_noise", "angular_acceleration_noise", "max_gap",
+                      "max_horizon", "angular_velocity_damping")
+    ])
+    run = jax.jit(jax.vmap(lambda params: kalman_predictions(2, params, arrays(awkward))))
+    positions, orientations = run(stacked)
+    for k, predictor in enumerate(predictors):
+        assert_agree(awkward, predictor, positions[k], orientations[k])
+
+
+def test_the_damped_twin_has_the_gradient_of_its_finite_differences_through_duplicate_times(awkward):
+    """Duplicate and out-of-order times step by dt = 0, where the damped step's closed form is 0 / 0:
+    the gradient in the log damping must stay finite and right."""
+    truth = jnp.asarray(awkward.truth_at(awkward.t_arrival[awkward.arrival_order()] + HORIZON)[1])
+
+    def loss(log_damping):
+        params = KalmanParams(*map(jnp.asarray, (0.001, 1.0, 0.002, 5.0, 1.0, 0.5)), jnp.exp(log_damping))
+        _, orientations = kalman_predictions(2, params, arrays(awkward))
+        return jnp.mean(1.0 - jnp.sum(orientations * truth, axis=-1) ** 2)
+
+    value_and_grad = jax.jit(jax.value_and_grad(loss))
+    for log_damping in (np.log(0.5), np.log(8.0)):
+        _, gradient = value_and_grad(log_damping)
+        step = 1e-5
+        difference = (value_and_grad(log_damping + step)[0] - value_and_grad(log_damping - step)[0]) / (2 * step)
+        assert np.isfinite(gradient)
+        assert float(gradient) == pytest.approx(float(difference), rel=1e-5)
