@@ -91,18 +91,24 @@ def cost_ratios(results: Sequence[Evaluation]) -> dict[str, float]:
 
 
 def plot(results: Sequence[Evaluation], horizon_ms: float, path: Path) -> None:
-    """Speed against error at one horizon: one column per trace, angle above, position below."""
-    import matplotlib
+    """Speed against error at one horizon: one column per trace, angle above, position below.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    A trace without position (every predictor's position error zero) gets no position panel.
+    """
+    from matplotlib.figure import Figure
 
     traces = list(dict.fromkeys(r.trace for r in results))
-    figure, axes = plt.subplots(2, len(traces), figsize=(4.5 * len(traces), 7.0), squeeze=False)
+    figure = Figure(figsize=(4.5 * len(traces), 7.0))
+    axes = figure.subplots(2, len(traces), squeeze=False)
     for column, trace in enumerate(traces):
+        of_trace = [r for r in results if r.trace == trace]
         for row, (field, unit) in enumerate((("angular_rms_deg", "deg"), ("position_rms_mm", "mm"))):
             axis = axes[row][column]
-            for result in (r for r in results if r.trace == trace):
+            if all(getattr(r.at(horizon_ms), field) == 0.0 for r in of_trace):
+                axis.set_axis_off()
+                axis.text(0.5, 0.5, f"{trace}: no {'position' if unit == 'mm' else 'orientation'} data", ha="center", transform=axis.transAxes)
+                continue
+            for result in of_trace:
                 error = getattr(result.at(horizon_ms), field)
                 axis.scatter(result.us_per_update, error)
                 axis.annotate(result.predictor, (result.us_per_update, error), textcoords="offset points", xytext=(4, 4))
@@ -112,7 +118,6 @@ def plot(results: Sequence[Evaluation], horizon_ms: float, path: Path) -> None:
             axis.grid(True, alpha=0.3)
     figure.tight_layout()
     figure.savefig(path, dpi=100)
-    plt.close(figure)
 
 
 def run_bench(
