@@ -41,6 +41,10 @@ from rig.truth import effective_latency
 Progress = Callable[[float, float], None]
 NO_IMAGE = -1
 RUN_FILES = ("video.avi", "truth.json", "tracker.csv", "app_frames.csv", "display_frames.csv")
+DEFAULT_WARP_MS = 2.0
+"""Modelled server cost per display frame of a per-display-frame (warp) renderer whose run gives
+none: a GPU's point warp of a display-sized image, well inside a refresh. Software OpenGL takes
+longer; `rig bench renderers` reports the real cost beside the modelled one."""
 _PRUNE_REFRESHES = 4
 
 
@@ -155,7 +159,9 @@ class Simulation:
         c = config
         self.t_begin = -c.warmup_s
         self.t_end = c.duration_s
-        self.pendulum = Pendulum(c.pendulum, t_start=self.t_begin - 1.0, t_end=self.t_end + 1.0)
+        # the truth's latency search (rig.truth) looks up to half a period past the filmed span
+        swing_s = 2.0 * np.pi * np.sqrt(c.pendulum.resolved_length_m / c.pendulum.g)
+        self.pendulum = Pendulum(c.pendulum, t_start=self.t_begin - 1.0, t_end=self.t_end + 1.0 + swing_s)
         self.display = Display(DisplayConfig(**{**asdict(c.display), "t0": self.t_begin}))
         self.layout: BenchLayout = make_layout(self.pendulum, c.camera, c.display)
         self.sensor = CameraSensor(c.camera, seed=c.seed + 1)
@@ -211,10 +217,17 @@ class Simulation:
                 sphere_radius_m=self.layout.sphere_radius_m,
                 scene_triangles=c.scene_triangles,
                 app_frame_ms=c.app_frame_ms,
-                warp_ms=c.warp_ms,
+                warp_ms=self._warp_ms(),
                 seed=c.seed,
             )
         )
+
+    def _warp_ms(self) -> float | None:
+        """The server cost per display frame this run models: the config's, else DEFAULT_WARP_MS
+        for a per-display-frame renderer (a direct renderer has no server)."""
+        if self.config.warp_ms is None and self.renderer.per_display_frame:
+            return DEFAULT_WARP_MS
+        return self.config.warp_ms
 
     def _loop(
         self,
@@ -228,7 +241,7 @@ class Simulation:
         c = self.config
         display = self.display
         per_display = self.renderer.per_display_frame
-        server_s = (c.warp_ms or 0.0) / 1e3 if per_display else 0.0
+        server_s = self._warp_ms() / 1e3 if per_display else 0.0
         panel_images: dict[int, np.ndarray] = {}
         app_finish: list[float] = []
         presents: list[tuple[int, int]] = []
@@ -263,15 +276,18 @@ class Simulation:
                     presents.append((last_present, j))
                     next_app_start = display.vblank_time(last_present)
             if per_display:
-                feed.deliver_until(t_display_event)
                 ready = int(np.searchsorted(app_finish, t_display_event, side="right")) - 1
-                t_photon = display.photon_time(k, row_estimate)
-                result = self.renderer.render_display_frame(DisplayFrameRequest(k, display.vblank_time(k), t_photon, feed.predict, ready))
-                p = result.pose.position
-                row_estimate = self.layout.display_row_fraction(p)
-                current_image = k
-                shown[k] = _Shown(float(p[0]), row_estimate, feed.newest_sensor_time)
-                panel_images[k] = self._panel_image(result.image)
+                # before the first application frame is finished the server has nothing to warp
+                # (nor, maybe, a tracker sample to warp with): the display stays dark
+                if ready >= 0:
+                    feed.deliver_until(t_display_event)
+                    t_photon = display.photon_time(k, row_estimate)
+                    result = self.renderer.render_display_frame(DisplayFrameRequest(k, display.vblank_time(k), t_photon, feed.predict, ready))
+                    p = result.pose.position
+                    row_estimate = self.layout.display_row_fraction(p)
+                    current_image = k
+                    shown[k] = _Shown(float(p[0]), row_estimate, feed.newest_sensor_time)
+                    panel_images[k] = self._panel_image(result.image)
             else:
                 while presents and presents[0][0] <= k:
                     current_image = presents.pop(0)[1]
@@ -363,6 +379,7 @@ class Simulation:
             "camera_fps": c.camera.fps,
             "frames": len(self.frame_times),
             "period_s": self.pendulum.period_s,
+            "display_frame_cost": {"ms": self._warp_ms(), "source": "modelled"} if self.renderer.per_display_frame else None,
             "led_roi": list(self.layout.led_roi),
             "sphere_roi": list(self.layout.sphere_roi),
             "config": c.to_dict(),

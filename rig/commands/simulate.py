@@ -8,7 +8,7 @@ from pathlib import Path
 
 from rig.commands import options
 from rig.progress import ProgressBar
-from rig.session import SimulationConfig, SimulationResult, simulate
+from rig.session import DEFAULT_WARP_MS, SimulationConfig, SimulationResult, simulate
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
@@ -39,7 +39,12 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
         default=defaults.app_frame_ms,
         help="modelled application frame cost in ms, or 'measured' for the real GL time (default: %(default)s)",
     )
-    group.add_argument("--warp-ms", type=options.positive_float, default=None, help="modelled warp cost per display frame in ms")
+    group.add_argument(
+        "--warp-ms",
+        type=options.positive_float,
+        default=None,
+        help=f"modelled warp cost per display frame in ms (default for the warp renderer: {DEFAULT_WARP_MS:g})",
+    )
     group.add_argument(
         "--transport-delay-ms",
         type=options.non_negative_float,

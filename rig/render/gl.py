@@ -31,6 +31,12 @@ LOAD_MAX_INTENSITY = 0.1
 SPHERE_AMBIENT = 0.6
 SPHERE_DIFFUSE = 0.4
 
+FRONT_HALF_DEPTH = np.array(
+    [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.5, -0.5], [0.0, 0.0, 0.0, 1.0]]
+)
+"""The sphere vertex shader's depth squeeze, z' = (z - w) / 2, as a clip-space matrix: the sphere's
+effective projection is FRONT_HALF_DEPTH @ world_to_clip (the warp renderer unprojects with it)."""
+
 
 def create_context() -> moderngl.Context:
     """A headless OpenGL 3.3 context through EGL.
@@ -204,20 +210,39 @@ void main() {
 """
 
 
-def sphere_program(ctx: moderngl.Context, world_to_clip: np.ndarray) -> moderngl.Program:
-    """The sphere's shader program, lit from the projection centre of `world_to_clip`."""
-    program = ctx.program(vertex_shader=SPHERE_VERTEX_SHADER, fragment_shader=SPHERE_FRAGMENT_SHADER)
+def write_matrix(program: moderngl.Program, name: str, matrix: np.ndarray) -> None:
+    """Set the mat4 uniform `name` of `program` to the 4x4 `matrix` (numpy, row-major)."""
     # moderngl takes matrices column-major; numpy holds them row-major.
-    program["world_to_clip"].write(np.asarray(world_to_clip, dtype=np.float64).T.astype(np.float32).tobytes())
+    program[name].write(np.asarray(matrix, dtype=np.float64).T.astype(np.float32).tobytes())
+
+
+def sphere_program(
+    ctx: moderngl.Context, world_to_clip: np.ndarray, fragment_shader: str = SPHERE_FRAGMENT_SHADER
+) -> moderngl.Program:
+    """The sphere's shader program, lit from the projection centre of `world_to_clip`.
+
+    A `fragment_shader` other than the default must declare the default's uniforms and inputs
+    (the warp client's adds an object-ID output).
+    """
+    program = ctx.program(vertex_shader=SPHERE_VERTEX_SHADER, fragment_shader=fragment_shader)
+    write_matrix(program, "world_to_clip", world_to_clip)
     program["eye"].value = tuple(headlight_direction(world_to_clip))
     program["ambient"].value = SPHERE_AMBIENT
     program["diffuse"].value = SPHERE_DIFFUSE
     return program
 
 
-def load_program(ctx: moderngl.Context) -> moderngl.Program:
-    """The load triangles' shader program: positions already in NDC, dimmer with depth."""
-    program = ctx.program(vertex_shader=LOAD_VERTEX_SHADER, fragment_shader=LOAD_FRAGMENT_SHADER)
+def load_program(
+    ctx: moderngl.Context,
+    vertex_shader: str = LOAD_VERTEX_SHADER,
+    fragment_shader: str = LOAD_FRAGMENT_SHADER,
+) -> moderngl.Program:
+    """The load triangles' shader program: positions already in NDC, dimmer with depth.
+
+    Other shaders must declare the defaults' uniforms (the warp client's place the NDC-valued
+    positions with a matrix and add an object-ID output).
+    """
+    program = ctx.program(vertex_shader=vertex_shader, fragment_shader=fragment_shader)
     program["max_intensity"].value = LOAD_MAX_INTENSITY
     program["depth_range"].value = LOAD_DEPTH_RANGE
     return program

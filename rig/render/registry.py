@@ -16,10 +16,11 @@ from importlib.metadata import EntryPoint, entry_points
 from rig.errors import ConfigError, RigError
 from rig.render.direct import DirectRenderer
 from rig.render.protocol import Renderer
+from rig.render.warp import WarpRenderer
 
 ENTRY_POINT_GROUP = "rig.renderers"
 
-BUILT_IN_RENDERERS: dict[str, type] = {"direct": DirectRenderer}
+BUILT_IN_RENDERERS: dict[str, type] = {"direct": DirectRenderer, "warp": WarpRenderer}
 
 
 def renderer_names() -> list[str]:

@@ -1,0 +1,141 @@
+"""The warp renderer's client: draws the scene into colour, per-pixel object ID and depth.
+
+The scene is the direct renderer's (`rig.render.gl`): the tracked sphere, lit by a headlight, in
+front of dim load triangles, on a black background. Each object has a 16-bit ID; 0 is the
+background. Load triangles are stored in the display's NDC, so the load's object matrix is
+inverse(world_to_clip): it maps those coordinates into the world, where any client view can see
+them. There is no multisampling: a pixel has one depth and one object for the warp to move.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from rig.render import gl
+from rig.render.warp_shaders import (
+    CLIENT_LOAD_FRAGMENT_SHADER,
+    CLIENT_LOAD_VERTEX_SHADER,
+    CLIENT_SPHERE_FRAGMENT_SHADER,
+    FULLSCREEN_VERTEX_SHADER,
+    ID_SCALE,
+    SURFACE_FRAGMENT_SHADER,
+)
+
+BACKGROUND_ID = 0
+SPHERE_ID = 1
+LOAD_ID = 2
+OBJECT_COUNT = 3
+
+
+class ClientTarget:
+    """One client view's images: RGBA8 colour, R16 object ID (id / ID_SCALE) and depth textures,
+    and the RGBA32F surface texture the warp reads (see `ClientScene.prepare_surface`)."""
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
+        self.size = size
+        self.colour = ctx.texture(size, 4)
+        self.object_id = ctx.texture(size, 1, dtype="nu2")
+        self.depth = ctx.depth_texture(size)
+        self.surface = ctx.texture(size, 4, dtype="f4")
+        for texture in (self.colour, self.object_id, self.depth, self.surface):
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.depth.compare_func = ""
+        self.framebuffer = ctx.framebuffer(color_attachments=[self.colour, self.object_id], depth_attachment=self.depth)
+        self.surface_framebuffer = ctx.framebuffer(color_attachments=[self.surface])
+
+    def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(colour (h, w, 4) uint8, object ID (h, w) int, window depth (h, w) float32), OpenGL rows
+        (row 0 at the bottom): the inputs of `rig.render.warp_reference.reference_warp`."""
+        w, h = self.size
+        colour = np.frombuffer(self.colour.read(), dtype=np.uint8).reshape(h, w, 4)
+        ids = np.frombuffer(self.object_id.read(), dtype=np.uint16).reshape(h, w).astype(np.int64)
+        depth = np.frombuffer(self.depth.read(), dtype=np.float32).reshape(h, w)
+        return colour.copy(), ids, depth.copy()
+
+    def release(self) -> None:
+        for resource in (self.surface_framebuffer, self.framebuffer, self.surface, self.colour, self.object_id, self.depth):
+            resource.release()
+
+
+@dataclass(frozen=True)
+class ClientView:
+    """A client viewpoint: its projection (world to clip, before any per-object depth partition)."""
+
+    world_to_clip: np.ndarray
+
+
+class ClientScene:
+    """The scene's GL objects in one context, drawn from any `ClientView` into a `ClientTarget`."""
+
+    def __init__(self, ctx: moderngl.Context, sphere_radius_m: float, triangles: np.ndarray) -> None:
+        self.ctx = ctx
+        self._resources: list = []
+        mesh = gl.sphere_mesh(sphere_radius_m)
+        self._sphere_program = self._keep(gl.sphere_program(ctx, np.eye(4), CLIENT_SPHERE_FRAGMENT_SHADER))
+        self._sphere_program["object_id"].value = SPHERE_ID / ID_SCALE
+        self._sphere_vao = self._keep(
+            ctx.vertex_array(
+                self._sphere_program,
+                [
+                    (self._keep(ctx.buffer(mesh.vertices.tobytes())), "3f", "in_vertex"),
+                    (self._keep(ctx.buffer(mesh.normals.tobytes())), "3f", "in_normal"),
+                ],
+                index_buffer=self._keep(ctx.buffer(mesh.indices.tobytes())),
+                index_element_size=4,
+            )
+        )
+        self._load_program = self._keep(gl.load_program(ctx, CLIENT_LOAD_VERTEX_SHADER, CLIENT_LOAD_FRAGMENT_SHADER))
+        self._load_program["object_id"].value = LOAD_ID / ID_SCALE
+        self._surface_program = self._keep(ctx.program(vertex_shader=FULLSCREEN_VERTEX_SHADER, fragment_shader=SURFACE_FRAGMENT_SHADER))
+        self._surface_program["client_id"].value = 0
+        self._surface_program["client_depth"].value = 1
+        self._surface_program["id_scale"].value = ID_SCALE
+        self._surface_vao = self._keep(ctx.vertex_array(self._surface_program, []))
+        self._load_vao = None
+        self.triangle_count = len(triangles)
+        if len(triangles):
+            self._load_vao = self._keep(
+                ctx.vertex_array(self._load_program, [(self._keep(ctx.buffer(triangles.tobytes())), "3f", "in_ndc")])
+            )
+
+    def _keep(self, resource):
+        self._resources.append(resource)
+        return resource
+
+    def draw(self, target: ClientTarget, view: ClientView, load_model: np.ndarray, sphere_position: np.ndarray | None) -> None:
+        """Clear `target` and draw the scene from `view`: the sphere at `sphere_position` (None: no
+        sphere), then the load behind it, whose NDC-valued vertices `load_model` maps to the world."""
+        ctx = self.ctx
+        target.framebuffer.use()
+        target.framebuffer.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        if sphere_position is not None:
+            self.draw_sphere(view, sphere_position)
+        if self._load_vao is not None:
+            gl.write_matrix(self._load_program, "object_to_clip", view.world_to_clip @ load_model)
+            self._load_vao.render(moderngl.TRIANGLES)
+
+    def draw_sphere(self, view: ClientView, position: np.ndarray) -> None:
+        """Draw the sphere at `position` into the framebuffer in use, depth-tested."""
+        gl.write_matrix(self._sphere_program, "world_to_clip", view.world_to_clip)
+        self._sphere_program["eye"].value = tuple(gl.headlight_direction(view.world_to_clip))
+        self._sphere_program["centre"].value = tuple(np.asarray(position, dtype=np.float64))
+        self.ctx.enable(moderngl.DEPTH_TEST)
+        self._sphere_vao.render(moderngl.TRIANGLES)
+
+    def prepare_surface(self, target: ClientTarget) -> None:
+        """Fill `target.surface` from its depth and object IDs: per pixel (NDC depth, depth slopes
+        along x and y, object id), computed once per client frame instead of once per warp."""
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        target.surface_framebuffer.use()
+        target.object_id.use(0)
+        target.depth.use(1)
+        self._surface_vao.render(moderngl.TRIANGLES, vertices=3)
+
+    def release(self) -> None:
+        for resource in reversed(self._resources):
+            resource.release()
+        self._resources.clear()
