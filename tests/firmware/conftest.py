@@ -203,13 +203,3 @@ def start_board(emulator_build: Path, world: ScriptedWorld, tmp_path: Path) -> I
         emulated.stop()
 
 
-@pytest.fixture(autouse=True)
-def no_threads_left() -> Iterator[None]:
-    """Fails a test that leaves a thread running."""
-    before = set(threading.enumerate())
-    yield
-    left = [thread for thread in threading.enumerate() if thread not in before and thread.is_alive()]
-    for thread in left:
-        thread.join(timeout=2.0)
-    still = [thread.name for thread in left if thread.is_alive()]
-    assert not still, f"threads left running: {still}"

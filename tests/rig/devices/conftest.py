@@ -1,25 +1,15 @@
-"""Shared by the device tests: no test may leave a thread running; a synthetic board recording
-of a pendulum and a late display, with the truth known."""
+"""Shared by the device tests: a synthetic board recording of a pendulum and a late display, with
+the truth known."""
 
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass
-from typing import Callable, Iterator
+from typing import Callable
 
 import numpy as np
 import pytest
 
 
-@pytest.fixture(autouse=True)
-def no_threads_left() -> Iterator[None]:
-    before = set(threading.enumerate())
-    yield
-    left = [thread for thread in threading.enumerate() if thread not in before and thread.is_alive()]
-    for thread in left:
-        thread.join(timeout=2.0)
-    still = [thread.name for thread in left if thread.is_alive()]
-    assert not still, f"threads left running: {still}"
 
 
 @dataclass(frozen=True)

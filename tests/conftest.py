@@ -1,0 +1,20 @@
+"""Shared by every test: no test may leave a thread running."""
+
+from __future__ import annotations
+
+import threading
+from typing import Iterator
+
+import pytest
+
+
+@pytest.fixture(autouse=True)
+def no_threads_left() -> Iterator[None]:
+    """Fails a test that leaves a thread running (after giving stragglers two seconds to end)."""
+    before = set(threading.enumerate())
+    yield
+    left = [thread for thread in threading.enumerate() if thread not in before and thread.is_alive()]
+    for thread in left:
+        thread.join(timeout=2.0)
+    still = [thread.name for thread in left if thread.is_alive()]
+    assert not still, f"threads left running: {still}"
