@@ -1,7 +1,6 @@
-"""Steed's phase method: the latency is the phase lag of the sphere's swing behind the LED's.
+"""Steed's phase method (``fft``): the latency is the phase lag of the sphere's swing behind the LED's.
 
-Each track is reduced to one signal, its displacement along its main axis of motion. The swing
-frequency is found from the LED signal: the peak of its Hann-windowed, zero-padded FFT, refined by
+Both signals are on a uniform time grid (gaps interpolated). The swing frequency is found from the LED signal: the peak of its Hann-windowed, zero-padded FFT, refined by
 a golden-section search. The phase of each signal at that frequency comes from the windowed DTFT,
 sum_n w[n] x[n] exp(-2 pi i f t[n]), with the 3x3 Gram correction that removes what the signal's
 negative-frequency image and its mean leak into that sum. The correction turns the DTFT into the
@@ -21,16 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.errors import AnalysisError
-from analysis.tracking import Track
 
 # Fewest pendulum periods a clip must hold for the frequency and phases to mean anything.
 MIN_CYCLES = 2.0
 # The FFT for the coarse frequency search is zero-padded to this many times the signal length.
 ZERO_PAD = 8
-# A track whose displacement along its axis has a smaller standard deviation does not move.
-MIN_MOTION_PX = 0.5
-# An axis whose x component is smaller than this is taken as vertical (see main_axis).
-VERTICAL_X = 0.05
 # Relative tolerance of the refined frequency (a maximum is located to about sqrt(machine epsilon)).
 FREQUENCY_TOLERANCE = 1e-9
 
@@ -48,37 +42,8 @@ class PhaseEstimate:
     sphere_amplitude: float
 
 
-def main_axis(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Unit vector along which the points (x, y) spread most (their first principal axis).
-
-    Its sign follows a fixed rule so that two tracks of the same swing share it: the x component
-    is positive, or for a vertical axis (|x component| < VERTICAL_X) the y component is.
-    """
-    points = np.column_stack([x - x.mean(), y - y.mean()])
-    _, vectors = np.linalg.eigh(points.T @ points)
-    axis = vectors[:, -1]
-    flip = axis[1] < 0 if abs(axis[0]) < VERTICAL_X else axis[0] < 0
-    return -axis if flip else axis
-
-
-def axis_signal(track: Track, name: str) -> np.ndarray:
-    """A track's displacement along its main axis, mean removed, linearly interpolated where invalid."""
-    valid = track.valid
-    if np.count_nonzero(valid) < 2:
-        raise AnalysisError(f"the {name} was found in fewer than two frames; check its ROI")
-    x, y = track.x[valid], track.y[valid]
-    axis = main_axis(x, y)
-    along = (x - x.mean()) * axis[0] + (y - y.mean()) * axis[1]
-    if along.std() < MIN_MOTION_PX:
-        raise AnalysisError(
-            f"the {name} does not move (it swings less than {MIN_MOTION_PX} px); "
-            f"check that the pendulum swings and that the {name} ROI holds the moving {name}"
-        )
-    signal = np.interp(track.t, track.t[valid], along)
-    return signal - signal.mean()
-
-
-def _centred_times(count: int, fps: float) -> np.ndarray:
+def centred_times(count: int, fps: float) -> np.ndarray:
+    """Times of ``count`` uniform samples at ``fps``, measured from the middle of the clip."""
     return (np.arange(count, dtype=np.float64) - (count - 1) / 2) / fps
 
 
@@ -126,7 +91,7 @@ def estimate_frequency(signal: np.ndarray, fps: float) -> float:
     first = math.ceil(bin_hz * size / fps)
     peak = first + int(np.argmax(spectrum[first:]))
     coarse = peak * fps / size
-    times = _centred_times(count, fps)
+    times = centred_times(count, fps)
     frequency = _golden_section_max(
         lambda f: _sine_fit(signal, times, window, f)[2],
         max(coarse - bin_hz, bin_hz / 2),
@@ -147,7 +112,7 @@ def sine_phase(signal: np.ndarray, fps: float, frequency: float) -> tuple[float,
 
     The phase follows the DTFT sign convention: A cos(2 pi f t + phase).
     """
-    times = _centred_times(signal.size, fps)
+    times = centred_times(signal.size, fps)
     a, b, _ = _sine_fit(signal, times, np.hanning(signal.size), frequency)
     return math.atan2(-b, a), math.hypot(a, b)
 
@@ -157,13 +122,17 @@ def wrap_phase(angle: float) -> float:
     return math.pi - (math.pi - angle) % (2 * math.pi)
 
 
-def fft_phase_latency(led: np.ndarray, sphere: np.ndarray, fps: float) -> PhaseEstimate:
+def fft_phase_latency(
+    led: np.ndarray, sphere: np.ndarray, fps: float, frequency: float | None = None
+) -> PhaseEstimate:
     """Latency by Steed's phase method; positive when the sphere lags the LED.
 
-    The latency is only known modulo one period: it is the wrapped phase difference, so values
-    near half a period may belong to the other side.
+    ``frequency`` is the LED's swing frequency if already known (else it is estimated). The
+    latency is only known modulo one period: it is the wrapped phase difference (see
+    ``analysis.cycles`` for the whole number of periods).
     """
-    frequency = estimate_frequency(led, fps)
+    if frequency is None:
+        frequency = estimate_frequency(led, fps)
     led_phase, led_amplitude = sine_phase(led, fps, frequency)
     sphere_phase, sphere_amplitude = sine_phase(sphere, fps, frequency)
     lag = wrap_phase(led_phase - sphere_phase)

@@ -1,45 +1,77 @@
-"""The analysis chain: frames -> ROIs -> blob tracks -> axis signals -> latency."""
+"""The analysis chain: frames -> ROIs -> blob tracks -> frame times -> swing signals -> latency.
+
+The video is decoded once. Its first frames are held to find the ROIs and their backgrounds, then
+every frame is tracked (and its row written to the tracks CSV) as it is decoded. With all tracks in
+hand the frame times are decided, the swing frequency and per-period phases are measured, the
+whole number of periods in the latency is chosen (``analysis.cycles``), and the requested
+estimators run, each taking the same whole number of periods.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import itertools
 import math
-from collections.abc import Callable, Sequence
+import time
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from analysis.cycles import DEFAULT_LATENCY_RANGE_S, CycleResolution, resolve_cycles, unwrap_near
 from analysis.errors import AnalysisError
-from analysis.phase import axis_signal, fft_phase_latency
-from analysis.result import LatencyResult, is_ambiguous
-from analysis.tracking import BlobModel, Roi, Track, calibrate_blob, find_moving_regions, track_blobs
-from analysis.video import open_frames
+from analysis.phase import estimate_frequency, fft_phase_latency
+from analysis.report import TrackStream, write_tracks_csv
+from analysis.result import DEFAULT_METHOD, METHODS, LatencyResult, MethodResult
+from analysis.signals import SwingSignals, swing_signals
+from analysis.timing import check_count, frame_times, implausible_period_warning, repeated_frames
+from analysis.tracking import BlobModel, BlobTracker, Detection, Roi, Track, calibrate_blob, find_moving_regions
+from analysis.video import Frame, FrameSource, VideoFile, open_frames
+from analysis.windows import WindowPhases, damping_rate, gain_ratio, window_phases, windowed_latency
+from analysis.xcorr import xcorr_latency
 
 # The first frames, up to this long, are held in memory to find the ROIs and their backgrounds
 # before tracking starts (so the video is decoded only once)...
 CALIBRATION_SECONDS = 1.5
+# ...and at least this many frames (a wrong, low frame rate must not starve it), as many when the
+# frame rate is not yet known...
+CALIBRATION_MIN_FRAMES = 120
+CALIBRATION_FRAMES_UNKNOWN_RATE = 360
 # ...but never more than this many bytes of them.
 CALIBRATION_MAX_BYTES = 256 * 2**20
 # A track must have a blob in at least this fraction of frames; any frame without one is reported.
 MIN_VALID = 0.5
+# A blob cut off by its ROI's edge in more than this fraction of frames has left its ROI.
+MAX_CLIPPED = 0.1
 # Blobs whose typical peaks differ by less than this fraction count as equally bright.
 EQUAL_BRIGHTNESS = 0.02
+PROGRESS_EVERY = 64
+# Clips shorter than this (by their stated length) report no progress: they are done at once.
+PROGRESS_MIN_SECONDS = 3.0
 
 BRIGHTER_RULE = "auto: brighter blob is the LED"
 LEFT_RULE = "auto: blobs equally bright, left blob is the LED"
+SIDES = ("left", "right")
 
 
-def _auto_models(window: Sequence[np.ndarray], warnings: list[str]) -> tuple[BlobModel, BlobModel, str]:
+def _side_rule(side: str) -> str:
+    return f"given: {side} blob is the LED"
+
+
+def _auto_models(
+    images: Sequence[np.ndarray], led_side: str | None, warnings: list[str]
+) -> tuple[BlobModel, BlobModel, str]:
     """LED and sphere models from the two largest moving regions, and the rule that told them apart.
 
-    The brighter blob (higher typical peak above its background) is the LED; if both are equally
-    bright (within EQUAL_BRIGHTNESS, e.g. both saturated) the left one is.
+    With ``led_side`` the blob on that side is the LED. Otherwise the brighter blob (higher typical
+    peak above its background) is the LED; if both are equally bright (within EQUAL_BRIGHTNESS,
+    e.g. both saturated) the left one is.
     """
-    regions = find_moving_regions(window)
+    regions = find_moving_regions(images)
     if len(regions) < 2:
         raise AnalysisError(
-            f"found {len(regions)} moving bright region(s) in the first {len(window)} frames, expected 2 "
+            f"found {len(regions)} moving bright region(s) in the first {len(images)} frames, expected 2 "
             "(the LED and the sphere); check that both are in view and swinging, "
             "or give led_roi and sphere_roi"
         )
@@ -48,31 +80,197 @@ def _auto_models(window: Sequence[np.ndarray], warnings: list[str]) -> tuple[Blo
             f"found {len(regions)} moving regions; used the two largest, "
             f"{regions[0].as_list()} and {regions[1].as_list()}"
         )
-    first, second = (calibrate_blob(roi, window, "auto-detected") for roi in regions[:2])
+    first, second = (calibrate_blob(roi, images, "auto-detected") for roi in regions[:2])
+    left, right = (first, second) if first.roi.x <= second.roi.x else (second, first)
+    if led_side is not None:
+        return (left, right, _side_rule("left")) if led_side == "left" else (right, left, _side_rule("right"))
     brighter, dimmer = (first, second) if first.typical_peak >= second.typical_peak else (second, first)
     if dimmer.typical_peak < (1 - EQUAL_BRIGHTNESS) * brighter.typical_peak:
         return brighter, dimmer, BRIGHTER_RULE
     warnings.append(
         "the two blobs are equally bright; took the left one as the LED. "
-        "Give led_roi and sphere_roi if that is wrong"
+        "Give led_side or led_roi and sphere_roi if that is wrong"
     )
-    left, right = (first, second) if first.roi.x <= second.roi.x else (second, first)
     return left, right, LEFT_RULE
+
+
+class _Tracked:
+    """Per-frame detections of both blobs, as lists, while the video is read."""
+
+    def __init__(self) -> None:
+        self.stamps: list[float] = []
+        self.rows: tuple[list[Detection], list[Detection]] = ([], [])
+
+    def track(self, stamp: float, detections: tuple[Detection, Detection]) -> None:
+        self.stamps.append(stamp)
+        self.rows[0].append(detections[0])
+        self.rows[1].append(detections[1])
+
+    def track_of(self, which: int, times: np.ndarray, drop: np.ndarray) -> Track:
+        rows = self.rows[which]
+        x = np.array([d.x for d in rows], dtype=np.float64)
+        y = np.array([d.y for d in rows], dtype=np.float64)
+        valid = np.array([d.valid for d in rows], dtype=bool) & ~drop
+        return Track(
+            t=times,
+            x=np.where(valid, x, np.nan),
+            y=np.where(valid, y, np.nan),
+            valid=valid,
+            peak=np.array([d.peak for d in rows], dtype=np.float64),
+            clipped=np.array([d.clipped for d in rows], dtype=bool),
+        )
+
+    def positions(self, which: int) -> tuple[np.ndarray, np.ndarray]:
+        rows = self.rows[which]
+        return np.array([d.x for d in rows]), np.array([d.y for d in rows])
+
+
+def _track_frames(
+    frames: Iterable[Frame],
+    trackers: tuple[BlobTracker, BlobTracker],
+    total: int,
+    progress: Callable[[int, int], object] | None,
+    stream: TrackStream | None,
+) -> _Tracked:
+    tracked = _Tracked()
+    for index, (stamp, image) in enumerate(frames):
+        detections = (trackers[0].locate(image), trackers[1].locate(image))
+        tracked.track(stamp, detections)
+        if stream is not None:
+            stream.write(index, stamp, *detections)
+        if progress is not None and (index + 1) % PROGRESS_EVERY == 0:
+            progress(index + 1, max(total, index + 1))
+    if progress is not None:
+        done = len(tracked.stamps)
+        progress(done, done)
+    return tracked
 
 
 def _checked_track(track: Track, name: str, warnings: list[str]) -> None:
     found = float(np.mean(track.valid))
-    missing = int(np.count_nonzero(~track.valid))
+    clipped = float(np.mean(track.clipped))
+    if clipped > MAX_CLIPPED:
+        raise AnalysisError(
+            f"the {name} leaves its ROI (cut off by its edge) in {clipped:.0%} of frames; "
+            f"give a larger {name} ROI that holds its whole swing"
+        )
     if found < MIN_VALID:
         raise AnalysisError(
             f"the {name} was found in only {found:.0%} of frames; check that its ROI holds it over "
             "the whole swing and that nothing hides it"
         )
+    missing = int(np.count_nonzero(~track.valid))
     if missing:
+        cut = int(np.count_nonzero(track.clipped))
+        reason = f", {cut} of them cut off by the ROI's edge" if cut else ""
         warnings.append(
-            f"the {name} was missing in {missing} frames ({1 - found:.1%}); "
-            "its position there was interpolated"
+            f"the {name} was missing in {missing} frames ({1 - found:.1%}){reason}; those frames were left out"
         )
+
+
+def _rois(
+    video: FrameSource, led_roi: Sequence[float] | None, sphere_roi: Sequence[float] | None
+) -> tuple[Roi, Roi] | None:
+    if (led_roi is None) != (sphere_roi is None):
+        raise AnalysisError("give both led_roi and sphere_roi, or neither to find them automatically")
+    if led_roi is None or sphere_roi is None:
+        return None
+    return Roi.parse(led_roi, video.frame_size, "LED"), Roi.parse(sphere_roi, video.frame_size, "sphere")
+
+
+def _method_names(method: str) -> tuple[str, ...]:
+    if method == "all":
+        return METHODS
+    if method not in METHODS:
+        raise AnalysisError(f"unknown method {method!r}; choose one of {', '.join(METHODS)} or all")
+    return (method,)
+
+
+def _range_s(latency_range_ms: Sequence[float]) -> tuple[float, float]:
+    low, high = (float(v) for v in latency_range_ms)
+    if not (math.isfinite(low) and math.isfinite(high) and low < high):
+        raise AnalysisError(f"latency range {list(latency_range_ms)!r} ms must be two finite numbers, low < high")
+    return low / 1e3, high / 1e3
+
+
+def _estimates(
+    names: tuple[str, ...],
+    signals: SwingSignals,
+    uniform: tuple[np.ndarray, np.ndarray, np.ndarray],
+    windows: WindowPhases,
+    frequency: float,
+    cycles: CycleResolution,
+    damping: float,
+    seed: int,
+    warnings: list[str],
+) -> dict[str, MethodResult]:
+    """Every requested estimator's result, each unwrapped to the chosen whole number of periods."""
+    period = 1.0 / frequency
+    results: dict[str, MethodResult] = {}
+    _, led, sphere = uniform
+    fps = 1.0 / signals.frame_interval
+    if "fft" in names:
+        started = time.perf_counter()
+        estimate = fft_phase_latency(led, sphere, fps, frequency)
+        latency = unwrap_near(estimate.latency_s, cycles.reference_s, period)
+        results["fft"] = MethodResult(
+            "fft", latency * 1e3, None, "sine", time.perf_counter() - started,
+            {"frequency_hz": estimate.frequency_hz, "cycles": estimate.cycles},
+        )  # fmt: skip
+    if "xcorr" in names:
+        started = time.perf_counter()
+        latency = xcorr_latency(led, sphere, fps, period, cycles.reference_s)
+        results["xcorr"] = MethodResult("xcorr", latency * 1e3, None, "sine", time.perf_counter() - started, {})
+    if "sinefit" in names or "bayes" in names:
+        from analysis.sinefit import Guess, fit_sine
+
+        started = time.perf_counter()
+        guess = Guess(frequency, damping, 0.0, cycles.reference_s, gain_ratio(windows))
+        fit = fit_sine(signals, (windows.led_noise, windows.sphere_noise), guess)
+        if abs(fit.latency_s - cycles.reference_s) > period / 4:
+            warnings.append(
+                f"the fit moved the latency from {cycles.reference_s * 1e3:.1f} to {fit.latency_s * 1e3:.1f} ms; "
+                "check the tracks and the plot"
+            )
+        if "sinefit" in names:
+            results["sinefit"] = MethodResult(
+                "sinefit",
+                fit.latency_s * 1e3,
+                (fit.ci95_s[0] * 1e3, fit.ci95_s[1] * 1e3),
+                fit.model,
+                time.perf_counter() - started,
+                {
+                    "se_ms": fit.se_s * 1e3,
+                    "se_white_noise_ms": fit.naive_se_s * 1e3,
+                    "variance_inflation": fit.lag_inflation,
+                    "bic_inflation": fit.inflation,
+                    "frequency_hz": fit.frequency_hz,
+                    "damping_per_s": fit.damping,
+                    "chirp_rad_per_s2": fit.chirp,
+                    "gain": fit.gain,
+                    "residual_rms_px": {"led": fit.residual_rms_px[0], "sphere": fit.residual_rms_px[1]},
+                    "bic": fit.bic,
+                    "bic_wald_screened": fit.bic_screened,
+                    "iterations": fit.iterations,
+                    "frames_per_bin": fit.problem.bins.frames_per_bin,
+                },
+                fit,
+            )
+        if "bayes" in names:
+            from analysis.bayes import sample_posterior
+
+            started = time.perf_counter()
+            posterior = sample_posterior(fit, seed)
+            results["bayes"] = MethodResult(
+                "bayes",
+                posterior.median_s * 1e3,
+                (posterior.ci95_s[0] * 1e3, posterior.ci95_s[1] * 1e3),
+                fit.model,
+                time.perf_counter() - started,
+                posterior.details(),
+                posterior,
+            )
+    return results
 
 
 def analyse(
@@ -81,68 +279,131 @@ def analyse(
     fps: float | None = None,
     led_roi: Sequence[float] | None = None,
     sphere_roi: Sequence[float] | None = None,
+    led_side: str | None = None,
+    method: str = DEFAULT_METHOD,
+    latency_range_ms: Sequence[float] = tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S),
     progress: Callable[[int, int], object] | None = None,
+    tracks_csv: str | Path | None = None,
+    seed: int = 0,
 ) -> LatencyResult:
     """Measure the latency between the LED and the rendered sphere in a video.
 
-    ``source`` is a video file or an array of frames, (N, H, W) grey or (N, H, W, 3) BGR; ``fps``
-    overrides the file's frame rate and is required for arrays. ROIs are [x, y, width, height] in
-    pixels: give both or neither; without them the two largest moving bright regions are used and
-    the brighter is taken as the LED. ``progress(done, total)`` is called as frames are tracked.
+    ``source`` is a video file, a folder of numbered images, or an array of frames, (N, H, W) grey
+    or (N, H, W, 3) BGR; ``fps`` overrides the file's frame rate and is required for arrays and
+    image folders. ROIs are [x, y, width, height] in pixels: give both or neither; without them the
+    two largest moving bright regions are used, the LED being the one on ``led_side`` ("left" or
+    "right") if given, else the brighter. ``method`` is one of fft, xcorr, sinefit, bayes, or all
+    (every one, sinefit reported first). Latencies are looked for in ``latency_range_ms``.
+    ``progress(done, total)`` is called as frames are tracked (for clips of PROGRESS_MIN_SECONDS
+    or more); ``tracks_csv`` receives the tracks
+    as they are measured. ``seed`` seeds the bayes sampler.
     """
+    names = _method_names(method)
+    if led_side is not None and led_side not in SIDES:
+        raise AnalysisError(f"led_side must be left or right, not {led_side!r}")
+    range_s = _range_s(latency_range_ms)
     video = open_frames(source, fps)
-    if (led_roi is None) != (sphere_roi is None):
-        raise AnalysisError("give both led_roi and sphere_roi, or neither to find them automatically")
-    given = (
-        None
-        if led_roi is None or sphere_roi is None
-        else (Roi.parse(led_roi, video.frame_size, "LED"), Roi.parse(sphere_roi, video.frame_size, "sphere"))
-    )
+    given = _rois(video, led_roi, sphere_roi)
+    if video.fps is not None and video.frame_count < PROGRESS_MIN_SECONDS * video.fps:
+        progress = None
     warnings: list[str] = []
-    with contextlib.closing(video.frames()) as stream:
+    started = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        stream = stack.enter_context(contextlib.closing(video.frames()))
+        rows = stack.enter_context(TrackStream(tracks_csv)) if tracks_csv is not None else None
         first = next(stream)
-        window_size = max(
-            2, min(round(CALIBRATION_SECONDS * video.fps), CALIBRATION_MAX_BYTES // first.nbytes)
+        rate = video.fps
+        wanted = (
+            max(CALIBRATION_MIN_FRAMES, round(CALIBRATION_SECONDS * rate)) if rate is not None else CALIBRATION_FRAMES_UNKNOWN_RATE
         )
-        window = [first, *itertools.islice(stream, window_size - 1)]
+        window = [first, *itertools.islice(stream, max(2, min(wanted, CALIBRATION_MAX_BYTES // first[1].nbytes)) - 1)]
+        images = [image for _, image in window]
         if given is None:
-            led_model, sphere_model, led_rule = _auto_models(window, warnings)
+            led_model, sphere_model, led_rule = _auto_models(images, led_side, warnings)
             roi_source = "auto"
         else:
-            led_model = calibrate_blob(given[0], window, "LED")
-            sphere_model = calibrate_blob(given[1], window, "sphere")
+            led_model = calibrate_blob(given[0], images, "LED")
+            sphere_model = calibrate_blob(given[1], images, "sphere")
             roi_source, led_rule = "given", "given"
-        led_track, sphere_track = track_blobs(
-            itertools.chain(window, stream), (led_model, sphere_model), video.fps, video.frame_count, progress
+        del images
+        tracked = _track_frames(
+            itertools.chain(window, stream),
+            (BlobTracker(led_model), BlobTracker(sphere_model)),
+            video.frame_count,
+            progress,
+            rows,
         )
+        del window
+    track_seconds = time.perf_counter() - started
+    analysis_started = time.perf_counter()
+    stamps = np.array(tracked.stamps, dtype=np.float64)
+    times = frame_times(stamps, video.fps if fps is not None else None, video.container_fps, video.stamp_origin)
+    warnings.extend(times.warnings)
+    if isinstance(video, VideoFile):
+        count_warning = check_count(stamps.size, video.frame_count, video.name)
+        if count_warning:
+            warnings.append(count_warning)
+    repeats = repeated_frames(tracked.positions(0), tracked.positions(1))
+    if np.any(repeats):
+        warnings.append(
+            f"{int(np.count_nonzero(repeats))} frame(s) repeat the one before exactly (inserted by the recorder); "
+            "they were left out"
+        )
+    led_track = tracked.track_of(0, times.t, repeats)
+    sphere_track = tracked.track_of(1, times.t, repeats)
+    if tracks_csv is not None:
+        write_tracks_csv(tracks_csv, led_track, sphere_track)
     _checked_track(led_track, "LED", warnings)
     _checked_track(sphere_track, "sphere", warnings)
-    estimate = fft_phase_latency(
-        axis_signal(led_track, "LED"), axis_signal(sphere_track, "sphere"), video.fps
-    )
-    period_s = 1.0 / estimate.frequency_hz
-    ambiguous = is_ambiguous(estimate.latency_s, period_s)
-    if ambiguous:
-        other_ms = (estimate.latency_s - math.copysign(period_s, estimate.latency_s)) * 1e3
-        warnings.append(
-            f"the latency is near half the period ({period_s / 2 * 1e3:.1f} ms), where the phase wraps; "
-            f"it may really be {other_ms:.1f} ms"
-        )
+    signals = swing_signals(led_track, sphere_track)
+    uniform = signals.uniform()
+    uniform_fps = 1.0 / signals.frame_interval
+    frequency = estimate_frequency(uniform[1], uniform_fps)
+    period = 1.0 / frequency
+    period_warning = implausible_period_warning(period, times)
+    if period_warning:
+        warnings.append(period_warning)
+    damping = damping_rate(window_phases(signals, frequency))
+    windows = window_phases(signals, frequency, damping)
+    wrapped = fft_phase_latency(uniform[1], uniform[2], uniform_fps, frequency).latency_s
+    cycles = resolve_cycles(wrapped, period, windows, damping, range_s)
+    if cycles.warning:
+        warnings.append(cycles.warning)
+    results = _estimates(names, signals, uniform, windows, frequency, cycles, damping, seed, warnings)
+    primary = results[names[0] if method != "all" else DEFAULT_METHOD]
+    windowed = windowed_latency(windows, primary.latency_ms / 1e3)
+    both = led_track.valid & sphere_track.valid
+    diagnostics: dict[str, Any] = {
+        "time_source": times.source,
+        "dropped_frames": times.dropped,
+        "repeated_frames": int(np.count_nonzero(repeats)),
+        "variable_frame_rate": times.variable,
+        "detection_rate": {"led": float(np.mean(led_track.valid)), "sphere": float(np.mean(sphere_track.valid))},
+        "clipped_frames": {"led": int(np.count_nonzero(led_track.clipped)), "sphere": int(np.count_nonzero(sphere_track.clipped))},
+        "latency_range_ms": [range_s[0] * 1e3, range_s[1] * 1e3],
+        "damping_per_s": damping,
+        "track_seconds": track_seconds,
+        "estimate_seconds": time.perf_counter() - analysis_started,
+    }
     return LatencyResult(
-        latency_ms=estimate.latency_s * 1e3,
-        ci95_ms=None,
-        method="fft",
-        model="sine",
-        period_s=period_s,
-        fps=video.fps,
-        frames=int(led_track.t.size),
-        frames_used=int(np.count_nonzero(led_track.valid & sphere_track.valid)),
-        ambiguous=ambiguous,
+        latency_ms=primary.latency_ms,
+        ci95_ms=primary.ci95_ms,
+        method=primary.method,
+        model=primary.model,
+        period_s=period,
+        fps=times.fps,
+        frames=int(times.t.size),
+        frames_used=int(np.count_nonzero(both)),
+        ambiguous=cycles.ambiguous,
         warnings=warnings,
         led_roi=led_model.roi,
         sphere_roi=sphere_model.roi,
         roi_source=roi_source,
         led_rule=led_rule,
+        methods=results,
+        cycles=cycles,
+        windowed=windowed,
+        diagnostics=diagnostics,
         led_track=led_track,
         sphere_track=sphere_track,
     )

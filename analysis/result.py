@@ -1,28 +1,52 @@
-"""What an analysis returns: the latency, how it was found, and the tracks it came from."""
+"""What an analysis returns: the latency, how it was found, each method's estimate, and the tracks."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any
 
+from analysis.cycles import CycleResolution
 from analysis.tracking import Roi, Track
+from analysis.windows import WindowedLatency
 
-# A latency within this fraction of a period from half a period is flagged as ambiguous: there the
-# wrapped phase difference may have come from the other side (lead instead of lag).
-AMBIGUITY_MARGIN = 0.1
+METHODS = ("fft", "xcorr", "sinefit", "bayes")
+DEFAULT_METHOD = "sinefit"
 
 
-def is_ambiguous(latency_s: float, period_s: float) -> bool:
-    """Whether |latency| lies within AMBIGUITY_MARGIN periods of half a period."""
-    return abs(latency_s) >= (0.5 - AMBIGUITY_MARGIN) * period_s
+@dataclass(frozen=True)
+class MethodResult:
+    """One estimator's latency (ms, positive when the sphere lags) and its 95 % interval, if it has one.
+
+    seconds is the time the estimator itself took; details holds its diagnostics, JSON-ready.
+    fit holds the estimator's own result object (for plots), left out of the JSON.
+    """
+
+    method: str
+    latency_ms: float
+    ci95_ms: tuple[float, float] | None
+    model: str
+    seconds: float
+    details: dict[str, Any]
+    fit: Any = field(default=None, repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "latency_ms": self.latency_ms,
+            "ci95_ms": list(self.ci95_ms) if self.ci95_ms is not None else None,
+            "model": self.model,
+            "seconds": self.seconds,
+            **self.details,
+        }
 
 
 @dataclass(frozen=True)
 class LatencyResult:
     """The measured latency (positive: the sphere lags the LED) and how it was obtained.
 
-    roi_source says where the ROIs came from ("given" or "auto"); led_rule says how the LED was
-    told from the sphere ("given", or "auto: brighter blob is the LED").
+    latency_ms, ci95_ms and model are those of ``method``; ``methods`` holds every estimator run.
+    roi_source says where the ROIs came from ("given" or "auto"); led_rule how the LED was told
+    from the sphere. ambiguous is True when the whole number of periods in the latency could not
+    be decided (see ``analysis.cycles``); a warning then says why.
     """
 
     latency_ms: float
@@ -39,6 +63,10 @@ class LatencyResult:
     sphere_roi: Roi
     roi_source: str
     led_rule: str
+    methods: dict[str, MethodResult]
+    cycles: CycleResolution
+    windowed: WindowedLatency | None
+    diagnostics: dict[str, Any]
     led_track: Track = field(repr=False)
     sphere_track: Track = field(repr=False)
 
@@ -59,4 +87,8 @@ class LatencyResult:
             "sphere_roi": self.sphere_roi.as_list(),
             "roi_source": self.roi_source,
             "led_rule": self.led_rule,
+            "methods": {name: result.to_dict() for name, result in self.methods.items()},
+            "cycles": self.cycles.to_dict(),
+            "windowed": self.windowed.to_dict() if self.windowed is not None else None,
+            "diagnostics": dict(self.diagnostics),
         }

@@ -1,17 +1,27 @@
 """Regions of interest and blob tracking: where the LED and the sphere are in every frame.
 
 Pixel coordinates are (x right, y down) with the centre of the top-left pixel at (0, 0). A blob's
-position is the intensity-weighted centroid of the pixels in its ROI that stand out from the ROI's
-background by more than a threshold. The weights are the background-subtracted intensities
-themselves (not intensity minus threshold), so the centroid stays linear in the image: a blob
-smeared by motion blur, or the double image of a display refresh during the exposure, gives the
-exposure-averaged position, which keeps the timing of the signal unbiased.
+core is the set of pixels that stand out from the ROI's static background by more than a
+threshold; its position is the centroid of the background-subtracted intensities over the box
+around the core grown by a margin, signed and not thresholded, so the centroid stays linear in
+the image: a blob smeared by motion blur, or the double image of a display refresh during the
+exposure, gives the exposure-averaged position, which keeps the timing of the signal unbiased (a
+threshold would cut the fainter image's edges more than the brighter's and bias the time).
+Saturated cores and bloom are symmetric about the blob and do not move its centroid.
+
+The background is each ROI's per-pixel temporal median, so static bright clutter (a reflection, a
+lamp) is subtracted away: only what moves counts. Each blob is measured in a small window that
+follows it (its last position plus its last step); the window grows until no pixel of the blob
+touches its edge, so it never cuts the blob. When the blob is not in its window it is searched
+for in the whole ROI, around the ROI's brightest pixel. A blob that touches the edge of its ROI is
+cut off: that frame's position is not valid (``clipped``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -24,16 +34,34 @@ NOISE_SIGMAS = 6.0
 PEAK_FRACTION_THRESHOLD = 0.05
 # A frame has a blob if its peak exceeds this fraction of the typical peak (and twice the threshold).
 PEAK_FRACTION_VALID = 0.25
-# Frames used to estimate each ROI's background and noise.
-CALIBRATION_SAMPLES = 64
+# Frames used to estimate each ROI's background and noise (odd: the median is one of them).
+CALIBRATION_SAMPLES = 9
+# find_moving_regions looks at about this many frames spread over those it is given.
+REGION_FRAMES = 120
+# Every this many pixels enter the image-wide statistics of find_moving_regions.
+STATISTICS_STRIDE = 7
 # Dilation radius joining the dotted trail of a sphere held still between display refreshes,
 # as a fraction of the larger frame side.
 TRAIL_JOIN_FRACTION = 0.02
-# Moving-region threshold: this fraction of the way from the typical to the largest temporal
-# intensity range, and at least this many pixel-noise deviations above the typical range.
-MOTION_FRACTION = 0.1
+# Pixels added to an ROI beyond twice that radius (see find_moving_regions).
+ROI_PAD_PX = 4
+# Moving pixels: a temporal intensity range this many pixel-noise deviations above the typical
+# range, and at least this fraction of the way from the typical to the largest range.
 MOTION_NOISE_SIGMAS = 10.0
-PROGRESS_EVERY = 64
+MOTION_FRACTION = 0.03
+# A moving region needs this many moving pixels, and this fraction of the largest region's
+# (isolated noise outliers and compression speckle are not regions).
+MIN_MOVING_PIXELS = 10
+MIN_MOVING_FRACTION = 0.05
+# Pixels added around a blob's calibrated reach and its last step to make its search window.
+WINDOW_MARGIN_PX = 4
+# The centroid sums the background-subtracted pixels, signed and unthresholded, over the box around
+# the blob's above-threshold core grown by this fraction of its reach (at least 2 px; when stray
+# pieces were cut away, over the core's pixels grown as much): the faint edges of a blob and the
+# fainter image of a double exposure count in full, as linearity needs.
+SUPPORT_GROWTH = 0.5
+# Times a window may double before the whole ROI is used.
+WINDOW_GROWTH = 3
 
 MAD_TO_SIGMA = 1.4826
 
@@ -77,7 +105,8 @@ class Roi:
 class Track:
     """A blob's position per frame. x and y are NaN where valid is False (no blob in that frame).
 
-    peak is the blob's brightest pixel above the ROI background, per frame.
+    t is the frame time in s; peak is the blob's brightest pixel above the ROI background;
+    clipped marks frames where the blob touched its ROI's edge (so it is not valid there).
     """
 
     t: np.ndarray
@@ -85,38 +114,54 @@ class Track:
     y: np.ndarray
     valid: np.ndarray
     peak: np.ndarray
+    clipped: np.ndarray
 
 
 @dataclass(frozen=True)
 class BlobModel:
-    """What the tracker knows of one ROI: its static background and how bright a blob is."""
+    """What the tracker knows of one ROI: its static background, how bright a blob is and how far
+    its pixels reach from its centroid (motion blur included)."""
 
     roi: Roi
     background: np.ndarray
     threshold: float
     min_peak: float
     typical_peak: float
+    reach: float
+
+
+class Detection(NamedTuple):
+    """One blob in one frame; x, y in frame pixels, NaN when not valid."""
+
+    x: float
+    y: float
+    peak: float
+    valid: bool
+    clipped: bool
 
 
 def find_moving_regions(frames: Sequence[np.ndarray]) -> list[Roi]:
-    """ROIs around the bright regions whose intensity changes over the frames, largest first.
+    """ROIs around the bright regions whose intensity changes over the frames, most moving pixels first.
 
     Moving pixels are those whose range (temporal max minus min) stands well above the typical
     range, which is what noise gives static pixels; the pixel noise itself is estimated from the
-    difference of two frames. Dilation joins the dotted trail that a sphere held between display
-    refreshes leaves, and each ROI is padded by the dilation radius again so that the blob stays
-    inside it. An empty list means nothing moves.
+    difference of two frames. The threshold follows the noise, so a dim sphere next to a bright
+    LED is found too. Dilation joins the dotted trail that a sphere held between display refreshes
+    leaves, and each ROI is padded by twice the dilation radius and ROI_PAD_PX more, so that the
+    blob's faint edges, which the tracker counts but the motion threshold does not, stay inside;
+    towards a neighbouring region it grows by at most half the gap, so no ROI reaches into another.
+    An empty list means nothing moves.
     """
     height, width = frames[0].shape
     high = frames[0].copy()
     low = frames[0].copy()
-    for frame in frames[1:]:
+    for frame in frames[1 :: max(1, len(frames) // REGION_FRAMES)]:
         cv2.max(high, frame, dst=high)
         cv2.min(low, frame, dst=low)
-    spread = cv2.subtract(high, low).astype(np.float64)
-    typical = float(np.median(spread))
+    spread = cv2.subtract(high, low)
+    typical = float(np.median(spread.reshape(-1)[::STATISTICS_STRIDE]))
     largest = float(spread.max())
-    change = frames[len(frames) // 2].astype(np.float64) - frames[0]
+    change = (frames[len(frames) // 2].astype(np.float64) - frames[0]).reshape(-1)[::STATISTICS_STRIDE]
     noise = MAD_TO_SIGMA * float(np.median(np.abs(change - np.median(change)))) / np.sqrt(2)
     if largest - typical <= MOTION_NOISE_SIGMAS * noise:
         return []
@@ -124,30 +169,74 @@ def find_moving_regions(frames: Sequence[np.ndarray]) -> list[Roi]:
     mask = (spread > typical + margin).astype(np.uint8)
     radius = max(2, round(TRAIL_JOIN_FRACTION * max(width, height)))
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
-    count, _, stats, _ = cv2.connectedComponentsWithStats(cv2.dilate(mask, kernel), connectivity=8)
-    order = np.argsort(-stats[1:, cv2.CC_STAT_AREA], kind="stable") + 1
-    regions = []
-    for label in order[: count - 1]:
-        x, y, w, h = (int(v) for v in stats[label, :4])
-        x0, y0 = max(x - radius, 0), max(y - radius, 0)
-        x1, y1 = min(x + w + radius, width), min(y + h + radius, height)
-        regions.append(Roi(x0, y0, x1 - x0, y1 - y0))
-    return regions
+    pad = 2 * radius + ROI_PAD_PX
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(cv2.dilate(mask, kernel), connectivity=8)
+    moving = np.bincount(labels[mask > 0], minlength=count)
+    order = np.argsort(-moving[1:], kind="stable") + 1
+    least = max(MIN_MOVING_PIXELS, MIN_MOVING_FRACTION * moving[order[0]]) if count > 1 else 0
+    kept = [label for label in order if moving[label] >= least]
+    boxes = [tuple(int(v) for v in stats[label, :4]) for label in kept]
+    return [_padded(box, [b for b in boxes if b is not box], pad, width, height) for box in boxes]
+
+
+def _padded(
+    box: tuple[int, int, int, int], others: list[tuple[int, int, int, int]], pad: int, width: int, height: int
+) -> Roi:
+    """A box grown by ``pad`` on each side, but on a side facing another box by at most half the gap."""
+    x, y, w, h = box
+    left = right = top = bottom = pad
+    for ox, oy, ow, oh in others:
+        if oy < y + h and y < oy + oh:
+            if ox >= x + w:
+                right = min(right, (ox - x - w) // 2)
+            elif ox + ow <= x:
+                left = min(left, (x - ox - ow) // 2)
+        if ox < x + w and x < ox + ow:
+            if oy >= y + h:
+                bottom = min(bottom, (oy - y - h) // 2)
+            elif oy + oh <= y:
+                top = min(top, (y - oy - oh) // 2)
+    x0, y0 = max(x - left, 0), max(y - top, 0)
+    x1, y1 = min(x + w + right, width), min(y + h + bottom, height)
+    return Roi(x0, y0, x1 - x0, y1 - y0)
+
+
+def _blob_reach(diffs: np.ndarray, threshold: float, min_peak: float) -> float:
+    """How far (px) a blob reaches from its centre: half the larger side of the box around the
+    above-threshold piece that holds the brightest pixel, 90th percentile over frames with a blob."""
+    reaches = []
+    for diff in diffs:
+        _, peak, _, (px, py) = cv2.minMaxLoc(diff)
+        if peak < min_peak:
+            continue
+        _, labels, stats, _ = cv2.connectedComponentsWithStats((diff > threshold).view(np.uint8), connectivity=8)
+        _, _, w, h, _ = stats[labels[py, px]]
+        reaches.append(max(w, h) / 2 + 1)
+    return float(np.percentile(reaches, 90)) if reaches else float(max(diffs.shape[1:]))
+
+
+def _noise_sigma(diff: np.ndarray, integer: bool) -> float:
+    """Standard deviation of the pixel noise about the background (MAD estimate), at least one
+    level for 8-bit images: a compressed dark background is flat, its MAD zero, yet it flickers
+    by a few levels."""
+    sample = np.abs(diff.reshape(-1)[::STATISTICS_STRIDE])
+    robust = MAD_TO_SIGMA * float(np.median(sample))
+    return max(robust, 1.0) if integer else robust
 
 
 def calibrate_blob(roi: Roi, frames: Sequence[np.ndarray], name: str) -> BlobModel:
-    """Background (per-pixel temporal median), noise and blob brightness of an ROI.
+    """Background (per-pixel temporal median), noise, blob brightness and reach of an ROI.
 
-    Uses up to CALIBRATION_SAMPLES frames spread over ``frames``; the median is the background as
-    long as the blob covers each pixel in fewer than half of them, which holds for a swinging
-    pendulum seen over at least half a period.
+    Uses up to CALIBRATION_SAMPLES frames spread over ``frames`` (the lower middle value for an
+    even number); the median is the background as long as the blob covers each pixel in fewer than
+    half of them, which holds for a swinging pendulum seen over at least half a period.
     """
     step = max(1, len(frames) // CALIBRATION_SAMPLES)
     crops = np.stack([roi.crop(frame) for frame in frames[::step][:CALIBRATION_SAMPLES]])
-    median = np.median(crops, axis=0)
-    background = (np.rint(median) if crops.dtype == np.uint8 else median).astype(crops.dtype)
-    diff = crops.astype(np.float64) - background
-    noise = MAD_TO_SIGMA * float(np.median(np.abs(diff)))
+    middle = (len(crops) - 1) // 2
+    background = np.ascontiguousarray(np.partition(crops, middle, axis=0)[middle])
+    diff = crops.astype(np.float32) - background
+    noise = _noise_sigma(diff, crops.dtype == np.uint8)
     typical_peak = float(np.median(diff.max(axis=(1, 2))))
     if typical_peak <= 2 * NOISE_SIGMAS * noise or typical_peak <= 0:
         raise AnalysisError(
@@ -156,52 +245,99 @@ def calibrate_blob(roi: Roi, frames: Sequence[np.ndarray], name: str) -> BlobMod
         )
     threshold = max(NOISE_SIGMAS * noise, PEAK_FRACTION_THRESHOLD * typical_peak)
     min_peak = max(2 * threshold, PEAK_FRACTION_VALID * typical_peak)
-    return BlobModel(roi, np.ascontiguousarray(background), threshold, min_peak, typical_peak)
+    reach = _blob_reach(diff, threshold, min_peak)
+    return BlobModel(roi, background, threshold, min_peak, typical_peak, reach)
 
 
-def locate_blob(model: BlobModel, frame: np.ndarray) -> tuple[float, float, float, bool]:
-    """(x, y, peak, valid) of the blob in one frame; x and y are NaN when no blob is bright enough."""
-    diff = cv2.subtract(model.roi.crop(frame), model.background)
-    peak = cv2.minMaxLoc(diff)[1]
-    if peak < model.min_peak:
-        return np.nan, np.nan, peak, False
-    # Moments over the bounding box of the kept pixels: the same sums, at a fraction of the cost.
-    x, y, w, h = cv2.boundingRect(cv2.compare(diff, model.threshold, cv2.CMP_GT))
-    weights = cv2.threshold(diff[y : y + h, x : x + w], model.threshold, 0, cv2.THRESH_TOZERO)[1]
-    moments = cv2.moments(weights)
-    mass = moments["m00"]
-    return model.roi.x + x + moments["m10"] / mass, model.roi.y + y + moments["m01"] / mass, peak, True
+class BlobTracker:
+    """Follows one blob from frame to frame in a window around where it is expected."""
 
+    def __init__(self, model: BlobModel) -> None:
+        self.model = model
+        self._grow = max(2, round(SUPPORT_GROWTH * model.reach))
+        self._kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (2 * self._grow + 1, 2 * self._grow + 1))
+        self._position: tuple[float, float] | None = None
+        self._step = (0.0, 0.0)
 
-def track_blobs(
-    frames: Iterable[np.ndarray],
-    models: Sequence[BlobModel],
-    fps: float,
-    total: int,
-    progress: Callable[[int, int], object] | None = None,
-) -> list[Track]:
-    """One track per model over all frames; ``progress(done, total)`` is called as frames go by."""
-    rows: list[list[tuple[float, float, float, bool]]] = [[] for _ in models]
-    done = 0
-    for frame in frames:
-        for model, row in zip(models, rows, strict=True):
-            row.append(locate_blob(model, frame))
-        done += 1
-        if progress is not None and done % PROGRESS_EVERY == 0:
-            progress(done, max(total, done))
-    if progress is not None:
-        progress(done, done)
-    times = np.arange(done, dtype=np.float64) / fps
-    tracks = []
-    for row in rows:
-        x, y, peak, valid = zip(*row, strict=True)
-        tracks.append(
-            Track(
-                times,
-                np.array(x, dtype=np.float64),
-                np.array(y, dtype=np.float64),
-                np.array(valid, dtype=bool),
-                np.array(peak, dtype=np.float64),
-            )
-        )
-    return tracks
+    def locate(self, frame: np.ndarray) -> Detection:
+        """The blob in one frame (frame pixel coordinates)."""
+        model = self.model
+        crop = model.roi.crop(frame)
+        found = None
+        if self._position is not None:
+            centre = (self._position[0] + self._step[0], self._position[1] + self._step[1])
+            half = model.reach + max(abs(self._step[0]), abs(self._step[1])) + WINDOW_MARGIN_PX
+            found = self._measure(crop, centre, half)
+        if found is None:
+            diff = cv2.subtract(crop, model.background)
+            _, peak, _, (px, py) = cv2.minMaxLoc(diff)
+            if peak < model.min_peak:
+                self._position = None
+                return Detection(np.nan, np.nan, peak, False, False)
+            found = self._measure(crop, (float(px), float(py)), model.reach + WINDOW_MARGIN_PX)
+        if found is None:
+            self._position = None
+            return Detection(np.nan, np.nan, 0.0, False, False)
+        x, y, peak, clipped = found
+        if clipped:
+            self._position = None
+            return Detection(np.nan, np.nan, peak, False, True)
+        if self._position is not None:
+            self._step = (x - self._position[0], y - self._position[1])
+        else:
+            self._step = (0.0, 0.0)
+        self._position = (x, y)
+        return Detection(model.roi.x + x, model.roi.y + y, peak, True, False)
+
+    def _measure(
+        self, crop: np.ndarray, centre: tuple[float, float], half: float
+    ) -> tuple[float, float, float, bool] | None:
+        """(x, y, peak, clipped) in ROI coordinates of the blob near ``centre``, or None if none there."""
+        model = self.model
+        height, width = crop.shape
+        grow = self._grow
+        cx, cy = centre
+        for _ in range(WINDOW_GROWTH + 1):
+            x0, y0 = max(0, int(cx - half)), max(0, int(cy - half))
+            x1, y1 = min(width, int(cx + half) + 2), min(height, int(cy + half) + 2)
+            if x1 <= x0 or y1 <= y0:
+                return None
+            diff = cv2.subtract(crop[y0:y1, x0:x1], model.background[y0:y1, x0:x1], dtype=cv2.CV_32F)
+            peak = cv2.minMaxLoc(diff)[1]
+            if peak < model.min_peak:
+                return None
+            mask, (bx, by, bw, bh) = self._blob_mask(diff)
+            sx0, sy0, sx1, sy1 = bx - grow, by - grow, bx + bw + grow, by + bh + grow
+            cut = (sx0 < 0 < x0) or (sy0 < 0 < y0) or (sx1 > x1 - x0 and x1 < width) or (sy1 > y1 - y0 and y1 < height)
+            if not cut:
+                clipped = bx == 0 or by == 0 or bx + bw == x1 - x0 or by + bh == y1 - y0
+                sx0, sy0, sx1, sy1 = max(sx0, 0), max(sy0, 0), min(sx1, x1 - x0), min(sy1, y1 - y0)
+                weights = diff[sy0:sy1, sx0:sx1]
+                if mask is not None:
+                    weights = np.where(cv2.dilate(mask[sy0:sy1, sx0:sx1], self._kernel) > 0, weights, 0.0)
+                moments = cv2.moments(weights)
+                mass = moments["m00"]
+                return x0 + sx0 + moments["m10"] / mass, y0 + sy0 + moments["m01"] / mass, peak, clipped
+            cx, cy = x0 + bx + bw / 2, y0 + by + bh / 2
+            half *= 2
+        return self._measure(crop, (width / 2, height / 2), max(width, height))
+
+    def _blob_mask(self, diff: np.ndarray) -> tuple[np.ndarray | None, tuple[int, int, int, int]]:
+        """(mask, bounding box) of the blob's core in a window: the pixels above the threshold in
+        connected pieces that reach twice the threshold somewhere (so a stray noise pixel is not
+        part of the blob, while the fainter image of a double exposure is). Pieces are only looked
+        for when the pixels spread wider than the blob's calibrated reach or touch the window's
+        edge; the mask is None when the whole box around the core is the blob's."""
+        threshold = self.model.threshold
+        mask = cv2.compare(diff, threshold, cv2.CMP_GT)
+        box = cv2.boundingRect(mask)
+        x, y, w, h = box
+        inside = x > 0 and y > 0 and x + w < diff.shape[1] and y + h < diff.shape[0]
+        if inside and max(w, h) <= 2 * self.model.reach + 2:
+            return None, box
+        count, labels, _, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        if count <= 2:
+            return None, box
+        strong = [k for k in range(1, count) if cv2.minMaxLoc(diff, (labels == k).view(np.uint8))[1] >= 2 * threshold]
+        kept = np.isin(labels, strong).view(np.uint8)
+        return kept, cv2.boundingRect(kept)

@@ -1,41 +1,58 @@
-"""Frame sources: a video file or an in-memory array, yielding grayscale frames in order.
+"""Frame sources: a video file, a folder of numbered images, or an in-memory array.
 
-Every source yields 2-D frames (height, width): uint8 for video files and uint8 arrays, float32 for
-other arrays. Frame ``i`` was taken at ``t = i / fps``.
+Every source yields ``(stamp, frame)`` pairs in order: ``frame`` is 2-D (height, width), uint8 for
+files, images and uint8 arrays, float32 for other arrays; ``stamp`` is the frame's time as the
+source records it, in seconds (a container's presentation time, an image's number over the frame
+rate, an array index over the frame rate), or NaN where there is none. Which times the analysis
+trusts is decided afterwards from all the stamps (see ``analysis.timing``).
 
 Motion-JPEG files are read as raw packets and decoded straight to grayscale with ``cv2.imdecode``:
 libjpeg then skips chroma upsampling and colour conversion, which makes decoding about 1.7x faster
-than ``VideoCapture.read`` followed by a grey conversion, and lets a few threads decode ahead of the
-tracker. Any other codec, or a Motion-JPEG stream whose packets are not complete JPEG images, is
-read the ordinary way.
+than ``VideoCapture.read`` followed by a grey conversion. Packets and image files are decoded by a
+few threads ahead of the tracker (OpenCV releases the GIL while decoding). Any other codec is read
+the ordinary way.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import re
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
-from typing import Protocol
+from typing import Protocol, TypeVar
 
 import cv2
 import numpy as np
 
 from analysis.errors import AnalysisError
 
-# Threads decoding JPEG frames (OpenCV releases the GIL while decoding), and how many frames they
-# may run ahead of the consumer.
+# Threads decoding frames, and how many frames they may run ahead of the consumer (enough to keep
+# them busy while the consumer finds the ROIs in the first frames).
 DECODE_THREADS = min(4, os.cpu_count() or 1)
-READ_AHEAD = 2 * DECODE_THREADS
+READ_AHEAD = 64
+IMAGE_SUFFIXES = frozenset({".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".webp"})
+# Frame rates outside this range are not believed when a container states them.
+PLAUSIBLE_FPS = (1.0, 10_000.0)
+
+Frame = tuple[float, np.ndarray]
+_Item = TypeVar("_Item")
 
 
 class FrameSource(Protocol):
     """What the analyser needs from a video: its rate, size, length and grey frames in order."""
 
     @property
-    def fps(self) -> float: ...
+    def fps(self) -> float | None:
+        """The frame rate the user gave, else the container's if plausible, else None."""
+        ...
+
+    @property
+    def container_fps(self) -> float | None:
+        """The frame rate the file states (None for arrays and image folders)."""
+        ...
 
     @property
     def frame_size(self) -> tuple[int, int]:
@@ -44,24 +61,35 @@ class FrameSource(Protocol):
 
     @property
     def frame_count(self) -> int:
-        """Number of frames; for a file, what its container says (used for progress only)."""
+        """Number of frames; for a file, what its container says (used for progress and checks)."""
         ...
 
-    def frames(self) -> Iterator[np.ndarray]: ...
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def stamp_origin(self) -> str:
+        """Where the frames' stamps come from, for messages."""
+        ...
+
+    def frames(self) -> Iterator[Frame]: ...
 
 
 def open_frames(source: str | Path | np.ndarray, fps: float | None = None) -> FrameSource:
-    """A frame source for a video path or a (N, H, W) / (N, H, W, 3) BGR array of frames."""
+    """A frame source for a video path, a folder of numbered images, or a (N, H, W) / (N, H, W, 3)
+    BGR array of frames; ``fps`` overrides the file's frame rate and is required for the others."""
     if isinstance(source, np.ndarray):
         return FrameArray(source, fps)
     if isinstance(source, (str, Path)):
-        return VideoFile(source, fps)
+        path = Path(source)
+        return ImageFolder(path, fps) if path.is_dir() else VideoFile(path, fps)
     raise AnalysisError(
-        f"cannot analyse a {type(source).__name__}; give a video file path or a numpy array of frames"
+        f"cannot analyse a {type(source).__name__}; give a video file, a folder of images or a numpy array of frames"
     )
 
 
-def _checked_fps(fps: float | None) -> float | None:
+def checked_fps(fps: float | None) -> float | None:
+    """A user's frame rate as a float; AnalysisError unless it is a positive finite number."""
     if fps is None:
         return None
     value = float(fps)
@@ -70,8 +98,34 @@ def _checked_fps(fps: float | None) -> float | None:
     return value
 
 
+def _ordered_map(
+    function: Callable[[_Item], np.ndarray | None], items: Iterable[_Item], describe: Callable[[int], str]
+) -> Iterator[np.ndarray]:
+    """function(item) for each item, computed by worker threads a few items ahead, yielded in order.
+
+    A None result is a frame that cannot be decoded: AnalysisError naming it via ``describe``.
+    """
+    with ThreadPoolExecutor(max_workers=DECODE_THREADS) as pool:
+        pending: deque[Future[np.ndarray | None]] = deque()
+        index = 0
+        iterator = iter(items)
+        more = True
+        while more or pending:
+            if more:
+                item = next(iterator, None)
+                more = item is not None
+                if item is not None:
+                    pending.append(pool.submit(function, item))
+            if pending and (not more or len(pending) > READ_AHEAD):
+                frame = pending.popleft().result()
+                if frame is None:
+                    raise AnalysisError(f"{describe(index)} is corrupt; re-record it or leave it out")
+                yield frame
+                index += 1
+
+
 class FrameArray:
-    """Frames held in memory: (N, H, W) grey or (N, H, W, 3) BGR, any real dtype."""
+    """Frames held in memory: (N, H, W) grey or (N, H, W, 3) BGR, any real dtype; frame i at i / fps."""
 
     def __init__(self, frames: np.ndarray, fps: float | None) -> None:
         if frames.ndim not in (3, 4) or (frames.ndim == 4 and frames.shape[3] != 3):
@@ -82,15 +136,19 @@ class FrameArray:
             raise AnalysisError("the array of frames is empty; give at least a few pendulum periods of video")
         if not np.issubdtype(frames.dtype, np.number) or np.iscomplexobj(frames):
             raise AnalysisError(f"frames must hold real pixel values, not {frames.dtype}")
-        checked = _checked_fps(fps)
+        checked = checked_fps(fps)
         if checked is None:
-            raise AnalysisError("an array of frames carries no frame rate; pass fps=<frames per second>")
+            raise AnalysisError("no frame rate is known for an array of frames; pass fps=<frames per second>")
         self._frames = frames
         self._fps = checked
 
     @property
     def fps(self) -> float:
         return self._fps
+
+    @property
+    def container_fps(self) -> None:
+        return None
 
     @property
     def frame_size(self) -> tuple[int, int]:
@@ -100,15 +158,103 @@ class FrameArray:
     def frame_count(self) -> int:
         return int(self._frames.shape[0])
 
-    def frames(self) -> Iterator[np.ndarray]:
+    @property
+    def name(self) -> str:
+        return "the array of frames"
+
+    @property
+    def stamp_origin(self) -> str:
+        return "array index"
+
+    def frames(self) -> Iterator[Frame]:
         dtype = np.uint8 if self._frames.dtype == np.uint8 else np.float32
-        for frame in self._frames:
+        for index, frame in enumerate(self._frames):
             grey = frame.astype(dtype, copy=False)
-            yield cv2.cvtColor(grey, cv2.COLOR_BGR2GRAY) if grey.ndim == 3 else grey
+            yield index / self._fps, cv2.cvtColor(grey, cv2.COLOR_BGR2GRAY) if grey.ndim == 3 else grey
+
+
+def _frame_number(path: Path) -> int | None:
+    numbers = re.findall(r"\d+", path.stem)
+    return int(numbers[-1]) if numbers else None
+
+
+class ImageFolder:
+    """A folder of numbered images (frame_0001.png, ...): frame n was taken at n / fps.
+
+    The number is the last run of digits in each file name; gaps in the numbering are dropped
+    frames and show as gaps in time.
+    """
+
+    def __init__(self, folder: Path, fps: float | None) -> None:
+        images = sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file())
+        if not images:
+            raise AnalysisError(
+                f"{folder} holds no images ({', '.join(sorted(IMAGE_SUFFIXES))}); give a video file or a folder of frames"
+            )
+        unnumbered = [p.name for p in images if _frame_number(p) is None]
+        if unnumbered:
+            raise AnalysisError(
+                f"{folder} holds images without a frame number, e.g. {unnumbered[0]}; name them like frame_0001.png"
+            )
+        numbered = sorted((_frame_number(p), p) for p in images)
+        repeated = [n for (n, _), (m, _) in zip(numbered, numbered[1:]) if n == m]
+        if repeated:
+            raise AnalysisError(f"{folder} holds two images numbered {repeated[0]}; keep one image per frame number")
+        self._numbers = [n for n, _ in numbered]
+        self._paths = [p for _, p in numbered]
+        checked = checked_fps(fps)
+        if checked is None:
+            raise AnalysisError(
+                f"no frame rate is known for the images in {folder}; pass --fps (fps=) with the camera's frame rate"
+            )
+        self._fps = checked
+        first = cv2.imread(str(self._paths[0]), cv2.IMREAD_GRAYSCALE)
+        if first is None:
+            raise AnalysisError(f"{self._paths[0]} cannot be read as an image")
+        self._frame_size = int(first.shape[1]), int(first.shape[0])
+        self._folder = folder
+
+    @property
+    def fps(self) -> float:
+        return self._fps
+
+    @property
+    def container_fps(self) -> None:
+        return None
+
+    @property
+    def frame_size(self) -> tuple[int, int]:
+        return self._frame_size
+
+    @property
+    def frame_count(self) -> int:
+        return len(self._paths)
+
+    @property
+    def name(self) -> str:
+        return str(self._folder)
+
+    @property
+    def stamp_origin(self) -> str:
+        return "image number"
+
+    def frames(self) -> Iterator[Frame]:
+        decoded = _ordered_map(
+            lambda path: cv2.imread(str(path), cv2.IMREAD_GRAYSCALE),
+            self._paths,
+            lambda index: f"image {self._paths[index]}",
+        )
+        for number, frame in zip(self._numbers, decoded, strict=False):
+            if (frame.shape[1], frame.shape[0]) != self._frame_size:
+                raise AnalysisError(
+                    f"image number {number} in {self._folder} is {frame.shape[1]}x{frame.shape[0]}, not "
+                    f"{self._frame_size[0]}x{self._frame_size[1]} like the first; keep one camera's frames per folder"
+                )
+            yield (number - self._numbers[0]) / self._fps, frame
 
 
 class VideoFile:
-    """A video file read with OpenCV; the frame rate comes from ``fps`` if given, else the container."""
+    """A video file read with OpenCV; its frames carry the container's presentation times."""
 
     def __init__(self, path: str | Path, fps: float | None = None) -> None:
         self._path = Path(path)
@@ -118,26 +264,31 @@ class VideoFile:
         try:
             if not capture.isOpened():
                 raise AnalysisError(
-                    f"{self._path} cannot be read as a video; give a video file (e.g. an MJPG .avi)"
+                    f"{self._path} cannot be read as a video; give a video file (mp4, avi, mov, mkv) "
+                    "or a folder of numbered images"
                 )
-            container_fps = capture.get(cv2.CAP_PROP_FPS)
+            stated = capture.get(cv2.CAP_PROP_FPS)
             self._frame_count = max(int(capture.get(cv2.CAP_PROP_FRAME_COUNT)), 0)
             fourcc = int(capture.get(cv2.CAP_PROP_FOURCC)).to_bytes(4, "little")
             ok, first = capture.read()
         finally:
             capture.release()
-        if not ok:
+        if not ok or first is None:
             raise AnalysisError(f"{self._path} contains no frames; record the pendulum for a few periods")
-        explicit = _checked_fps(fps)
-        if explicit is None and not (math.isfinite(container_fps) and container_fps > 0):
-            raise AnalysisError(f"{self._path} does not say its frame rate; pass fps=<frames per second>")
-        self._fps = explicit if explicit is not None else float(container_fps)
+        low, high = PLAUSIBLE_FPS
+        self._container_fps = float(stated) if math.isfinite(stated) and low <= stated <= high else None
+        explicit = checked_fps(fps)
+        self._fps = explicit if explicit is not None else self._container_fps
         self._frame_size = int(first.shape[1]), int(first.shape[0])
         self._raw_jpeg = fourcc.upper() == b"MJPG" and self._raw_packets_decode()
 
     @property
-    def fps(self) -> float:
+    def fps(self) -> float | None:
         return self._fps
+
+    @property
+    def container_fps(self) -> float | None:
+        return self._container_fps
 
     @property
     def frame_size(self) -> tuple[int, int]:
@@ -146,6 +297,14 @@ class VideoFile:
     @property
     def frame_count(self) -> int:
         return self._frame_count
+
+    @property
+    def name(self) -> str:
+        return str(self._path)
+
+    @property
+    def stamp_origin(self) -> str:
+        return "container"
 
     def _raw_packets_decode(self) -> bool:
         """Whether this file's packets are whole JPEG images of the frame size (see module docstring)."""
@@ -161,38 +320,35 @@ class VideoFile:
         grey = cv2.imdecode(packet.reshape(-1), cv2.IMREAD_GRAYSCALE)
         return grey is not None and (grey.shape[1], grey.shape[0]) == self._frame_size
 
-    def frames(self) -> Iterator[np.ndarray]:
+    def frames(self) -> Iterator[Frame]:
         capture = cv2.VideoCapture(str(self._path))
         try:
             if self._raw_jpeg and capture.set(cv2.CAP_PROP_FORMAT, -1):
-                yield from self._decoded_packets(capture)
+                stamps: deque[float] = deque()
+                packets = self._packets(capture, stamps)
+                decoded = _ordered_map(
+                    lambda packet: cv2.imdecode(packet, cv2.IMREAD_GRAYSCALE),
+                    packets,
+                    lambda index: f"frame {index} of {self._path}",
+                )
+                for frame in decoded:
+                    yield stamps.popleft(), frame
                 return
             while True:
                 ok, frame = capture.read()
                 if not ok:
                     return
-                yield cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame
+                stamp = capture.get(cv2.CAP_PROP_POS_MSEC) / 1e3
+                yield stamp, cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame
         finally:
             capture.release()
 
-    def _decoded_packets(self, capture: cv2.VideoCapture) -> Iterator[np.ndarray]:
-        """JPEG packets decoded to grey by worker threads a few frames ahead of the consumer, in order."""
-        with ThreadPoolExecutor(max_workers=DECODE_THREADS) as pool:
-            pending: deque[Future[np.ndarray | None]] = deque()
-            index = 0
-            more = True
-            while more or pending:
-                if more:
-                    more, packet = capture.read()
-                    if more:
-                        pending.append(
-                            pool.submit(cv2.imdecode, packet.reshape(-1).copy(), cv2.IMREAD_GRAYSCALE)
-                        )
-                if pending and (not more or len(pending) > READ_AHEAD):
-                    grey = pending.popleft().result()
-                    if grey is None:
-                        raise AnalysisError(
-                            f"frame {index} of {self._path} is corrupt; re-record or trim the video"
-                        )
-                    yield grey
-                    index += 1
+    @staticmethod
+    def _packets(capture: cv2.VideoCapture, stamps: deque[float]) -> Iterator[np.ndarray]:
+        """Raw packets in order; each one's presentation time (s) is appended to ``stamps``."""
+        while True:
+            ok, packet = capture.read()
+            if not ok or packet is None:
+                return
+            stamps.append(capture.get(cv2.CAP_PROP_POS_MSEC) / 1e3)
+            yield packet.reshape(-1).copy()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib
 
-SUBJECTS = ("predictors", "renderers")
+SUBJECTS = ("analyser", "predictors", "renderers")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:

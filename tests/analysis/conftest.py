@@ -1,12 +1,14 @@
 """Synthetic pendulum videos with a known latency, for testing the analyser (given to tests as fixtures).
 
-The LED hangs on a damped pendulum and is drawn as a saturating Gaussian blob. The sphere is a
+The LED hangs on a damped pendulum and is drawn as a saturating Gaussian blob (with an optional
+wide halo: bloom). With ``chirp`` the swing's frequency rises as its amplitude decays, as a real
+pendulum's does (by amplitude^2 / 16). The sphere is a
 dimmer, shaded blob that a display shows at the LED's position ``latency_s`` earlier: each display
 refresh holds one pose for 1/display_hz, sampled so that the middle of the hold is ``latency_s``
 after the sampled pose; that makes ``latency_s`` the mean delay of the sphere's swing, which is
 what the phase method measures. The camera integrates light over an exposure centred on its frame
 time ``n / fps`` (box filter; the sphere's held poses are weighted by their exact overlap with it),
-then adds Gaussian noise and clips to 8 bits.
+then adds static bright clutter, Gaussian noise and optional defocus blur, and clips to 8 bits.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import cv2
 import numpy as np
 import pytest
 
-LED_SUBSAMPLES = 4
+LED_SUBSAMPLES = 12
 # Noise frames drawn once and picked at random per frame: independent enough, and fast.
 NOISE_BANK = 61
 
@@ -57,6 +59,11 @@ class PendulumScene:
     panel: float = 20.0
     noise: float = 2.0
     led_moves: bool = True
+    chirp: bool = False
+    bloom_gain: float = 0.0
+    bloom_sigma: float = 4.5
+    clutter: tuple[tuple[float, float, float], ...] = ()
+    defocus_px: float = 0.0
     seed: int = 0
 
     @property
@@ -68,7 +75,13 @@ def pendulum_angle(scene: PendulumScene, t: np.ndarray) -> np.ndarray:
     if not scene.led_moves:
         return np.zeros_like(t)
     damping = -math.log(1 - scene.decay) / scene.duration_s
-    return scene.swing_rad * np.exp(-damping * t) * np.sin(2 * np.pi * t / scene.period_s + scene.phase_rad)
+    omega = 2 * np.pi / scene.period_s
+    phase = omega * t
+    if scene.chirp:
+        # omega(t) = omega (1 - A(t)^2 / 16), A(t) = swing exp(-damping t), integrated from t = 0.
+        decay = (1 - np.exp(-2 * damping * t)) / (2 * damping) if damping > 0 else t
+        phase = phase - omega * scene.swing_rad**2 / 16 * decay
+    return scene.swing_rad * np.exp(-damping * t) * np.sin(phase + scene.phase_rad)
 
 
 def _arc(
@@ -117,9 +130,10 @@ def render(scene: PendulumScene) -> np.ndarray:
     exposure = scene.exposure / scene.fps
     offsets = ((np.arange(LED_SUBSAMPLES) + 0.5) / LED_SUBSAMPLES - 0.5) * exposure
     led_x, led_y = led_positions(scene, t[:, None] + offsets[None, :])
-    image = scene.led_gain * _blobs(
-        scene, led_x, led_y, np.full(led_x.shape, 1 / LED_SUBSAMPLES), scene.led_sigma, 0.0
-    )
+    share = np.full(led_x.shape, 1 / LED_SUBSAMPLES)
+    image = scene.led_gain * _blobs(scene, led_x, led_y, share, scene.led_sigma, 0.0)
+    if scene.bloom_gain:
+        image += scene.bloom_gain * _blobs(scene, led_x, led_y, share, scene.bloom_sigma, 0.0)
 
     sampled, weights = sphere_samples(scene, t)
     sphere_x, sphere_y = _arc(scene, sampled, scene.sphere_centre, scene.sphere_scale)
@@ -127,10 +141,16 @@ def render(scene: PendulumScene) -> np.ndarray:
 
     static = np.full((scene.height, scene.width), scene.background, dtype=np.float32)
     static[:, scene.width // 2 :] = scene.panel + np.linspace(0, 4, scene.height, dtype=np.float32)[:, None]
+    cols, rows = np.meshgrid(np.arange(scene.width), np.arange(scene.height))
+    for x, y, gain in scene.clutter:
+        static += (gain * np.exp(-((cols - x) ** 2 + (rows - y) ** 2) / (2 * 2.5**2))).astype(np.float32)
     rng = np.random.default_rng(scene.seed)
     bank = scene.noise * rng.standard_normal((NOISE_BANK, scene.height, scene.width), dtype=np.float32)
     image += static + 0.5
     image += bank[rng.integers(NOISE_BANK, size=count)]
+    if scene.defocus_px:
+        for index in range(count):
+            image[index] = cv2.GaussianBlur(image[index], (0, 0), scene.defocus_px)
     np.clip(image, 0, 255, out=image)
     frames = image.astype(np.uint8)
     frames.flags.writeable = False

@@ -1,27 +1,57 @@
-"""The tracks CSV: one row per frame, empty coordinates where a blob was missing."""
+"""The tracks CSV: written row by row while tracking, replaced by the final table at the end."""
 
 import csv
 
 import numpy as np
 import pytest
 
-from analysis import analyse, write_tracks_csv
+from analysis import AnalysisError, analyse
+from analysis.report import STREAM_HEADER, TRACKS_CSV_HEADER
 
 
-def test_tracks_csv_has_a_row_per_frame(tmp_path, scene, render_video):
-    clip = scene(latency_s=0.03, duration_s=2.5)
+def read(path):
+    with path.open(newline="") as stream:
+        return list(csv.reader(stream))
+
+
+def test_tracks_csv_has_a_row_per_frame_with_the_final_times(tmp_path, scene, render_video):
+    clip = scene(latency_s=0.03, duration_s=2.5, fps=120.0)
     frames = render_video(clip).copy()
     frames[10, :, 80:] = 21
-    result = analyse(frames, fps=clip.fps)
     path = tmp_path / "tracks.csv"
-    write_tracks_csv(path, result)
-    with path.open(newline="") as stream:
-        rows = list(csv.reader(stream))
-    assert rows[0] == ["t", "led_x", "led_y", "led_valid", "sphere_x", "sphere_y", "sphere_valid"]
+    result = analyse(frames, fps=clip.fps, method="fft", tracks_csv=path)
+    rows = read(path)
+    assert tuple(rows[0]) == TRACKS_CSV_HEADER
     assert len(rows) == clip.frame_count + 1
-    assert rows[11][4:] == ["", "", "0"]
-    assert rows[12][6] == "1"
-    table = np.array([[float(value) for value in row] for row in rows[1:] if row[6] == "1"])
-    assert table[:, 0] == pytest.approx(np.delete(result.led_track.t, 10), abs=1e-6)
-    assert table[:, 1] == pytest.approx(np.delete(result.led_track.x, 10), abs=1e-4)
-    assert table[:, 5] == pytest.approx(np.delete(result.sphere_track.y, 10), abs=1e-4)
+    assert rows[11][5:8] == ["", "", "0"]
+    assert rows[12][7] == "1"
+    table = np.array([[float(v) if v else np.nan for v in row] for row in rows[1:]])
+    assert table[:, 0] == pytest.approx(np.arange(clip.frame_count))
+    assert table[:, 1] == pytest.approx(result.led_track.t, abs=1e-6)
+    assert table[:, 2] == pytest.approx(result.led_track.x, abs=1e-4, nan_ok=True)
+    assert table[:, 6] == pytest.approx(result.sphere_track.y, abs=1e-4, nan_ok=True)
+    assert not (tmp_path / "tracks.csv.partial").exists()
+
+
+def test_tracks_measured_before_a_failure_are_kept(tmp_path, scene, render_video):
+    clip = scene(period_s=1.0, duration_s=1.6, fps=120.0)
+    path = tmp_path / "tracks.csv"
+    with pytest.raises(AnalysisError, match="periods"):
+        analyse(render_video(clip), fps=clip.fps, tracks_csv=path)
+    rows = read(path)
+    assert len(rows) == clip.frame_count + 1
+    assert all(row[4] == "1" for row in rows[1:])
+
+
+def test_tracks_are_on_disk_as_the_video_is_tracked(tmp_path, scene, render_video):
+    clip = scene(duration_s=4.1, fps=120.0)
+    path = tmp_path / "tracks.csv"
+    seen = []
+
+    def progress(done, total):
+        seen.append((done, len(read(path)) - 1))
+
+    analyse(render_video(clip), fps=clip.fps, method="fft", tracks_csv=path, progress=progress)
+    # Rows are flushed in blocks: by the time 128 frames are tracked, at least the first 64 are on disk.
+    assert read(path)[0] and seen[1][0] == 128 and seen[1][1] >= 64
+    assert tuple(STREAM_HEADER) != tuple(TRACKS_CSV_HEADER)

@@ -8,7 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from analysis.errors import AnalysisError
-from analysis.phase import axis_signal, estimate_frequency, fft_phase_latency, main_axis, wrap_phase
+from analysis.phase import estimate_frequency, fft_phase_latency, wrap_phase
+from analysis.signals import SwingSignals, axis_signal, binned, main_axis
 from analysis.tracking import Track
 
 
@@ -115,10 +116,12 @@ def test_vertical_main_axis_points_down_the_image():
 
 def _track(x: np.ndarray, y: np.ndarray, valid: np.ndarray, fps: float = 100.0) -> Track:
     t = np.arange(x.size) / fps
-    return Track(t, np.where(valid, x, np.nan), np.where(valid, y, np.nan), valid, np.full(x.size, 200.0))
+    return Track(
+        t, np.where(valid, x, np.nan), np.where(valid, y, np.nan), valid, np.full(x.size, 200.0), np.zeros(x.size, bool)
+    )
 
 
-def test_axis_signal_projects_and_interpolates_missing_frames():
+def test_axis_signal_projects_and_leaves_missing_frames_empty():
     n = 400
     t = np.arange(n) / 100.0
     along = 30 * np.sin(2 * math.pi * t)
@@ -126,9 +129,31 @@ def test_axis_signal_projects_and_interpolates_missing_frames():
     valid[101:104] = False
     # Motion along (-0.6, 0.8): the rule turns the axis to (0.6, -0.8), so the signal is -along.
     signal = axis_signal(_track(50 - 0.6 * along, 40 + 0.8 * along, valid), "LED")
-    expected = -along
-    expected[101:104] = np.interp(t[101:104], [t[100], t[104]], [expected[100], expected[104]])
-    assert signal == pytest.approx(expected - expected.mean(), abs=1e-9)
+    expected = -along[valid]
+    assert signal[valid] == pytest.approx(expected - expected.mean(), abs=1e-9)
+    assert np.isnan(signal[101:104]).all()
+
+
+def test_uniform_signals_interpolate_gaps_and_resample_uneven_times():
+    t = np.array([0.0, 0.01, 0.02, 0.04, 0.05])
+    signals = SwingSignals(t, np.array([0.0, 1.0, np.nan, 4.0, 5.0]), np.array([1.0, 1.0, 1.0, 1.0, np.nan]))
+    grid, led, sphere = signals.uniform()
+    assert grid == pytest.approx(np.arange(6) * 0.01)
+    assert led == pytest.approx([0.0, 1.0, 2.0, 3.0, 4.0, 5.0])
+    assert sphere == pytest.approx(np.ones(6))
+
+
+def test_bins_average_each_signal_over_its_own_valid_frames():
+    t = np.arange(9) / 10.0
+    led = np.arange(9, dtype=float)
+    sphere = led.copy()
+    sphere[[1, 6, 7, 8]] = np.nan
+    bins = binned(SwingSignals(t, led, sphere), 3)
+    assert bins.led_t == pytest.approx([0.1, 0.4, 0.7])
+    assert bins.led == pytest.approx([1.0, 4.0, 7.0])
+    assert bins.sphere_t[:2] == pytest.approx([0.1, 0.4])
+    assert bins.sphere[:2] == pytest.approx([1.0, 4.0])
+    assert np.isnan(bins.sphere[2]) and bins.sphere_count.tolist() == [2, 3, 0]
 
 
 def test_blob_that_does_not_move_raises():

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from analysis.errors import AnalysisError
-from analysis.tracking import Roi, calibrate_blob, find_moving_regions, locate_blob, track_blobs
+from analysis.tracking import BlobTracker, Roi, calibrate_blob, find_moving_regions
 
 WIDTH, HEIGHT = 64, 48
 
@@ -24,6 +24,12 @@ def frames_of(images: list[np.ndarray], noise: float = 1.0, seed: int = 0) -> li
     ]
 
 
+def locate(model, frame):
+    """The blob found in one frame by a fresh tracker (a whole-ROI search)."""
+    detection = BlobTracker(model).locate(frame)
+    return detection.x, detection.y, detection.peak, detection.valid
+
+
 def sweep(peak: float) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
     """A blob crossing the frame at sub-pixel steps, and its true centres."""
     xs = np.linspace(8.0, 55.0, 41) + 0.137
@@ -38,11 +44,15 @@ FULL = Roi(0, 0, WIDTH, HEIGHT)
 def test_centroid_is_sub_pixel_accurate(peak):
     xs, ys, frames = sweep(peak)
     model = calibrate_blob(FULL, frames, "LED")
-    found = np.array([locate_blob(model, frame) for frame in frames])
+    found = np.array([locate(model, frame) for frame in frames])
     assert found[:, 3].all()
     error = np.hypot(found[:, 0] - xs, found[:, 1] - ys)
-    assert np.sqrt(np.mean(error**2)) < 0.04
-    assert error.max() < 0.1
+    # Noise of one unit on every pixel of the box moves a single centroid by a few hundredths...
+    assert np.sqrt(np.mean(error**2)) < 0.06
+    assert error.max() < 0.15
+    # ...but not on average: no pull towards pixel centres or the window.
+    assert abs(np.mean(found[:, 0] - xs)) < 0.015
+    assert abs(np.mean(found[:, 1] - ys)) < 0.015
 
 
 def test_double_image_of_a_refresh_gives_the_weighted_position():
@@ -51,16 +61,16 @@ def test_double_image_of_a_refresh_gives_the_weighted_position():
     _, _, frames = sweep(150.0)
     model = calibrate_blob(FULL, frames, "sphere")
     double = frames_of([0.7 * gaussian(30.0, 24.0, 150.0) + 0.3 * gaussian(36.0, 24.0, 150.0)], seed=3)[0]
-    x, y, _, valid = locate_blob(model, double)
+    x, y, _, valid = locate(model, double)
     assert valid
     assert x == pytest.approx(0.7 * 30.0 + 0.3 * 36.0, abs=0.2)
-    assert y == pytest.approx(24.0, abs=0.05)
+    assert y == pytest.approx(24.0, abs=0.1)
 
 
 def test_frame_without_blob_is_invalid():
     _, _, frames = sweep(150.0)
     model = calibrate_blob(FULL, frames, "sphere")
-    x, y, _, valid = locate_blob(model, frames_of([np.zeros((HEIGHT, WIDTH))], seed=5)[0])
+    x, y, _, valid = locate(model, frames_of([np.zeros((HEIGHT, WIDTH))], seed=5)[0])
     assert not valid
     assert math.isnan(x) and math.isnan(y)
 
@@ -69,7 +79,7 @@ def test_blob_is_located_in_frame_coordinates_from_an_roi():
     xs, ys, frames = sweep(150.0)
     roi = Roi(3, 10, 58, 25)
     model = calibrate_blob(roi, frames, "LED")
-    x, y, _, valid = locate_blob(model, frames[20])
+    x, y, _, valid = locate(model, frames[20])
     assert valid
     assert (x, y) == pytest.approx((xs[20], ys[20]), abs=0.05)
 
@@ -80,19 +90,41 @@ def test_roi_without_a_moving_blob_raises():
         calibrate_blob(FULL, frames, "LED")
 
 
-def test_tracks_hold_every_frame_and_report_progress():
-    xs, _, frames = sweep(150.0)
+def test_tracker_follows_the_blob_in_a_window_and_finds_it_again_after_losing_it():
+    xs, ys, frames = sweep(150.0)
     model = calibrate_blob(FULL, frames, "LED")
-    calls = []
-    (track,) = track_blobs(
-        frames * 4, [model], 50.0, len(frames) * 4, lambda done, total: calls.append((done, total))
-    )
-    assert track.t == pytest.approx(np.arange(len(frames) * 4) / 50.0)
-    assert track.x == pytest.approx(np.tile(xs, 4), abs=0.05)
-    assert track.valid.all()
-    assert calls[0] == (64, 164)
-    assert calls[-1] == (164, 164)
-    assert [done for done, _ in calls] == sorted(done for done, _ in calls)
+    tracker = BlobTracker(model)
+    empty = frames_of([np.zeros((HEIGHT, WIDTH))], seed=9)[0]
+    sequence = frames[:20] + [empty, empty] + frames[20:]
+    found = [tracker.locate(frame) for frame in sequence]
+    valid = np.array([d.valid for d in found])
+    assert valid.tolist() == [True] * 20 + [False, False] + [True] * 21
+    x = np.array([d.x for d in found])[valid]
+    assert x == pytest.approx(xs, abs=0.1)
+
+
+def test_static_bright_clutter_is_background_and_never_the_blob():
+    xs, ys, _ = sweep(150.0)
+    lamp = gaussian(50.0, 40.0, 240.0, sigma=2.5)
+    frames = frames_of([gaussian(x, y, 150.0) + lamp for x, y in zip(xs, ys, strict=True)])
+    model = calibrate_blob(FULL, frames, "LED")
+    tracker = BlobTracker(model)
+    found = np.array([(d.x, d.y) for d in (tracker.locate(f) for f in frames)])
+    assert found[:, 0] == pytest.approx(xs, abs=0.1)
+    assert found[:, 1] == pytest.approx(ys, abs=0.1)
+
+
+def test_blob_cut_by_the_roi_edge_is_clipped_not_valid():
+    xs, ys, frames = sweep(150.0)
+    roi = Roi(20, 0, 44, HEIGHT)
+    model = calibrate_blob(roi, frames, "sphere")
+    tracker = BlobTracker(model)
+    found = [tracker.locate(frame) for frame in frames]
+    clipped = np.array([d.clipped for d in found])
+    near_edge = xs < 20 + 5
+    assert clipped[near_edge & (xs > 20 - 2)].all()
+    assert not clipped[xs > 30].any()
+    assert all(d.valid for d, far in zip(found, xs > 30, strict=True) if far)
 
 
 def _contains(roi: Roi, x: np.ndarray, y: np.ndarray, margin: float) -> bool:
@@ -104,8 +136,9 @@ def _contains(roi: Roi, x: np.ndarray, y: np.ndarray, margin: float) -> bool:
     )
 
 
-def test_moving_regions_enclose_the_led_and_the_sphere(scene, render_video, scene_truth):
-    clip = scene(duration_s=2.5, display_hz=60.0)
+@pytest.mark.parametrize("sphere_gain", [150.0, 25.0], ids=["bright", "dim"])
+def test_moving_regions_enclose_the_led_and_the_sphere(scene, render_video, scene_truth, sphere_gain):
+    clip = scene(duration_s=2.5, display_hz=60.0, sphere_gain=sphere_gain)
     frames = render_video(clip)
     regions = find_moving_regions(list(frames[: int(1.5 * clip.fps)]))
     assert len(regions) == 2
@@ -140,3 +173,9 @@ def test_bad_roi_is_refused(values):
 
 def test_roi_at_the_frame_edge_is_accepted():
     assert Roi.parse(np.array([4, 8, 60, 40]), (WIDTH, HEIGHT), "LED").as_list() == [4, 8, 60, 40]
+
+
+def test_static_clutter_is_not_a_moving_region(scene, render_video):
+    clip = scene(duration_s=2.5, clutter=((60.0, 20.0, 400.0), (120.0, 100.0, 300.0)))
+    regions = find_moving_regions(list(render_video(clip)[: int(1.5 * clip.fps)]))
+    assert len(regions) == 2

@@ -1,11 +1,11 @@
-"""Opening videos and frame arrays: frames, frame rates, and the errors a user can cause."""
+"""Opening videos, image folders and frame arrays: frames, their stamps, and the errors a user can cause."""
 
 import cv2
 import numpy as np
 import pytest
 
 from analysis import AnalysisError, analyse
-from analysis.video import FrameArray, VideoFile, open_frames
+from analysis.video import FrameArray, ImageFolder, VideoFile, open_frames
 
 
 def moving_squares(count: int = 12, width: int = 48, height: int = 32) -> np.ndarray:
@@ -28,7 +28,9 @@ def write_video(path, frames: np.ndarray, fourcc: str, fps: float = 240.0):
 def test_mjpg_file_gives_grey_frames_and_its_frame_rate(tmp_path):
     frames = moving_squares()
     video = open_frames(write_video(tmp_path / "clip.avi", frames, "MJPG"))
-    decoded = np.stack(list(video.frames()))
+    stamps, decoded = zip(*video.frames(), strict=True)
+    decoded = np.stack(decoded)
+    assert np.array(stamps) == pytest.approx(np.arange(12) / 240.0, abs=1e-6)
     assert video.fps == 240.0
     assert video.frame_size == (48, 32)
     assert video.frame_count == 12
@@ -40,7 +42,7 @@ def test_lossless_file_read_the_ordinary_way_is_exact(tmp_path):
     frames = moving_squares()
     video = VideoFile(write_video(tmp_path / "clip.avi", frames, "FFV1", fps=90.0))
     assert video.fps == 90.0
-    assert np.array_equal(np.stack(list(video.frames())), frames)
+    assert np.array_equal(np.stack([frame for _, frame in video.frames()]), frames)
 
 
 def test_explicit_frame_rate_wins_over_the_container(tmp_path):
@@ -79,7 +81,7 @@ def test_array_of_the_wrong_shape_raises(shape):
 
 
 def test_array_without_frame_rate_raises():
-    with pytest.raises(AnalysisError, match="fps"):
+    with pytest.raises(AnalysisError, match="no frame rate is known"):
         analyse(moving_squares())
 
 
@@ -90,18 +92,76 @@ def test_frame_rate_that_is_not_positive_raises(fps):
 
 
 def test_source_of_another_kind_raises():
-    with pytest.raises(AnalysisError, match="video file path or a numpy array"):
+    with pytest.raises(AnalysisError, match="video file, a folder of images or a numpy array"):
         open_frames([[1, 2], [3, 4]], fps=30.0)
 
 
 def test_bgr_array_frames_are_made_grey():
     grey = moving_squares()
-    frames = list(FrameArray(np.repeat(grey[..., None], 3, axis=3), 30.0).frames())
+    frames = [frame for _, frame in FrameArray(np.repeat(grey[..., None], 3, axis=3), 30.0).frames()]
     assert np.array_equal(np.stack(frames), grey)
 
 
 def test_float_array_frames_stay_float():
     grey = moving_squares().astype(np.float64) / 255
-    frames = list(FrameArray(grey, 30.0).frames())
+    stamps, frames = zip(*FrameArray(grey, 30.0).frames(), strict=True)
+    assert stamps == pytest.approx(np.arange(grey.shape[0]) / 30.0)
     assert frames[0].dtype == np.float32
     assert np.allclose(np.stack(frames), grey, atol=1e-7)
+
+
+@pytest.mark.parametrize(
+    ("fourcc", "suffix"),
+    [("mp4v", ".mp4"), ("XVID", ".avi"), ("MJPG", ".mkv"), ("mp4v", ".mov")],
+    ids=["mpeg4-mp4", "xvid-avi", "mjpeg-mkv", "mpeg4-mov"],
+)
+def test_other_codecs_and_containers_give_frames_and_stamps(tmp_path, fourcc, suffix):
+    frames = moving_squares(count=20)
+    video = open_frames(write_video(tmp_path / f"clip{suffix}", frames, fourcc, fps=120.0))
+    stamps, decoded = zip(*video.frames(), strict=True)
+    assert len(decoded) == 20
+    assert decoded[0].shape == (32, 48)
+    # Matroska keeps milliseconds: stamps are within half a millisecond of i / fps.
+    assert np.array(stamps) == pytest.approx(np.arange(20) / 120.0, abs=6e-4)
+    assert np.abs(np.stack(decoded).astype(int) - frames).mean() < 6.0
+
+
+def write_images(folder, frames: np.ndarray, numbers) -> None:
+    folder.mkdir()
+    for number, frame in zip(numbers, frames, strict=True):
+        cv2.imwrite(str(folder / f"frame_{number:05d}.png"), frame)
+
+
+def test_image_folder_frames_are_in_number_order_with_gaps_as_time(tmp_path):
+    frames = moving_squares(count=6)
+    numbers = [3, 4, 5, 7, 8, 12]
+    write_images(tmp_path / "shots", frames[::-1], numbers[::-1])
+    video = open_frames(tmp_path / "shots", fps=100.0)
+    assert isinstance(video, ImageFolder)
+    stamps, decoded = zip(*video.frames(), strict=True)
+    assert np.array(stamps) == pytest.approx((np.array(numbers) - 3) / 100.0)
+    assert np.array_equal(np.stack(decoded), frames)
+    assert (video.frame_count, video.frame_size) == (6, (48, 32))
+
+
+def test_image_folder_needs_a_frame_rate(tmp_path):
+    write_images(tmp_path / "shots", moving_squares(count=3), [1, 2, 3])
+    with pytest.raises(AnalysisError, match="no frame rate is known"):
+        analyse(tmp_path / "shots")
+
+
+def test_image_folder_without_numbers_or_images_raises(tmp_path):
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(AnalysisError, match="holds no images"):
+        open_frames(tmp_path / "empty", fps=30.0)
+    (tmp_path / "named").mkdir()
+    cv2.imwrite(str(tmp_path / "named" / "first.png"), moving_squares(count=1)[0])
+    with pytest.raises(AnalysisError, match="without a frame number"):
+        open_frames(tmp_path / "named", fps=30.0)
+
+
+def test_image_folder_with_a_frame_of_another_size_raises(tmp_path):
+    write_images(tmp_path / "shots", moving_squares(count=3), [1, 2, 3])
+    cv2.imwrite(str(tmp_path / "shots" / "frame_00004.png"), np.zeros((10, 10), dtype=np.uint8))
+    with pytest.raises(AnalysisError, match="10x10"):
+        list(open_frames(tmp_path / "shots", fps=30.0).frames())

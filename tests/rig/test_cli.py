@@ -10,7 +10,7 @@ from rig.cli import build_parser, main
 COMMANDS = ["demo", "simulate", "analyse", "bench", "tune", "board"]
 
 
-@pytest.mark.parametrize("command", [[]] + [[c] for c in COMMANDS] + [["bench", "predictors"], ["bench", "renderers"]])
+@pytest.mark.parametrize("command", [[]] + [[c] for c in COMMANDS] + [["bench", subject] for subject in ("analyser", "predictors", "renderers")])
 def test_every_command_has_help(command: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as exit_:
         main([*command, "--help"])

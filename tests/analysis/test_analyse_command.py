@@ -1,0 +1,65 @@
+"""`rig analyse`: one line or JSON on stdout, tracks CSV and plot files, exit status 2 on bad input."""
+
+import csv
+import json
+
+import cv2
+import pytest
+
+from rig.cli import main
+
+
+@pytest.fixture
+def clip_file(tmp_path, scene, render_video, mjpg_file):
+    clip = scene(latency_s=0.045, period_s=0.9, duration_s=4.3, fps=120.0)
+    return mjpg_file(tmp_path / "clip.avi", render_video(clip), clip.fps)
+
+
+def test_one_line_summary_with_the_interval(clip_file, capsys):
+    assert main(["analyse", str(clip_file)]) == 0
+    line = capsys.readouterr().out.splitlines()[0]
+    assert line.startswith("latency 45.")
+    assert "95% CI" in line and "by sinefit" in line and "per swing sd" in line
+
+
+def test_json_csv_and_plot_for_every_method(tmp_path, clip_file, capsys):
+    tracks, plot = tmp_path / "tracks.csv", tmp_path / "plot.png"
+    code = main(["analyse", str(clip_file), "--method", "all", "--json", "--csv", str(tracks), "--plot", str(plot)])
+    assert code == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["method"] == "sinefit"
+    assert set(report["methods"]) == {"fft", "xcorr", "sinefit", "bayes"}
+    assert report["latency_ms"] == pytest.approx(45.0, abs=0.3)
+    with tracks.open(newline="") as stream:
+        assert len(list(csv.reader(stream))) == 517
+    assert plot.stat().st_size > 10_000
+
+
+def test_image_folder_needs_and_takes_a_frame_rate(tmp_path, scene, render_video, capsys):
+    clip = scene(latency_s=0.03, duration_s=3.0, fps=120.0)
+    folder = tmp_path / "frames"
+    folder.mkdir()
+    for index, frame in enumerate(render_video(clip)):
+        cv2.imwrite(str(folder / f"img{index:04d}.png"), frame)
+    assert main(["analyse", str(folder), "--method", "fft"]) == 2
+    assert "no frame rate is known" in capsys.readouterr().err
+    assert main(["analyse", str(folder), "--fps", "120", "--method", "fft", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["latency_ms"] == pytest.approx(30.0, abs=0.5)
+
+
+def test_bad_input_is_one_line_and_status_2_with_the_tracks_kept(tmp_path, scene, render_video, mjpg_file, capsys):
+    clip = scene(period_s=1.0, duration_s=1.6, fps=120.0)
+    video = mjpg_file(tmp_path / "short.avi", render_video(clip), clip.fps)
+    tracks = tmp_path / "tracks.csv"
+    assert main(["analyse", str(video), "--csv", str(tracks)]) == 2
+    error = capsys.readouterr().err.strip()
+    assert len(error.splitlines()) == 1 and "periods" in error
+    with tracks.open(newline="") as stream:
+        assert len(list(csv.reader(stream))) == clip.frame_count + 1
+
+
+def test_latency_range_option_is_checked(clip_file, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["analyse", str(clip_file), "--latency-range", "300,-100"])
+    assert exit_.value.code == 2
+    assert "LOW must be below HIGH" in capsys.readouterr().err

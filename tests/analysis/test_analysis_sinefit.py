@@ -1,0 +1,125 @@
+"""The joint fit on swing signals of known latency: accuracy, model choice, honest uncertainty."""
+
+import math
+
+import numpy as np
+import pytest
+
+from analysis.cycles import chirp_shape
+from analysis.signals import SwingSignals
+from analysis.sinefit import Guess, fit_sine, frames_per_bin, long_run_variance
+
+FPS = 120.0
+SECONDS = 6.0
+PERIOD = 0.8
+
+
+def swing(
+    latency: float,
+    *,
+    decay: float = 0.0,
+    chirp: float = 0.0,
+    wide: float = 0.0,
+    noise: tuple[float, float] = (0.0, 0.0),
+    seed: int = 0,
+) -> SwingSignals:
+    """LED and sphere signals: a damped swing whose frequency rises as it decays (the pendulum's
+    chirp, see analysis.swing_model), with a third harmonic of relative size ``wide`` decaying with
+    the cube of the amplitude, and the same swing ``latency`` later."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(SECONDS * FPS)) / FPS
+
+    def position(time: np.ndarray) -> np.ndarray:
+        phase = 2 * math.pi * time / PERIOD - chirp * chirp_shape(time - SECONDS / 2, decay) + 0.3
+        return np.exp(-decay * time) * (np.sin(phase) - wide * np.exp(-2 * decay * time) * np.sin(3 * phase))
+
+    led = 40 * position(t) + noise[0] * rng.standard_normal(t.size)
+    sphere = 25 * position(t - latency) + 3.0 + noise[1] * rng.standard_normal(t.size)
+    return SwingSignals(t, led, sphere)
+
+
+def guess(latency: float) -> Guess:
+    return Guess(1 / PERIOD * 1.0005, 0.0, 0.0, latency + 0.004, 0.6)
+
+
+def test_noise_free_damped_chirping_swing_is_fitted_exactly():
+    fit = fit_sine(swing(0.137, decay=0.15, chirp=0.01), (0.01, 0.01), guess(0.137))
+    assert fit.latency_s == pytest.approx(0.137, abs=2e-6)
+    assert fit.frequency_hz == pytest.approx(1 / PERIOD, rel=1e-4)
+    assert fit.damping == pytest.approx(0.15, rel=1e-3)
+    assert fit.model.startswith("damped")
+
+
+@pytest.mark.parametrize(
+    ("kind", "model"),
+    [({}, "sine"), ({"decay": 0.2}, "damped"), ({"decay": 0.2, "wide": 0.03}, "damped+harmonics")],
+    ids=["pure", "damped", "wide"],
+)
+def test_the_simplest_model_the_data_support_is_chosen(kind, model):
+    fit = fit_sine(swing(0.05, noise=(0.05, 0.1), **kind), (0.05, 0.1), guess(0.05))
+    assert fit.model == model
+    assert fit.latency_s == pytest.approx(0.05, abs=5 * fit.se_s)
+
+
+def test_missing_samples_carry_no_weight():
+    signals = swing(0.08, decay=0.1, noise=(0.05, 0.1), seed=4)
+    sphere = signals.sphere.copy()
+    sphere[np.random.default_rng(1).choice(sphere.size, sphere.size // 10, replace=False)] = np.nan
+    sphere[200:260] = np.nan
+    fit = fit_sine(SwingSignals(signals.t, signals.led, sphere), (0.05, 0.1), guess(0.08))
+    assert fit.latency_s == pytest.approx(0.08, abs=4 * fit.se_s)
+    assert fit.se_s < 2e-4
+
+
+def test_standard_errors_match_the_scatter_over_noise_draws():
+    errors, ses = [], []
+    for seed in range(24):
+        fit = fit_sine(swing(0.06, decay=0.1, noise=(0.3, 0.5), seed=seed), (0.3, 0.5), guess(0.06))
+        errors.append(fit.latency_s - 0.06)
+        ses.append(fit.se_s)
+    z = np.array(errors) / np.array(ses)
+    assert 0.6 < np.std(z) < 1.4
+    assert np.mean(np.abs(z) < 1.96) >= 0.8
+
+
+def test_correlated_residuals_widen_the_interval():
+    rng = np.random.default_rng(2)
+    signals = swing(0.06, decay=0.1)
+    # A slow random wander (AR(1), 0.97 per frame) on the sphere: far fewer independent samples.
+    wander = np.zeros(signals.t.size)
+    for i in range(1, wander.size):
+        wander[i] = 0.97 * wander[i - 1] + 0.2 * rng.standard_normal()
+    fit = fit_sine(SwingSignals(signals.t, signals.led, signals.sphere + wander), (0.05, 0.8), guess(0.06))
+    assert fit.inflation > 2
+    assert fit.se_s > 1.5 * fit.naive_se_s
+    assert fit.ci95_s[0] <= 0.06 <= fit.ci95_s[1]
+
+
+def test_long_run_variance_of_white_and_correlated_series():
+    rng = np.random.default_rng(5)
+    white = rng.standard_normal(20000)
+    assert long_run_variance(white, 20) == pytest.approx(20000, rel=0.1)
+    correlated = np.convolve(white, np.ones(5), mode="same")
+    # Sum of 5 neighbours: long-run variance 25 per sample.
+    assert long_run_variance(correlated, 40) == pytest.approx(25 * 20000, rel=0.15)
+
+
+def test_frames_are_binned_to_about_sixteen_per_period():
+    assert frames_per_bin(1 / 240, 1.0) == 15
+    assert frames_per_bin(1 / 60, 0.6) == 2
+    assert frames_per_bin(1 / 60, 0.3) == 1
+
+
+def test_posterior_agrees_with_the_fit_and_reports_its_sampler():
+    from analysis.bayes import sample_posterior
+
+    fit = fit_sine(swing(0.06, decay=0.1, noise=(0.3, 0.5), seed=3), (0.3, 0.5), guess(0.06))
+    posterior = sample_posterior(fit, seed=1, steps=300, burn_in=100)
+    assert posterior.median_s == pytest.approx(fit.latency_s, abs=0.3 * fit.se_s)
+    width = posterior.ci95_s[1] - posterior.ci95_s[0]
+    assert width == pytest.approx(fit.ci95_s[1] - fit.ci95_s[0], rel=0.3)
+    assert posterior.ci95_s[0] <= 0.06 <= posterior.ci95_s[1]
+    details = posterior.details()
+    assert 0.1 < details["acceptance_fraction"] < 0.9
+    assert 1 < details["autocorrelation_steps"] < posterior.steps / 5
+    assert sample_posterior(fit, seed=1, steps=300, burn_in=100).median_s == posterior.median_s
