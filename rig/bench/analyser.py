@@ -42,6 +42,7 @@ import numpy as np
 
 import analysis
 from analysis.video import open_frames
+from rig.commands import options
 from rig.errors import RigError
 from rig.session import SimulationConfig, simulate
 from rig.sim.camera import CameraConfig, VideoFileWriter
@@ -379,16 +380,6 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _case_count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {text}")
-    return value
-
-
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "analyser",
@@ -401,6 +392,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--json", type=Path, metavar="OUT", help="write the summary and every case as JSON")
     parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot speed against error per method")
     parser.add_argument("--quick", action="store_true", help="two short cases (a smoke test)")
-    parser.add_argument("--cases", type=_case_count, default=DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
+    parser.add_argument("--cases", type=options.positive_int, default=DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
     parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the simulated videos here (default: a temporary folder)")
     parser.set_defaults(func=_run)

@@ -39,6 +39,13 @@ def non_negative_int(text: str) -> int:
     return value
 
 
+def positive_int(text: str) -> int:
+    value = non_negative_int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {text}")
+    return value
+
+
 def roi(text: str) -> tuple[int, int, int, int]:
     """X,Y,W,H in pixels."""
     parts = text.split(",")
