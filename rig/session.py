@@ -334,7 +334,10 @@ class Simulation:
     def _panel_light(self, instants: np.ndarray, content: list[int], panel_images: dict[int, np.ndarray]) -> np.ndarray:
         """The display panel's light averaged over the given instants, row by row (scan-out)."""
         refresh = self.display.refresh_shown(instants[:, None], self._panel_rows[None, :])
-        image_ids = np.where(refresh >= 0, np.asarray(content)[np.maximum(refresh, 0)], NO_IMAGE)
+        # Only the last few refreshes can be on screen: look them up without copying all of content.
+        first = max(int(refresh.min()), 0)
+        recent = np.asarray(content[first:])
+        image_ids = np.where(refresh >= 0, recent[np.maximum(refresh, 0) - first], NO_IMAGE)
         _, _, pw, ph = self.layout.panel
         light = np.zeros((ph, pw), dtype=np.float32)
         for image_id in np.unique(image_ids):
