@@ -33,7 +33,7 @@ class TinyRenderer:
         return AppFrameResult(0.001, "modelled", pose, np.full(self.shape, 128, dtype=np.uint8))
 
     def render_display_frame(self, request):
-        raise NotImplementedError
+        raise RuntimeError("tiny shows application frames only")
 
     def close(self):
         pass
