@@ -18,12 +18,20 @@ that itself drifts by that much would be mistaken for a chirp, so a smaller diff
 nothing. Otherwise the result is ambiguous and a warning lists the candidates. The rule assumes the
 latency is constant over the clip; the motion's chirp is strong for wide swings and low Q, weak or
 absent for small swings with little damping.
+
+Stronger than the chirp are events that happen once (``analysis.onset``): the swing's start, when
+the clip holds the release, and its stop. Each gives the sphere-minus-LED time of the event, good to
+a few frames. When every such lag picks the same candidate (latency + k period, for any k) and
+lies within EVENT_TOLERANCE_PERIODS of it, that candidate is the latency, even outside the
+plausible range (a warning then says so); lags that disagree with each other or with the phase
+decide nothing, and a warning says so.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -34,14 +42,18 @@ DECISIVE_CHI2 = 25.0
 MIN_SEPARATION_S = 0.002
 # Passes of per-signal reweighting of the window phases.
 REWEIGHTING_PASSES = 2
+# An event's lag decides the whole number of periods when within this fraction of a period of a candidate.
+EVENT_TOLERANCE_PERIODS = 0.25
 
 
 @dataclass(frozen=True)
 class CycleResolution:
     """The whole-period choice: the latency every estimate is unwrapped towards, and how it was chosen.
 
-    how: "range" (one candidate in the plausible range), "chirp" (decided by the chirp) or
-    "unresolved" (ambiguous: reference_s is then the candidate nearest zero).
+    how: "range" (one candidate in the plausible range), "chirp" (decided by the chirp), the names
+    of the events that decided it joined by "+" (e.g. "swing start+swing stop"), or "unresolved"
+    (ambiguous: reference_s is then the candidate nearest zero). events_s holds every event's
+    sphere-minus-LED lag (s), whether it decided or not.
     """
 
     reference_s: float
@@ -51,10 +63,12 @@ class CycleResolution:
     separation_s: float | None
     evidence_chi2: float | None
     warning: str | None
+    events_s: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, object]:
         return {
             "how": self.how,
+            "events_ms": {name: lag * 1e3 for name, lag in self.events_s.items()},
             "candidates_ms": [round(c * 1e3, 4) for c in self.candidates_s],
             "separation_ms": None if self.separation_s is None else self.separation_s * 1e3,
             "evidence_chi2": self.evidence_chi2,
@@ -144,17 +158,51 @@ def _separation(windows: WindowPhases, gamma: float, candidates: list[float]) ->
     return smallest
 
 
+def _event_choice(
+    latency_s: float, period_s: float, event_lags_s: dict[str, float], latency_range_s: tuple[float, float]
+) -> tuple[float | None, str | None]:
+    """(the candidate every event picks, or None; a warning, or None)."""
+    if not event_lags_s:
+        return None, None
+    picks = {name: unwrap_near(latency_s, lag, period_s) for name, lag in event_lags_s.items()}
+    listed = ", ".join(f"the {name} {lag * 1e3:.0f} ms" for name, lag in event_lags_s.items())
+    off = [name for name, lag in event_lags_s.items() if abs(lag - picks[name]) > EVENT_TOLERANCE_PERIODS * period_s]
+    if off or len({round(pick / period_s) for pick in picks.values()}) > 1:
+        return None, (
+            f"the swing's events ({listed} from LED to sphere) do not agree with each other or with the phase "
+            f"(latency {latency_s * 1e3:.1f} ms modulo {period_s * 1e3:.1f} ms); they were not used. Check the tracks "
+            "at the start and end of the clip"
+        )
+    chosen = next(iter(picks.values()))
+    low, high = latency_range_s
+    if not low <= chosen <= high:
+        return chosen, (
+            f"the swing's events ({listed}) put the latency at {chosen * 1e3:.1f} ms, outside the range "
+            f"{low * 1e3:g} to {high * 1e3:g} ms; reported it"
+        )
+    return chosen, None
+
+
 def resolve_cycles(
     latency_s: float,
     period_s: float,
     windows: WindowPhases,
     gamma: float,
     latency_range_s: tuple[float, float] = DEFAULT_LATENCY_RANGE_S,
+    event_lags_s: Mapping[str, float] | None = None,
 ) -> CycleResolution:
-    """Choose among the whole-period alternatives of a latency known modulo ``period_s``."""
+    """Choose among the whole-period alternatives of a latency known modulo ``period_s``.
+
+    event_lags_s: sphere-minus-LED times of one-off events of the swing, by name (see the module
+    docstring); they decide when they agree.
+    """
+    events = dict(event_lags_s or {})
     candidates = candidate_latencies(latency_s, period_s, latency_range_s)
+    chosen, event_warning = _event_choice(latency_s, period_s, events, latency_range_s)
+    if chosen is not None:
+        return CycleResolution(chosen, False, "+".join(events), candidates, None, None, event_warning, events)
     if len(candidates) == 1:
-        return CycleResolution(candidates[0], False, "range", candidates, None, None, None)
+        return CycleResolution(candidates[0], False, "range", candidates, None, None, event_warning, events)
     listed = ", ".join(f"{c * 1e3:.1f}" for c in candidates)
     if np.count_nonzero(windows.both) < 4:
         evidence = np.zeros(len(candidates))
@@ -165,7 +213,7 @@ def resolve_cycles(
     best = candidates[int(order[0])]
     runner_up = float(evidence[order[1]])
     if runner_up >= DECISIVE_CHI2 and separation >= MIN_SEPARATION_S:
-        return CycleResolution(best, False, "chirp", candidates, separation, runner_up, None)
+        return CycleResolution(best, False, "chirp", candidates, separation, runner_up, event_warning, events)
     reference = min(candidates, key=abs)
     low, high = latency_range_s
     warning = (
@@ -175,4 +223,6 @@ def resolve_cycles(
         f"chi-square {runner_up:.1f}); reported the one nearest zero. Film a wider swing of a more "
         "damped pendulum, use a longer pendulum, or narrow the range if you know better"
     )
-    return CycleResolution(reference, True, "unresolved", candidates, separation, runner_up, warning)
+    if event_warning:
+        warning = f"{warning}. Also, {event_warning[0].lower()}{event_warning[1:]}"
+    return CycleResolution(reference, True, "unresolved", candidates, separation, runner_up, warning, events)

@@ -10,10 +10,11 @@ estimators run, each taking the same whole number of periods.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import itertools
 import math
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,7 @@ import numpy as np
 
 from analysis.cycles import DEFAULT_LATENCY_RANGE_S, CycleResolution, resolve_cycles, unwrap_near
 from analysis.errors import AnalysisError
+from analysis.onset import departure_time, stop_time
 from analysis.phase import estimate_frequency, fft_phase_latency
 from analysis.report import TrackStream, write_tracks_csv
 from analysis.result import DEFAULT_METHOD, METHODS, LatencyResult, MethodResult
@@ -38,8 +40,9 @@ CALIBRATION_SECONDS = 1.5
 # frame rate is not yet known...
 CALIBRATION_MIN_FRAMES = 120
 CALIBRATION_FRAMES_UNKNOWN_RATE = 360
-# ...but never more than this many bytes of them.
-CALIBRATION_MAX_BYTES = 256 * 2**20
+# A clip that starts with the pendulum at rest (a lab films, then releases it) is held further,
+# until its last that many frames show both blobs move, but never more than this many bytes of it.
+CALIBRATION_MAX_BYTES = 1024 * 2**20
 # A track must have a blob in at least this fraction of frames; any frame without one is reported.
 MIN_VALID = 0.5
 # A blob cut off by its ROI's edge in more than this fraction of frames has left its ROI.
@@ -53,6 +56,9 @@ PROGRESS_MIN_SECONDS = 3.0
 BRIGHTER_RULE = "auto: brighter blob is the LED"
 LEFT_RULE = "auto: blobs equally bright, left blob is the LED"
 SIDES = ("left", "right")
+# The swing is analysed up to this long before the first blob stops (a hand slowing the pendulum
+# is no free swing).
+STOP_MARGIN_S = 0.2
 
 
 def _side_rule(side: str) -> str:
@@ -92,6 +98,29 @@ def _auto_models(
         "Give led_side or led_roi and sphere_roi if that is wrong"
     )
     return left, right, LEFT_RULE
+
+
+def _shows_motion(images: Sequence[np.ndarray], given: tuple[Roi, Roi] | None) -> bool:
+    """Whether both blobs move in these frames: two moving regions, or motion inside each given ROI."""
+    if given is None:
+        return len(find_moving_regions(images)) >= 2
+    return all(find_moving_regions([roi.crop(image) for image in images]) for roi in given)
+
+
+def _calibration_window(
+    first: Frame, stream: Iterator[Frame], wanted: int, most: int, given: tuple[Roi, Roi] | None
+) -> list[Frame]:
+    """The first frames, held to calibrate on their last ``wanted``: ``wanted`` of them, or more,
+    half ``wanted`` at a time, up to ``most`` frames, while the first quarter of those last frames
+    does not show both blobs move (the pendulum was held still, or not yet the sphere). A blob must
+    move in most calibration frames for their median to be its background."""
+    window = [first, *itertools.islice(stream, max(2, min(wanted, most)) - 1)]
+    while len(window) < most and not _shows_motion([image for _, image in window[-wanted:][: max(wanted // 4, 2)]], given):
+        more = list(itertools.islice(stream, min(max(wanted // 2, 1), most - len(window))))
+        if not more:
+            break
+        window.extend(more)
+    return window
 
 
 class _Tracked:
@@ -144,6 +173,32 @@ def _track_frames(
         done = len(tracked.stamps)
         progress(done, done)
     return tracked
+
+
+def _swing_events(
+    led: Track, sphere: Track, reference_departures: Mapping[str, float]
+) -> tuple[dict[str, float], tuple[float, float]]:
+    """Sphere-minus-LED lags of the swing's one-off events (``analysis.cycles``), and the span in
+    which both blobs swing freely: from the later departure to the earlier stop less STOP_MARGIN_S."""
+    departures = (departure_time(led.t, led.x, led.y), departure_time(sphere.t, sphere.x, sphere.y))
+    stops = (stop_time(led.t, led.x, led.y), stop_time(sphere.t, sphere.x, sphere.y))
+    events: dict[str, float] = {}
+    if departures[1] is not None:
+        if departures[0] is not None:
+            events["swing start"] = departures[1] - departures[0]
+        for name, time in reference_departures.items():
+            events[name] = departures[1] - time
+    if stops[0] is not None and stops[1] is not None:
+        events["swing stop"] = stops[1] - stops[0]
+    begin = max((d for d in departures if d is not None), default=-math.inf)
+    end = min((s - STOP_MARGIN_S for s in stops if s is not None), default=math.inf)
+    return events, (max(begin, float(led.t[0])), min(end, float(led.t[-1])))
+
+
+def _during(track: Track, span: tuple[float, float]) -> Track:
+    """The part of a track inside [start, end]."""
+    inside = (track.t >= span[0]) & (track.t <= span[1])
+    return Track(**{column.name: getattr(track, column.name)[inside] for column in dataclasses.fields(Track)})
 
 
 def _checked_track(track: Track, name: str, warnings: list[str]) -> None:
@@ -285,6 +340,7 @@ def analyse(
     progress: Callable[[int, int], object] | None = None,
     tracks_csv: str | Path | None = None,
     seed: int = 0,
+    reference_departures: Callable[[Track], Mapping[str, float]] | None = None,
 ) -> LatencyResult:
     """Measure the latency between the LED and the rendered sphere in a video.
 
@@ -296,7 +352,11 @@ def analyse(
     (every one, sinefit reported first). Latencies are looked for in ``latency_range_ms``.
     ``progress(done, total)`` is called as frames are tracked (for clips of PROGRESS_MIN_SECONDS
     or more); ``tracks_csv`` receives the tracks
-    as they are measured. ``seed`` seeds the bayes sampler.
+    as they are measured. ``seed`` seeds the bayes sampler. ``reference_departures(led_track)``
+    names times (s, on the video's clock) at which other instruments saw the pendulum depart from
+    rest, in the sense of ``analysis.onset`` (e.g. a rig board's encoder, its clock aligned by the
+    LED's blink code, which it reads from the LED track); with the sphere's departure each gives a
+    lag that fixes the whole number of periods.
     """
     names = _method_names(method)
     if led_side is not None and led_side not in SIDES:
@@ -316,8 +376,8 @@ def analyse(
         wanted = (
             max(CALIBRATION_MIN_FRAMES, round(CALIBRATION_SECONDS * rate)) if rate is not None else CALIBRATION_FRAMES_UNKNOWN_RATE
         )
-        window = [first, *itertools.islice(stream, max(2, min(wanted, CALIBRATION_MAX_BYTES // first[1].nbytes)) - 1)]
-        images = [image for _, image in window]
+        window = _calibration_window(first, stream, wanted, CALIBRATION_MAX_BYTES // first[1].nbytes, given)
+        images = [image for _, image in window[-wanted:]]
         if given is None:
             led_model, sphere_model, led_rule = _auto_models(images, led_side, warnings)
             roi_source = "auto"
@@ -355,7 +415,9 @@ def analyse(
         write_tracks_csv(tracks_csv, led_track, sphere_track)
     _checked_track(led_track, "LED", warnings)
     _checked_track(sphere_track, "sphere", warnings)
-    signals = swing_signals(led_track, sphere_track)
+    references = reference_departures(led_track) if reference_departures is not None else {}
+    events, swinging = _swing_events(led_track, sphere_track, references)
+    signals = swing_signals(_during(led_track, swinging), _during(sphere_track, swinging))
     uniform = signals.uniform()
     uniform_fps = 1.0 / signals.frame_interval
     frequency = estimate_frequency(uniform[1], uniform_fps)
@@ -366,7 +428,7 @@ def analyse(
     damping = damping_rate(window_phases(signals, frequency))
     windows = window_phases(signals, frequency, damping)
     wrapped = fft_phase_latency(uniform[1], uniform[2], uniform_fps, frequency).latency_s
-    cycles = resolve_cycles(wrapped, period, windows, damping, range_s)
+    cycles = resolve_cycles(wrapped, period, windows, damping, range_s, events)
     if cycles.warning:
         warnings.append(cycles.warning)
     results = _estimates(names, signals, uniform, windows, frequency, cycles, damping, seed, warnings)
@@ -381,6 +443,7 @@ def analyse(
         "detection_rate": {"led": float(np.mean(led_track.valid)), "sphere": float(np.mean(sphere_track.valid))},
         "clipped_frames": {"led": int(np.count_nonzero(led_track.clipped)), "sphere": int(np.count_nonzero(sphere_track.clipped))},
         "latency_range_ms": [range_s[0] * 1e3, range_s[1] * 1e3],
+        "swinging_s": [float(swinging[0]), float(swinging[1])],
         "damping_per_s": damping,
         "track_seconds": track_seconds,
         "estimate_seconds": time.perf_counter() - analysis_started,

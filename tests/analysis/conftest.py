@@ -33,6 +33,8 @@ class PendulumScene:
 
     exposure is a fraction of the frame interval; decay is the fraction of the swing's amplitude
     lost over the clip; the sphere swings like the LED, scaled by sphere_scale about its centre.
+    With release_s the pendulum is held at its full swing until then and released from rest (the
+    swing then starts there, not at phase_rad); with stop_s it is stopped dead then.
     """
 
     latency_s: float = 0.05
@@ -64,6 +66,8 @@ class PendulumScene:
     bloom_sigma: float = 4.5
     clutter: tuple[tuple[float, float, float], ...] = ()
     defocus_px: float = 0.0
+    release_s: float | None = None
+    stop_s: float | None = None
     seed: int = 0
 
     @property
@@ -74,8 +78,13 @@ class PendulumScene:
 def pendulum_angle(scene: PendulumScene, t: np.ndarray) -> np.ndarray:
     if not scene.led_moves:
         return np.zeros_like(t)
+    if scene.stop_s is not None:
+        t = np.minimum(t, scene.stop_s)
     damping = -math.log(1 - scene.decay) / scene.duration_s
     omega = 2 * np.pi / scene.period_s
+    if scene.release_s is not None:
+        since = np.maximum(t - scene.release_s, 0.0)
+        return scene.swing_rad * np.exp(-damping * since) * np.cos(omega * since)
     phase = omega * t
     if scene.chirp:
         # omega(t) = omega (1 - A(t)^2 / 16), A(t) = swing exp(-damping t), integrated from t = 0.

@@ -112,3 +112,26 @@ def test_windows_with_too_few_samples_have_no_phase():
     windows = window_phases(SwingSignals(signals.t, signals.led, sphere), 1 / 0.8)
     assert np.isnan(windows.sphere_phase[0]) and np.isfinite(windows.led_phase[0])
     assert windowed_latency(windows, 0.05).count == windows.t.size - 2
+
+
+def test_events_that_agree_fix_a_latency_beyond_the_chirps_reach():
+    resolution = resolve_cycles(-0.2, 0.6, phases(0.4, 0.0), 0.2, event_lags_s={"swing start": 0.41, "swing stop": 0.38})
+    assert (resolution.how, resolution.ambiguous) == ("swing start+swing stop", False)
+    assert resolution.reference_s == pytest.approx(0.4)
+
+
+def test_events_that_disagree_decide_nothing_and_say_so():
+    resolution = resolve_cycles(-0.2, 0.6, phases(0.4, 0.0), 0.2, event_lags_s={"swing start": 0.41, "swing stop": -0.19})
+    assert resolution.ambiguous and resolution.how == "unresolved"
+    assert "do not agree" in resolution.warning
+
+
+def test_an_event_a_quarter_period_off_the_phase_decides_nothing():
+    resolution = resolve_cycles(0.05, 1.0, phases(0.05, 0.0), 0.2, event_lags_s={"swing start": 0.40})
+    assert resolution.how == "range" and "do not agree" in resolution.warning
+
+
+def test_an_event_outside_the_plausible_range_is_reported_with_a_warning():
+    resolution = resolve_cycles(0.05, 1.0, phases(0.05, 0.0), 0.2, (-0.2, 0.6), {"swing start": 1.04})
+    assert resolution.reference_s == pytest.approx(1.05) and not resolution.ambiguous
+    assert "outside the range" in resolution.warning
