@@ -12,6 +12,8 @@ A run writes into its output folder as it goes, so an interrupted run leaves a r
 * `app_frames.csv` every application frame (start, cost and where it came from, pose drawn);
 * `display_frames.csv` every refresh (what it shows, its photon time, the delay from sensor to photons);
 * `video.avi` the camera's video;
+* `board/` with a simulated board (config.board): its LED and encoder recording, as a real board's
+  (rig.sim.board);
 * `truth.json` at the end: the true effective latency and the whole configuration.
 """
 
@@ -28,10 +30,12 @@ import numpy as np
 
 import predictors
 from predictors import Pose, PoseSample
+from rig.devices.recording import FILES, METADATA
 from rig.errors import ConfigError, RigError
 from rig.render import make_renderer
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, Renderer, RenderSetup
 from rig.sim.bench import BenchLayout, make_layout
+from rig.sim.board import BOARD_FOLDER, SimulatedBoard, SimulatedBoardConfig
 from rig.sim.camera import CameraConfig, CameraSensor, VideoFileWriter
 from rig.sim.display import Display, DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -40,7 +44,7 @@ from rig.truth import effective_latency
 
 Progress = Callable[[float, float], None]
 NO_IMAGE = -1
-RUN_FILES = ("video.avi", "truth.json", "tracker.csv", "app_frames.csv", "display_frames.csv")
+RUN_FILES = ("video.avi", "truth.json", "tracker.csv", "app_frames.csv", "display_frames.csv", BOARD_FOLDER)
 DEFAULT_WARP_MS = 2.0
 """Modelled server cost per display frame of a per-display-frame (warp) renderer whose run gives
 none: a GPU's point warp of a display-sized image, well inside a refresh. Software OpenGL takes
@@ -65,6 +69,7 @@ class SimulationConfig:
     app_frame_ms: float | None = 5.0
     warp_ms: float | None = None
     warmup_s: float = 0.5
+    board: SimulatedBoardConfig | None = None
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.duration_s) and 0.5 <= self.duration_s <= 3600.0):
@@ -77,6 +82,19 @@ class SimulationConfig:
             raise ConfigError(f"warp cost must be a positive number of ms, got {self.warp_ms}")
         if self.warmup_s < 0:
             raise ConfigError(f"warm-up must be >= 0 s, got {self.warmup_s}")
+        release = self.pendulum.release_s
+        swing_s = self.pendulum.small_angle_period_s
+        if release is not None and not 0.0 <= release <= self.duration_s - swing_s:
+            raise ConfigError(
+                f"the pendulum's release at {release:g} s must fall within the filmed span with at least one "
+                f"swing ({swing_s:.2f} s) filmed after it: release it between 0 and "
+                f"{self.duration_s - swing_s:.2f} s, or film longer"
+            )
+        if self.board is not None and not 0.0 < self.board.blink_start_s < self.board.blink_end_s <= self.duration_s:
+            raise ConfigError(
+                f"the blink ({self.board.blink_start_s:g} s to {self.board.blink_end_s:g} s) must fall within the "
+                f"filmed span (0 to {self.duration_s:g} s): start it after 0 s and film at least until it ends"
+            )
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -160,7 +178,7 @@ class Simulation:
         self.t_begin = -c.warmup_s
         self.t_end = c.duration_s
         # the truth's latency search (rig.truth) looks up to half a period past the filmed span
-        swing_s = 2.0 * np.pi * np.sqrt(c.pendulum.resolved_length_m / c.pendulum.g)
+        swing_s = c.pendulum.small_angle_period_s
         self.pendulum = Pendulum(c.pendulum, t_start=self.t_begin - 1.0, t_end=self.t_end + 1.0 + swing_s)
         self.display = Display(DisplayConfig(**{**asdict(c.display), "t0": self.t_begin}))
         self.layout: BenchLayout = make_layout(self.pendulum, c.camera, c.display)
@@ -168,6 +186,7 @@ class Simulation:
         self.predictor = predictors.make(c.predictor, **c.predictor_params)
         self.renderer: Renderer = make_renderer(c.renderer)
         self.frame_times = np.arange(0.0, c.duration_s - c.camera.exposure, 1.0 / c.camera.fps)
+        self.board: SimulatedBoard | None = None
         self._panel_rows = (np.arange(self.layout.panel[3]) + 0.5) / self.layout.panel[3]
 
     def run(self) -> SimulationResult:
@@ -178,6 +197,8 @@ class Simulation:
                 f"{self.out_dir} already holds a run ({', '.join(existing)}); "
                 "choose another output folder or pass --overwrite"
             )
+        if self.overwrite:
+            self._remove_board_recording()
         c = self.config
         samples = simulate_tracker(self.pendulum, c.tracker, self.t_begin, self.t_end, seed=c.seed)
         video_path = self.out_dir / "video.avi"
@@ -197,15 +218,29 @@ class Simulation:
                 ["refresh", "t_vblank", "image", "row_fraction", "t_photon", "t_sensor_newest", "delay_ms", "x"],
             )
             try:
+                if c.board is not None:
+                    self.board = SimulatedBoard(c.board, self.pendulum, self.t_begin, self.t_end, self.out_dir / BOARD_FOLDER)
                 self._open_renderer()
                 self._loop(feed, video, shown, content, app_log, display_log)
+                if self.board is not None:
+                    self.board.finish()
             finally:
                 self.renderer.close()
                 app_log.close()
                 display_log.close()
+                if self.board is not None:
+                    self.board.close()
         truth = self._truth(shown, content)
         (self.out_dir / "truth.json").write_text(json.dumps(truth, indent=2))
         return SimulationResult(self.out_dir, video_path, truth)
+
+    def _remove_board_recording(self) -> None:
+        """Remove a previous run's board recording (only the files a recording holds)."""
+        folder = self.out_dir / BOARD_FOLDER
+        for name in [name for name, _ in FILES.values()] + [METADATA]:
+            (folder / name).unlink(missing_ok=True)
+        if folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
 
     def _open_renderer(self) -> None:
         c = self.config
@@ -297,6 +332,8 @@ class Simulation:
                 t_photon = display.photon_time(k, s.row_fraction)
                 display_log.write([k, display.vblank_time(k), current_image, s.row_fraction, t_photon, s.t_sensor_newest, (t_photon - s.t_sensor_newest) * 1e3, s.x_m])
             next_camera = self._expose_ready_frames(next_camera, display.vblank_time(k + 1), content, panel_images, video)
+            if self.board is not None:
+                self.board.advance(display.vblank_time(k))
             self._prune(panel_images, content, k)
             if self.progress is not None:
                 self.progress(min(display.vblank_time(k) - self.t_begin, self.t_end - self.t_begin), self.t_end - self.t_begin)
@@ -327,7 +364,8 @@ class Simulation:
             instants = self.frame_times[next_camera] + offsets
             led = self.layout.led_pixels(self.pendulum.led_position(instants))
             panel = self._panel_light(instants, content, panel_images)
-            video.write(self.sensor.expose(led, panel, self.layout.panel))
+            levels = self.config.board.led_level(instants) if self.config.board is not None else None
+            video.write(self.sensor.expose(led, panel, self.layout.panel, levels))
             next_camera += 1
         return next_camera
 
@@ -385,6 +423,7 @@ class Simulation:
             "display_frame_cost": {"ms": self._warp_ms(), "source": "modelled"} if self.renderer.per_display_frame else None,
             "led_roi": list(self.layout.led_roi),
             "sphere_roi": list(self.layout.sphere_roi),
+            "board": self.board.truth() if self.board is not None else None,
             "config": c.to_dict(),
         }
 

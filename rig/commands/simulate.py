@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import replace
 from pathlib import Path
 
 from rig.commands import options
 from rig.progress import ProgressBar
 from rig.session import DEFAULT_WARP_MS, SimulationConfig, SimulationResult, simulate
+from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
@@ -74,6 +76,37 @@ def config_from_args(args: argparse.Namespace) -> SimulationConfig:
     )
 
 
+def add_lab_options(parser: argparse.ArgumentParser) -> None:
+    """What a lab does during a filmed run: release a held pendulum, blink the board's LED."""
+    board = SimulatedBoardConfig()
+    group = parser.add_argument_group("lab procedure")
+    group.add_argument(
+        "--release-s",
+        type=options.non_negative_float,
+        default=None,
+        metavar="S",
+        help="hold the pendulum at rest at its amplitude and release it S seconds into the film "
+        "(at least one swing before the end; default: swinging from the start)",
+    )
+    group.add_argument(
+        "--board",
+        action="store_true",
+        help=f"simulate the rig board: it plays the LED blink code ({board.blink_bits} bits of "
+        f"{board.blink_bit_s * 1e3:g} ms from {board.blink_start_s:g} s of film; the film must last until "
+        f"{board.blink_end_s:g} s) and records its LED changes and the pendulum encoder on its own clock "
+        f"({board.board_offset_s:g} s ahead) in DIR/{BOARD_FOLDER}/, as `rig board record` does",
+    )
+
+
+def with_lab_options(config: SimulationConfig, args: argparse.Namespace) -> SimulationConfig:
+    """The config with the release and board that the lab options ask for."""
+    return replace(
+        config,
+        pendulum=replace(config.pendulum, release_s=args.release_s),
+        board=SimulatedBoardConfig() if args.board else None,
+    )
+
+
 def run_simulation(config: SimulationConfig, out: Path, overwrite: bool) -> SimulationResult:
     return simulate(config, out, progress=ProgressBar("simulating"), overwrite=overwrite)
 
@@ -93,7 +126,7 @@ def summary(result: SimulationResult) -> dict[str, object]:
 
 
 def _run(args: argparse.Namespace) -> int:
-    result = run_simulation(config_from_args(args), args.out, args.overwrite)
+    result = run_simulation(with_lab_options(config_from_args(args), args), args.out, args.overwrite)
     if args.json:
         print(json.dumps(summary(result)))
     else:
@@ -111,10 +144,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "simulate",
         help="simulate the rig and write a video with known latency",
         description="Simulate pendulum, tracker, predictor, renderer, display and camera on a virtual clock. "
-        "Writes DIR/video.avi, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and DIR/display_frames.csv.",
+        "Writes DIR/video.avi, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and DIR/display_frames.csv, "
+        f"and with --board the board's recording in DIR/{BOARD_FOLDER}/.",
     )
     parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
     parser.add_argument("--overwrite", action="store_true", help="replace a run already in DIR")
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
     add_simulation_options(parser)
+    add_lab_options(parser)
     parser.set_defaults(func=_run)

@@ -2,7 +2,8 @@
 
 Each frame integrates the scene over its exposure by averaging `subsamples` instants (motion blur),
 adds a dark level and read noise, and saturates at 255 like an 8-bit sensor. The LED is a bright
-Gaussian spot whose core saturates; the display panel shows whatever each of its rows emits at
+Gaussian spot whose core saturates, as bright as its drive level (0..255, the board's PWM) at each
+instant makes it; the display panel shows whatever each of its rows emits at
 each instant (the session works that out from the display's scan-out).
 
 Read noise is drawn from a bank of precomputed noise fields at random offsets: full per-pixel
@@ -20,6 +21,7 @@ import numpy as np
 from rig.errors import ConfigError, RigError
 
 LED_SIGMA_PX = 2.2
+LED_FULL_LEVEL = 255
 _NOISE_BANK_SIZE = 8
 _NOISE_PAD = 64
 
@@ -80,23 +82,33 @@ class CameraSensor:
         led_px: np.ndarray,
         panel: np.ndarray,
         panel_rect: tuple[int, int, int, int],
+        led_levels: np.ndarray | None = None,
     ) -> np.ndarray:
         """One frame: LED positions (S, 2) in pixels at each sub-instant, and the panel's mean light.
 
         `panel` is the display's light averaged over the exposure, in camera digital numbers,
-        shape (h, w) of `panel_rect` = (x, y, w, h).
+        shape (h, w) of `panel_rect` = (x, y, w, h). `led_levels` (S,) is the LED's drive level
+        0..255 at each sub-instant, its light scaled by level / 255; None is fully on throughout.
         """
         c = self.config
         image = np.full((c.height, c.width), c.dark_dn, dtype=np.float32)
         px, py, pw, ph = panel_rect
         image[py : py + ph, px : px + pw] += panel
-        self._add_led(image, led_px)
+        self._add_led(image, led_px, led_levels)
         k = self._rng.integers(_NOISE_BANK_SIZE)
         oy, ox = self._rng.integers(_NOISE_PAD, size=2)
         image += self._noise[k, oy : oy + c.height, ox : ox + c.width]
         return np.clip(np.rint(image), 0, 255).astype(np.uint8)
 
-    def _add_led(self, image: np.ndarray, led_px: np.ndarray) -> None:
+    def _add_led(self, image: np.ndarray, led_px: np.ndarray, led_levels: np.ndarray | None) -> None:
+        scale = self.config.led_peak_dn / len(led_px)
+        gain = None
+        if led_levels is not None:
+            levels = np.asarray(led_levels, dtype=np.float64)
+            lit = levels > 0.0
+            if not lit.any():
+                return
+            led_px, gain = led_px[lit], levels[lit] / LED_FULL_LEVEL
         reach = 5.0 * LED_SIGMA_PX
         x0 = int(max(0, np.floor(led_px[:, 0].min() - reach)))
         x1 = int(min(image.shape[1], np.ceil(led_px[:, 0].max() + reach)))
@@ -108,7 +120,9 @@ class CameraSensor:
         ys = np.arange(y0, y1, dtype=np.float32) + 0.5
         gx = np.exp(-0.5 * ((xs[None, :] - led_px[:, 0:1]) / LED_SIGMA_PX) ** 2)
         gy = np.exp(-0.5 * ((ys[None, :] - led_px[:, 1:2]) / LED_SIGMA_PX) ** 2)
-        spot = np.einsum("sy,sx->yx", gy, gx) * (self.config.led_peak_dn / len(led_px))
+        if gain is not None:
+            gy = gy * gain[:, None]
+        spot = np.einsum("sy,sx->yx", gy, gx) * scale
         image[y0:y1, x0:x1] += spot.astype(np.float32)
 
 

@@ -13,8 +13,10 @@ The angle obeys the nonlinear pendulum with linear viscous damping,
     theta'' = -(g / L) sin(theta) - (omega0 / Q) theta',    omega0 = sqrt(g / L),
 
 so for small swings the amplitude decays as exp(-omega0 t / (2 Q)). Q = inf means no damping.
-The equation is integrated once, accurately (DOP853, rtol 1e-11, atol 1e-12), over the whole time
-window; every query afterwards is a vectorised evaluation of the integrator's dense output.
+A pendulum may also be held at rest at +amplitude and let go at a set time, as a lab releases it
+while filming. The equation is integrated once, accurately (DOP853, rtol 1e-11, atol 1e-12), from
+the release to the end of the time window; every query afterwards is a vectorised evaluation of
+the integrator's dense output.
 """
 
 from __future__ import annotations
@@ -46,8 +48,9 @@ class PendulumConfig:
     amplitude_deg is the angle the pendulum is released from, at rest. phase_deg says where in
     the swing the simulation starts: the release happens phase_deg / 360 of a period (the exact
     period at that amplitude) before the start time, so 0 starts at the release and 90 starts near
-    the first downward zero crossing. quality is the Q factor of the viscous damping; math.inf
-    means undamped.
+    the first downward zero crossing. release_s instead holds the pendulum at rest at +amplitude
+    until that time (s, on the simulation's clock) and releases it then; phase_deg must be 0 with
+    it. quality is the Q factor of the viscous damping; math.inf means undamped.
     """
 
     period_s: float | None = 1.0
@@ -57,6 +60,7 @@ class PendulumConfig:
     g: float = 9.80665
     phase_deg: float = 0.0
     pivot: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    release_s: float | None = None
 
     def __post_init__(self) -> None:
         if (self.period_s is None) == (self.length_m is None):
@@ -81,6 +85,14 @@ class PendulumConfig:
             )
         if not (0.0 <= self.phase_deg < 360.0):
             raise ConfigError(f"PendulumConfig.phase_deg must be in [0, 360) degrees, got {self.phase_deg!r}")
+        if self.release_s is not None:
+            if not math.isfinite(self.release_s):
+                raise ConfigError(f"PendulumConfig.release_s must be a finite time in seconds, got {self.release_s!r}")
+            if self.phase_deg != 0.0:
+                raise ConfigError(
+                    "PendulumConfig.release_s and phase_deg exclude each other: a held pendulum starts "
+                    f"from rest at its release, so leave phase_deg at 0 (got {self.phase_deg!r})"
+                )
         pivot = np.asarray(self.pivot, dtype=np.float64)
         if pivot.shape != (3,) or not np.isfinite(pivot).all():
             raise ConfigError(
@@ -95,9 +107,18 @@ class PendulumConfig:
         assert self.period_s is not None
         return self.g * (self.period_s / (2.0 * math.pi)) ** 2
 
+    @property
+    def small_angle_period_s(self) -> float:
+        """2 pi sqrt(L / g): the period of an infinitesimal, undamped swing."""
+        return 2.0 * math.pi * math.sqrt(self.resolved_length_m / self.g)
+
 
 class Pendulum:
-    """The pendulum's motion over [t_start, t_end], integrated once at construction."""
+    """The pendulum's motion over [t_start, t_end], integrated once at construction.
+
+    t_release is when it is let go from rest at +amplitude; before it (with release_s set) the
+    pendulum is held there.
+    """
 
     def __init__(self, config: PendulumConfig, t_end: float, t_start: float = 0.0) -> None:
         if not (math.isfinite(t_start) and math.isfinite(t_end) and t_end > t_start):
@@ -111,13 +132,17 @@ class Pendulum:
         self.omega0 = math.sqrt(config.g / self.length_m)
         self.pivot = np.asarray(config.pivot, dtype=np.float64)
         self.amplitude_rad = math.radians(config.amplitude_deg)
-        self.t_release = self.t_start - config.phase_deg / 360.0 * self.period_s
-        self._solution = self._integrate()
+        if config.release_s is not None:
+            self.t_release = float(config.release_s)
+        else:
+            self.t_release = self.t_start - config.phase_deg / 360.0 * self.period_s
+        # released after the window: held throughout, nothing to integrate
+        self._solution = self._integrate() if self.t_release < self.t_end else None
 
     @property
     def small_angle_period_s(self) -> float:
         """2 pi sqrt(L / g): the period of an infinitesimal, undamped swing."""
-        return 2.0 * math.pi / self.omega0
+        return self.config.small_angle_period_s
 
     @property
     def period_s(self) -> float:
@@ -154,10 +179,13 @@ class Pendulum:
                 f"time {bad!r} s is outside the simulated window [{self.t_start!r}, {self.t_end!r}] s; "
                 "build the Pendulum with a window that covers every time you ask for"
             )
-        if times.size == 0:
-            return np.empty(times.shape), np.empty(times.shape)
-        state = self._solution(times.ravel())
-        return state[0].reshape(times.shape), state[1].reshape(times.shape)
+        angle = np.full(times.shape, self.amplitude_rad)
+        velocity = np.zeros(times.shape)
+        moving = times > self.t_release
+        if self._solution is not None and moving.any():
+            state = self._solution(times[moving])
+            angle[moving], velocity[moving] = state[0], state[1]
+        return angle, velocity
 
     def angle(self, t: ArrayLike) -> np.ndarray:
         """theta(t) in radians, the shape of t."""

@@ -2,16 +2,21 @@
 
 import csv
 import json
+import shutil
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
-from rig.errors import RigError
-from rig.session import SimulationConfig, simulate
+from rig.devices.blink_code import align_blink_code
+from rig.devices.recording import load_table
+from rig.errors import ConfigError, RigError
+from rig.session import Simulation, SimulationConfig, simulate
+from rig.sim.board import SimulatedBoardConfig, encoder_count
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
+from rig.sim.pendulum import PendulumConfig
 from rig.sim.tracker import TrackerConfig, read_tracker_csv
 
 SMALL_CAMERA = CameraConfig(fps=120.0, width=320, height=240, subsamples=4)
@@ -119,3 +124,151 @@ def test_unknown_renderer_and_predictor_are_reported(tmp_path: Path) -> None:
         simulate(small_config(renderer="nonesuch"), tmp_path / "a")
     with pytest.raises(PredictorError):
         simulate(small_config(predictor="nonesuch"), tmp_path / "b")
+
+
+# A lab's run: the board blinks its code while the pendulum is held, then the pendulum is let go.
+BOARD = SimulatedBoardConfig(board_offset_s=100.0, blink_start_s=0.3, blink_bits=32, blink_bit_s=0.04)
+RELEASE_S = 1.8
+
+
+def lab_config(**overrides) -> SimulationConfig:
+    return small_config(duration_s=3.0, pendulum=PendulumConfig(release_s=RELEASE_S), board=BOARD, **overrides)
+
+
+@pytest.fixture(scope="module")
+def lab_run(tmp_path_factory: pytest.TempPathFactory) -> Simulation:
+    simulation = Simulation(lab_config(), tmp_path_factory.mktemp("lab"))
+    simulation.run()
+    return simulation
+
+
+def video_frames(video: Path) -> np.ndarray:
+    """Every frame of the video, grey (N, height, width)."""
+    capture = cv2.VideoCapture(str(video))
+    frames = []
+    while True:
+        ok, frame = capture.read()
+        if not ok:
+            return np.array(frames)
+        frames.append(frame[:, :, 1])
+
+
+def exposure_levels(run: Simulation) -> np.ndarray:
+    """The LED's level at 9 instants spread over each frame's exposure, shape (9, frames)."""
+    exposure = run.config.camera.exposure
+    return np.stack([BOARD.led_level(run.frame_times + f * exposure) for f in np.linspace(0.0, 1.0, 9)])
+
+
+def test_a_run_without_a_board_records_none(default_run) -> None:
+    assert not (default_run.out_dir / "board").exists()
+    assert default_run.truth["board"] is None
+    assert default_run.truth["config"]["pendulum"]["release_s"] is None
+
+
+def test_truth_describes_the_board_and_the_release(lab_run) -> None:
+    truth = json.loads((lab_run.out_dir / "truth.json").read_text())
+    assert truth["board"] == {
+        "offset_s": 100.0,
+        "release_s": RELEASE_S,
+        "blink": {"start_board_time": 100.3, "bit_s": 0.04, "seed": 0xACE1, "bits": 32, "level": 255},
+    }
+    assert truth["config"]["board"]["counts_per_rev"] == 2400
+
+
+def test_the_board_record_aligns_the_cameras_truth_to_the_board_clock(lab_run) -> None:
+    """Which frames have the LED on (the simulation knows) against led.csv gives the board's offset."""
+    exposure = lab_run.config.camera.exposure
+    middles = lab_run.frame_times + exposure / 2
+    lit = BOARD.led_level(middles) > 0
+    led = load_table(lab_run.out_dir / "board", "led.csv")
+    alignment = align_blink_code(middles, lit, led["board_time_s"], led["level"], exposure_s=exposure)
+    assert alignment.low_s - 1e-6 <= BOARD.board_offset_s <= alignment.high_s + 1e-6
+    assert alignment.offset_s == pytest.approx(BOARD.board_offset_s, abs=1 / lab_run.config.camera.fps)
+    assert alignment.agreement == 1.0
+
+
+def test_the_video_shows_the_blink(lab_run) -> None:
+    """The LED's brightest pixel is saturated in frames exposed wholly inside an on bit and dark in
+    frames exposed wholly inside an off bit; the video's own on/off times the board's clock."""
+    camera = lab_run.config.camera
+    x, y, w, h = lab_run.layout.led_roi
+    peaks = video_frames(lab_run.out_dir / "video.avi")[:, y : y + h, x : x + w].max(axis=(1, 2))
+    assert peaks.size == lab_run.frame_times.size
+    levels = exposure_levels(lab_run)
+    on, off = np.all(levels > 0, axis=0), np.all(levels == 0, axis=0)
+    assert off.sum() > 30 and on.sum() > 150
+    assert peaks[on].min() >= 240
+    assert peaks[off].max() <= camera.dark_dn + 6 * camera.noise_dn
+    led = load_table(lab_run.out_dir / "board", "led.csv")
+    middles = lab_run.frame_times + camera.exposure / 2
+    alignment = align_blink_code(middles, peaks > 128, led["board_time_s"], led["level"], exposure_s=camera.exposure)
+    assert alignment.low_s - 1e-6 <= BOARD.board_offset_s <= alignment.high_s + 1e-6
+
+
+def test_encoder_csv_follows_the_pendulum_from_its_release(lab_run) -> None:
+    encoder = load_table(lab_run.out_dir / "board", "encoder.csv")
+    t, count, step = encoder["rig_time_s"], encoder["count"], encoder["step"]
+    assert t.min() > RELEASE_S and t.max() <= lab_run.config.duration_s
+    dense = encoder_count(lab_run.pendulum.angle(np.arange(lab_run.t_begin, lab_run.t_end, 20e-6)), BOARD.counts_per_rev)
+    assert t.size == np.abs(np.diff(dense)).sum() > 500
+    np.testing.assert_array_equal(encoder_count(lab_run.pendulum.angle(t - 1e-6), BOARD.counts_per_rev), count - step)
+    np.testing.assert_array_equal(encoder_count(lab_run.pendulum.angle(t + 1e-6), BOARD.counts_per_rev), count)
+    np.testing.assert_allclose(encoder["board_time_s"] - t, BOARD.board_offset_s, rtol=0, atol=1e-6)
+
+
+def test_the_held_led_stays_put_in_the_video_until_the_release(lab_run) -> None:
+    camera = lab_run.config.camera
+    left = video_frames(lab_run.out_dir / "video.avi")[:, :, : camera.width // 2]
+    bright = left.max(axis=1) > 128
+    columns = (bright * (np.arange(left.shape[2]) + 0.5)).sum(axis=1) / np.maximum(bright.sum(axis=1), 1)
+    lit = np.all(exposure_levels(lab_run) > 0, axis=0)
+    held = lit & (lab_run.frame_times + camera.exposure < RELEASE_S)
+    swinging = lab_run.frame_times > RELEASE_S + 0.1
+    expected = lab_run.layout.led_pixels(lab_run.pendulum.led_position(np.array([0.0])))[0, 0]
+    assert held.sum() > 60
+    assert np.all(np.abs(columns[held] - expected) <= 1.0)
+    assert np.ptp(columns[swinging]) > camera.width / 4
+
+
+def test_a_held_run_keeps_its_true_latency(lab_run) -> None:
+    truth = json.loads((lab_run.out_dir / "truth.json").read_text())
+    half_refresh_ms = 1e3 / 60 / 2
+    assert truth["latency_ms"] == pytest.approx(truth["display_frame_delay_ms"]["mean"] + half_refresh_ms, abs=1.5)
+
+
+def test_an_interrupted_run_leaves_a_readable_board_recording(tmp_path: Path) -> None:
+    def interrupt_after_two_seconds_of_film(done: float, total: float) -> None:
+        if done > 2.0 + lab_config().warmup_s:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        simulate(lab_config(), tmp_path, progress=interrupt_after_two_seconds_of_film)
+    led = load_table(tmp_path / "board", "led.csv")
+    assert led["rig_time_s"].size > 10 and led["rig_time_s"].max() <= 2.1
+    encoder = load_table(tmp_path / "board", "encoder.csv")
+    assert encoder["rig_time_s"].size > 50
+    assert RELEASE_S < encoder["rig_time_s"].min() and encoder["rig_time_s"].max() <= 2.1
+    assert not (tmp_path / "board" / "recording.json").exists()
+
+
+def test_overwriting_a_board_run_removes_its_recording(lab_run, tmp_path: Path) -> None:
+    folder = tmp_path / "run"
+    shutil.copytree(lab_run.out_dir, folder)
+    with pytest.raises(RigError, match="board"):
+        simulate(small_config(), folder)
+    simulate(small_config(), folder, overwrite=True)
+    assert not (folder / "board").exists()
+
+
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        (dict(pendulum=PendulumConfig(release_s=2.5)), "release at 2.5 s must fall within the filmed span"),
+        (dict(pendulum=PendulumConfig(release_s=-0.1)), "release at -0.1 s must fall within the filmed span"),
+        (dict(board=SimulatedBoardConfig(blink_start_s=2.0, blink_bits=32, blink_bit_s=0.04)), r"blink \(2 s to 3.28 s\) must fall within the filmed span"),
+        (dict(board=SimulatedBoardConfig(blink_start_s=0.0)), "blink .* must fall within the filmed span"),
+    ],
+)
+def test_a_release_or_blink_outside_the_film_is_rejected(overrides: dict, message: str) -> None:
+    with pytest.raises(ConfigError, match=message):
+        SimulationConfig(**{"duration_s": 3.0, **overrides})

@@ -49,6 +49,32 @@ def test_motion_blur_spreads_the_spot_along_its_path() -> None:
     assert np.ptp(lit[:, 1]) > 3 * np.ptp(lit[:, 0])
 
 
+def test_led_light_scales_with_its_level_at_each_sub_instant() -> None:
+    config = CameraConfig(noise_dn=0.0, dark_dn=0.0, led_peak_dn=200.0, subsamples=4)
+    spot = np.array([[60.5, 40.5]] * 4)
+
+    def frame(levels: list[int] | None) -> np.ndarray:
+        sensor = CameraSensor(config, seed=1)
+        return sensor.expose(spot, np.zeros((1, 1)), NO_PANEL, None if levels is None else np.array(levels)).astype(float)
+
+    full = frame(None)
+    assert full.max() == 200
+    np.testing.assert_array_equal(frame([255] * 4), full)
+    np.testing.assert_array_equal(frame([0] * 4), 0)
+    # each pixel, to the rounding of the two 8-bit frames
+    assert np.abs(frame([255, 0, 0, 255]) - full / 2).max() <= 0.6
+    assert np.abs(frame([51] * 4) - full / 5).max() <= 0.6
+
+
+def test_a_dark_sub_instant_leaves_no_trail() -> None:
+    """The LED moves while it blinks: only where it was lit shows in the frame."""
+    config = CameraConfig(noise_dn=0.0, dark_dn=0.0, led_peak_dn=200.0, subsamples=4)
+    path = np.column_stack([np.linspace(40.0, 160.0, 4), np.full(4, 60.0)])
+    frame = CameraSensor(config, seed=1).expose(path, np.zeros((1, 1)), NO_PANEL, np.array([255, 0, 0, 0]))
+    x, _ = _centroid(frame, 0.0)
+    assert x == pytest.approx(40.0, abs=0.1)
+
+
 def test_noise_has_the_configured_spread_around_the_dark_level() -> None:
     config = CameraConfig(noise_dn=3.0, dark_dn=20.0)
     sensor = CameraSensor(config, seed=5)
