@@ -9,9 +9,11 @@ A blob departs when its distance from its resting place first exceeds DEPARTURE_
 farthest it gets from there (the far end of the first swing, twice the amplitude). Released from
 rest, the distance grows as 1 - cos(omega t), so that threshold is crossed the same time after
 the release for any amplitude in pixels: the LED's and the sphere's departures lie exactly the
-latency apart, however large each appears. It must have rested first: over the clip's first MIN_REST_S
-it stays within REST_FRACTION of that reach of its resting place (noise and a blinking LED's
-missing frames allowed); a clip that starts mid-swing has no departure. The stop is the departure of the reversed track.
+latency apart, however large each appears. A blob that jitters at rest (a rendered sphere follows
+the tracker's noise) departs only beyond its jitter, and only when CONFIRM_FRAMES frames in a row
+are beyond the level. It must have rested first: over the clip's first MIN_REST_S it stays within
+REST_FRACTION of that reach, plus its jitter, of its resting place (a blinking LED's missing frames
+are skipped); a clip that starts mid-swing has no departure. The stop is the departure of the reversed track.
 """
 
 from __future__ import annotations
@@ -24,14 +26,18 @@ MIN_REST_S = 0.2
 # The reach is this percentile of the distances from rest: one stray detection does not set it.
 REACH_PERCENTILE = 99.5
 MIN_REST_FRAMES = 5
+# Noise moves a resting blob at most this many standard deviations from its resting place...
+JITTER_FACTOR = 6.0
+MAD_TO_SIGMA = 1.4826
+# ...and a departure is this many frames in a row beyond the level (one stray detection is none).
+CONFIRM_FRAMES = 3
 
 
 def departure_time(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> float | None:
     """The time (s) the point (x, y) leaves the place it rests at from the first sample, or None.
 
     t increasing; NaN positions are frames without the blob and are skipped. The time is
-    interpolated between the last frame inside DEPARTURE_FRACTION of the reach and the first
-    outside it.
+    interpolated between the last frame inside the departure level and the first beyond it.
     """
     valid = np.isfinite(x) & np.isfinite(y)
     t, x, y = t[valid], x[valid], y[valid]
@@ -45,20 +51,27 @@ def departure_time(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> float | None:
     reach = float(np.percentile(distance, REACH_PERCENTILE))
     if reach <= 0:
         return None
-    away = np.flatnonzero(distance > DEPARTURE_FRACTION * reach)
-    if away.size == 0 or away[0] == 0:
+    jitter = JITTER_FACTOR * max(_noise_sd(x[resting]), _noise_sd(y[resting]))
+    if np.any(distance[resting] > REST_FRACTION * reach + jitter):
+        return None
+    level = max(DEPARTURE_FRACTION * reach, jitter)
+    held = np.convolve(distance > level, np.ones(CONFIRM_FRAMES), "valid") == CONFIRM_FRAMES
+    away = np.flatnonzero(held)
+    if away.size == 0 or away[0] == 0 or t[away[0] - 1] - t[0] < MIN_REST_S:
         return None
     first = int(away[0])
-    if t[first - 1] - t[0] < MIN_REST_S or np.any(distance[resting] > REST_FRACTION * reach + _jitter(distance[resting])):
-        return None
     before, after = distance[first - 1], distance[first]
-    level = DEPARTURE_FRACTION * reach
     return float(t[first - 1] + (t[first] - t[first - 1]) * (level - before) / (after - before))
 
 
-def _jitter(distance_at_rest: np.ndarray) -> float:
-    """How far noise alone moves a resting blob: a generous bound from its spread at rest."""
-    return 6.0 * float(np.median(distance_at_rest)) + 1e-9
+def _noise_sd(values: np.ndarray) -> float:
+    """The standard deviation of white noise on a smooth signal, from its second differences
+    (which a swing, sampled many times per period, hardly has): robust, so a swing that has
+    started does not pass for noise."""
+    second = np.diff(values, 2)
+    if second.size == 0:
+        return 0.0
+    return MAD_TO_SIGMA * float(np.median(np.abs(second - np.median(second)))) / np.sqrt(6.0)
 
 
 def stop_time(t: np.ndarray, x: np.ndarray, y: np.ndarray) -> float | None:

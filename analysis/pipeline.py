@@ -59,6 +59,11 @@ SIDES = ("left", "right")
 # The swing is analysed up to this long before the first blob stops (a hand slowing the pendulum
 # is no free swing).
 STOP_MARGIN_S = 0.2
+# A blob swings when its place changes by this many times its size, and this many pixels, over
+# about SWING_SAMPLES frames.
+SWING_SIZES = 2.0
+SWING_MIN_PX = 4.0
+SWING_SAMPLES = 32
 
 
 def _side_rule(side: str) -> str:
@@ -100,11 +105,35 @@ def _auto_models(
     return left, right, LEFT_RULE
 
 
+def _swings(crops: Sequence[np.ndarray]) -> bool:
+    """Whether the brightest thing in these crops of one region moves by more than twice its size.
+
+    Only frames where it is lit count (at least half its brightest above the region's darkest); in
+    each, its place is the centre, and its size the square root of the number, of its pixels above
+    half that frame's peak. A blinking LED, or a sphere jittering with the tracker's noise, stays
+    within its size; a swinging one does not.
+    """
+    stack = np.stack(crops).astype(np.float32)
+    lifted = stack - stack.min(axis=0)
+    peaks = lifted.max(axis=(1, 2))
+    places, sizes = [], []
+    for image, peak in zip(lifted, peaks):
+        if peak > 0 and peak >= 0.5 * peaks.max():
+            rows, columns = np.nonzero(image >= 0.5 * peak)
+            places.append((columns.mean(), rows.mean()))
+            sizes.append(math.sqrt(rows.size))
+    if len(places) < 2:
+        return False
+    travel = float(np.max(np.ptp(np.array(places), axis=0)))
+    return travel >= max(SWING_MIN_PX, SWING_SIZES * float(np.median(sizes)))
+
+
 def _shows_motion(images: Sequence[np.ndarray], given: tuple[Roi, Roi] | None) -> bool:
-    """Whether both blobs move in these frames: two moving regions, or motion inside each given ROI."""
-    if given is None:
-        return len(find_moving_regions(images)) >= 2
-    return all(find_moving_regions([roi.crop(image) for image in images]) for roi in given)
+    """Whether both blobs swing in these frames: in the given ROIs, or in the two largest moving
+    regions (those ``_auto_models`` takes)."""
+    samples = images[:: max(1, len(images) // SWING_SAMPLES)]
+    regions = list(given) if given is not None else find_moving_regions(images)[:2]
+    return len(regions) == 2 and all(_swings([region.crop(image) for image in samples]) for region in regions)
 
 
 def _calibration_window(

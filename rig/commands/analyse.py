@@ -12,6 +12,7 @@ from analysis.cycles import DEFAULT_LATENCY_RANGE_S
 from analysis.plots import plot_tracks
 from analysis.result import DEFAULT_METHOD
 from rig.commands import options
+from rig.devices.board_reference import EVENT_NAME, BoardReference
 from rig.errors import RigError
 from rig.progress import ProgressBar
 
@@ -29,6 +30,22 @@ def summary_line(result: LatencyResult) -> str:
     )
 
 
+def board_line(board: BoardReference, result: LatencyResult) -> str:
+    """What the board recording told: the clock offset, and the start of swing it saw."""
+    alignment = board.alignment
+    assert alignment is not None
+    line = (
+        f"board: video on the board's clock by the blink code (offset {alignment.offset_s:.4f} s, "
+        f"within {(alignment.high_s - alignment.low_s) * 1e3:.1f} ms, {alignment.agreement:.0%} of frames agree)"
+    )
+    lag = result.cycles.events_s.get(EVENT_NAME)
+    if board.departure_board_s is None:
+        return line + "; the encoder did not start from rest while filmed, so it fixed nothing"
+    if lag is None:
+        return line + "; the sphere's start of swing is not in the video, so the encoder's fixed nothing"
+    return line + f"; the sphere left rest {lag * 1e3:.0f} ms after the encoder did"
+
+
 def run_analysis(
     video: Path,
     fps: float | None = None,
@@ -39,8 +56,10 @@ def run_analysis(
     led_side: str | None = None,
     latency_range_ms: tuple[float, float] = tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S),
     seed: int = 0,
+    board: BoardReference | None = None,
 ) -> LatencyResult:
-    """Analyse a video with a progress bar on the terminal."""
+    """Analyse a video with a progress bar on the terminal; with a board recording, its encoder's
+    start of swing (put on the video's clock by the blink code) fixes the whole number of periods."""
     return analysis.analyse(
         video,
         fps=fps,
@@ -52,12 +71,14 @@ def run_analysis(
         progress=ProgressBar("analysing"),
         tracks_csv=tracks_csv,
         seed=seed,
+        reference_departures=board.departures if board is not None else None,
     )
 
 
 def _run(args: argparse.Namespace) -> int:
+    board = BoardReference.load(args.board) if args.board is not None else None
     result = run_analysis(
-        args.video, args.fps, args.led_roi, args.sphere_roi, args.method, args.csv, args.led_side, args.latency_range, args.seed
+        args.video, args.fps, args.led_roi, args.sphere_roi, args.method, args.csv, args.led_side, args.latency_range, args.seed, board
     )
     if args.plot is not None:
         try:
@@ -65,9 +86,11 @@ def _run(args: argparse.Namespace) -> int:
         except OSError as error:
             raise RigError(f"cannot write the plot {args.plot}: {error}") from error
     if args.json:
-        print(json.dumps(result.to_dict()))
+        print(json.dumps(result.to_dict() | ({"board": board.to_dict()} if board is not None else {})))
     else:
         print(summary_line(result))
+        if board is not None:
+            print(board_line(board, result))
         for name, estimate in result.methods.items():
             if name != result.method:
                 ci = f" (95% {estimate.ci95_ms[0]:.2f} to {estimate.ci95_ms[1]:.2f})" if estimate.ci95_ms else ""
@@ -114,6 +137,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         default=(low, high),
         metavar="LOW,HIGH",
         help=f"latencies considered, in ms, to fix the whole number of swing periods (default: {low:g},{high:g})",
+    )
+    parser.add_argument(
+        "--board",
+        type=Path,
+        metavar="DIR",
+        help="a `rig board record --blink` folder made while filming: the LED's blink code puts the video on the "
+        "board's clock and the encoder's start of swing fixes the whole number of periods",
     )
     parser.add_argument("--seed", type=int, default=0, help="random seed of the bayes sampler (default: %(default)s)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")

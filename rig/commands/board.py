@@ -2,8 +2,9 @@
 
     rig board info                  who the board is, its counters and the clock offset
     rig board sync                  measure the clock offset (and, repeated, its drift)
-    rig board record --out DIR --duration S
-                                    record encoder, photodiode and LED events as CSV (rig/devices/recording.py)
+    rig board record --out DIR --duration S [--blink]
+                                    record encoder, photodiode and LED events as CSV (rig/devices/recording.py);
+                                    with --blink, play the blink code first (for `rig analyse --board DIR`)
     rig board blink                 play the LED blink code (to align a camera to the board)
     rig board latency DIR           the latency from a recording's photodiode passages and encoder
 
@@ -23,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from rig.commands.options import non_negative_float, non_negative_int, positive_float
+from rig.devices.blink_code import BlinkSchedule
 from rig.devices.clock_sync import OffsetInterval
 from rig.devices.microcontroller import Microcontroller
 from rig.devices.photodiode_latency import estimate_from_recording, plot_board_latency
@@ -67,14 +69,18 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     record.add_argument("--fall", type=non_negative_int, default=DEFAULT_FALL, help=f"photodiode falling threshold, below --rise (default {DEFAULT_FALL})")
     record.add_argument("--raw-every", type=non_negative_int, default=0, help="also record every n-th raw ADC sample (0, the default: none)")
     record.add_argument("--resync-every", type=positive_float, default=5.0, help="seconds between clock syncs while recording (default 5)")
+    record.add_argument(
+        "--blink",
+        action="store_true",
+        help="play the blink code at the start, then leave the LED lit: film it, release the pendulum after it, "
+        "and `rig analyse VIDEO --board DIR` aligns the video to this recording",
+    )
+    _add_blink_options(record)
     record.set_defaults(func=run_record)
 
     blink = commands.add_parser("blink", help="play the LED blink code, to align a camera's video to the board's clock")
     _add_port(blink)
-    blink.add_argument("--bits", type=non_negative_int, default=64, help="bits of code (default 64)")
-    blink.add_argument("--bit-ms", type=positive_float, default=50.0, help="duration of one bit, ms (default 50)")
-    blink.add_argument("--seed", type=non_negative_int, default=0xACE1, help="code seed, 1..65535 (default 44257)")
-    blink.add_argument("--level", type=non_negative_int, default=255, help="LED level of a 1 bit, 1..255 (default 255)")
+    _add_blink_options(blink)
     blink.add_argument("--out", type=Path, help="also record the LED changes (led.csv) and the schedule (blink.json) here")
     blink.add_argument("--json", action="store_true", help="print the schedule as one JSON object")
     blink.set_defaults(func=run_blink)
@@ -85,6 +91,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     latency.add_argument("--json", action="store_true", help="print one JSON object")
     latency.add_argument("--plot", type=Path, help="also draw the fit into this PNG file")
     latency.set_defaults(func=run_latency)
+
+
+def _add_blink_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--bits", type=non_negative_int, default=64, help="bits of blink code (default 64)")
+    parser.add_argument("--bit-ms", type=positive_float, default=50.0, help="duration of one bit, ms (default 50)")
+    parser.add_argument("--seed", type=non_negative_int, default=0xACE1, help="code seed, 1..65535 (default 44257)")
+    parser.add_argument("--level", type=non_negative_int, default=255, help="LED level of a 1 bit (and after a recording's blink), 1..255 (default 255)")
 
 
 def _add_port(parser: argparse.ArgumentParser) -> None:
@@ -152,6 +165,8 @@ def run_sync(args: argparse.Namespace) -> int:
 
 
 def run_record(args: argparse.Namespace) -> int:
+    if args.blink and _blink_seconds(args) > args.duration:
+        raise RigError(f"--duration {args.duration:g} s is shorter than the blink ({_blink_seconds(args):.2f} s): record for longer")
     board = _board(args, resync_every_s=args.resync_every)
     recorder = BoardRecorder(args.out)
     board.add_listener(recorder)
@@ -160,7 +175,11 @@ def run_record(args: argparse.Namespace) -> int:
             board.configure_encoder(args.encoder_rate)
             board.configure_photodiode(args.rise, args.fall, args.raw_every)
             board.stream(encoder=True, photodiode=True, samples=args.raw_every > 0)
-            _wait(board, args.duration, ProgressBar(f"recording {args.out}"))
+            started = time.monotonic()
+            if args.blink:
+                _play_blink(board, args, args.out, ProgressBar("blinking"))
+                board.set_led(args.level)
+            _wait(board, max(args.duration - (time.monotonic() - started), 0.0), ProgressBar(f"recording {args.out}"))
             board.stream()
             board.sync()
             status = board.status()
@@ -173,6 +192,7 @@ def run_record(args: argparse.Namespace) -> int:
                         "rise": args.rise,
                         "fall": args.fall,
                         "raw_every": args.raw_every,
+                        "blink": args.blink,
                     },
                     "events": recorder.counts,
                     "link": board.counters,
@@ -193,11 +213,8 @@ def run_blink(args: argparse.Namespace) -> int:
         board.add_listener(recorder)
     try:
         with board:
-            schedule = board.blink(bits=args.bits, bit_s=args.bit_ms / 1e3, seed=args.seed, level=args.level, start_in_s=BLINK_LEAD_S)
-            report = asdict(schedule) | {"start_rig_time": board.to_rig_time(schedule.start_board_time)}
-            if recorder is not None:
-                (args.out / "blink.json").write_text(json.dumps(report, indent=2) + "\n")
-            _wait(board, BLINK_LEAD_S + schedule.bits * schedule.bit_s + BLINK_TAIL_S, ProgressBar("blinking"))
+            schedule = _play_blink(board, args, args.out, ProgressBar("blinking"))
+            report = _blink_report(board, schedule)
     finally:
         if recorder is not None:
             recorder.close()
@@ -206,6 +223,23 @@ def run_blink(args: argparse.Namespace) -> int:
     else:
         print(f"blinked {schedule.bits} bits of {schedule.bit_s * 1e3:g} ms from board time {schedule.start_board_time:.6f} s (seed {schedule.seed})")
     return 0
+
+
+def _blink_report(board: Microcontroller, schedule: BlinkSchedule) -> dict[str, Any]:
+    return asdict(schedule) | {"start_rig_time": board.to_rig_time(schedule.start_board_time)}
+
+
+def _play_blink(board: Microcontroller, args: argparse.Namespace, out: Path | None, progress: ProgressBar) -> BlinkSchedule:
+    """Plays the blink code (writing blink.json into out, if given) and waits until it is over."""
+    schedule = board.blink(bits=args.bits, bit_s=args.bit_ms / 1e3, seed=args.seed, level=args.level, start_in_s=BLINK_LEAD_S)
+    if out is not None:
+        (out / "blink.json").write_text(json.dumps(_blink_report(board, schedule), indent=2) + "\n")
+    _wait(board, _blink_seconds(args), progress)
+    return schedule
+
+
+def _blink_seconds(args: argparse.Namespace) -> float:
+    return BLINK_LEAD_S + args.bits * args.bit_ms / 1e3 + BLINK_TAIL_S
 
 
 def run_latency(args: argparse.Namespace) -> int:

@@ -28,7 +28,6 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from matplotlib.figure import Figure
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize_scalar
 
@@ -61,7 +60,9 @@ class BoardLatency:
 
 
 @dataclass(frozen=True)
-class _Trajectory:
+class EncoderTrajectory:
+    """The pendulum's angle in encoder counts against board time, linear between edges."""
+
     times: NDArray[np.float64]
     angles: NDArray[np.float64]
 
@@ -73,7 +74,8 @@ class _Trajectory:
         return (self.angle(t + h) - self.angle(t - h)) / (2 * h)
 
 
-def _trajectory(edge_times: ArrayLike, counts: ArrayLike, steps: ArrayLike) -> _Trajectory:
+def encoder_trajectory(edge_times: ArrayLike, counts: ArrayLike, steps: ArrayLike) -> EncoderTrajectory:
+    """From encoder.csv's columns: an edge from count - step to count is the angle count - step / 2."""
     times = np.asarray(edge_times, dtype=np.float64)
     angles = np.asarray(counts, dtype=np.float64) - 0.5 * np.asarray(steps, dtype=np.float64)
     order = np.argsort(times, kind="stable")
@@ -81,10 +83,10 @@ def _trajectory(edge_times: ArrayLike, counts: ArrayLike, steps: ArrayLike) -> _
     keep = np.append(np.diff(times) > 0, True)
     if keep.sum() < 10:
         raise RigError("the recording has fewer than 10 encoder edges: was the pendulum swinging?")
-    return _Trajectory(times[keep], angles[keep])
+    return EncoderTrajectory(times[keep], angles[keep])
 
 
-def _period(trajectory: _Trajectory) -> float:
+def _period(trajectory: EncoderTrajectory) -> float:
     """Median time between upward crossings of the mean angle."""
     centred = trajectory.angles - np.mean(trajectory.angles)
     upward = np.flatnonzero((centred[:-1] < 0) & (centred[1:] >= 0))
@@ -96,7 +98,7 @@ def _period(trajectory: _Trajectory) -> float:
 class _Fit:
     """The least-squares problem of the module docstring."""
 
-    def __init__(self, trajectory: _Trajectory, centroids: NDArray[np.float64]) -> None:
+    def __init__(self, trajectory: EncoderTrajectory, centroids: NDArray[np.float64]) -> None:
         self.trajectory = trajectory
         self.centroids = centroids
         self.top_speed = float(np.max(np.abs(trajectory.velocity(trajectory.times))))
@@ -132,7 +134,7 @@ def estimate_board_latency(
 ) -> BoardLatency:
     """Latency from encoder edges (board s; count after the edge; its step, +1 or -1) and the
     photodiode passages (board s of each centroid; how long each lasted); see the module docstring."""
-    trajectory = _trajectory(edge_times, counts, steps)
+    trajectory = encoder_trajectory(edge_times, counts, steps)
     period = _period(trajectory)
     limit = DEFAULT_MAX_LATENCY_PERIODS * period if max_latency_s is None else max_latency_s
     if not 0 < limit < 0.5 * period:
@@ -199,9 +201,11 @@ def plot_board_latency(out_dir: Path, latency: BoardLatency, path: Path) -> Path
     """A PNG for people: the encoder's angle over the recording, with every passage of the sphere
     moved back by the latency (each should sit on the swing, at the photodiode's angle), and each
     passage's residual."""
+    from matplotlib.figure import Figure  # imported here so that importing rig.devices stays light
+
     encoder = load_table(out_dir, "encoder.csv")
     passages = load_table(out_dir, "passages.csv")
-    trajectory = _trajectory(encoder["board_time_s"], encoder["count"], encoder["step"])
+    trajectory = encoder_trajectory(encoder["board_time_s"], encoder["count"], encoder["step"])
     shown = passages["board_time_s"] - latency.latency_s
     speed = trajectory.velocity(shown)
     residual = (trajectory.angle(shown) - latency.photodiode_counts) / np.where(speed == 0, np.inf, np.abs(speed))

@@ -8,7 +8,11 @@ import pytest
 import analysis
 from rig.cli import main
 from rig.session import SimulationConfig, simulate
+from rig.sim.board import SimulatedBoardConfig
+from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
+from rig.sim.pendulum import PendulumConfig
+from rig.sim.tracker import TrackerConfig
 
 TOLERANCE_MS = 1.0
 
@@ -46,3 +50,26 @@ def test_demo_command_agrees_with_truth(tmp_path: Path, capsys: pytest.CaptureFi
     assert report["agrees"]
     assert abs(report["difference_ms"]) <= TOLERANCE_MS
     assert (tmp_path / "demo.png").stat().st_size > 10_000
+
+
+def test_a_board_recording_fixes_a_latency_beyond_half_a_period(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The lab procedure: the board blinks its code while the pendulum is held, then it is released.
+    440 ms on a 0.6 s pendulum: -160 ms fits the phase as well, and a narrow swing has too little
+    chirp to tell them apart; the encoder's start of swing, on the video's clock, does."""
+    config = SimulationConfig(
+        duration_s=7.0,
+        pendulum=PendulumConfig(period_s=0.6, amplitude_deg=8.0, quality=500.0, release_s=2.5),
+        tracker=TrackerConfig(transport_delay_s=0.4),
+        camera=CameraConfig(fps=120.0),
+        board=SimulatedBoardConfig(board_offset_s=37.5, blink_start_s=0.2, blink_bits=32),
+        warmup_s=0.9,
+    )
+    run = simulate(config, tmp_path)
+    argv = ["analyse", str(run.video_path), "--board", str(tmp_path / "board"), "--latency-range=-200,1000", "--json"]
+    assert main(argv) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert not report["ambiguous"] and "board encoder start" in report["cycles"]["how"]
+    assert report["latency_ms"] == pytest.approx(run.truth["latency_ms"], abs=TOLERANCE_MS)
+    low, high = report["board"]["offset_interval_s"]
+    assert low <= 37.5 <= high
+    assert report["cycles"]["events_ms"]["board encoder start"] == pytest.approx(run.truth["latency_ms"], abs=20.0)

@@ -16,10 +16,11 @@ import pytest
 import serial
 
 from rig.commands.board import add_parser
-from rig.devices import BoardIdentity, BoardRecorder, LedChange, LinkChange, Microcontroller
+from rig.devices import BlinkSchedule, BoardIdentity, BoardRecorder, LedChange, LinkChange, Microcontroller
 from rig.devices.framing import FrameDecoder, encode_frame
 from rig.devices.protocol import protocol
 from rig.devices.recording import load_table
+from rig.errors import RigError
 
 RISE, FALL = 512, 256
 # Board seconds to record: the emulator keeps to the wall clock unless the machine is too busy,
@@ -164,13 +165,27 @@ def test_raw_link_counts_and_skips_bad_frames(board) -> None:
     assert replies[3]["rx_frames"] - replies[9]["rx_frames"] == 3
 
 
-def test_record_command_writes_a_recording(board, tmp_path: Path) -> None:
+def test_record_command_writes_a_recording_after_the_blink_code(board, tmp_path: Path) -> None:
     out = tmp_path / "run"
-    assert run_cli("board", "record", f"--port={board.url}", f"--out={out}", "--duration=1.5", f"--rise={RISE}", f"--fall={FALL}") == 0
+    options = [f"--port={board.url}", f"--out={out}", "--duration=1.5", f"--rise={RISE}", f"--fall={FALL}"]
+    assert run_cli("board", "record", *options, "--blink", "--bits=12", "--bit-ms=20", "--level=200") == 0
     metadata = json.loads((out / "recording.json").read_text())
     assert metadata["identity"]["name"] == "rig-avr" and metadata["options"]["rise"] == RISE
     assert metadata["events"]["encoder.csv"] == load_table(out, "encoder.csv")["count"].size > 0
     assert metadata["events"]["sync.csv"] >= 2 and metadata["link"]["corrupt"] == 0
+    schedule = json.loads((out / "blink.json").read_text())
+    led = load_table(out, "led.csv")
+    code = BlinkSchedule(schedule["start_board_time"], 0.02, schedule["seed"], 12, 200).code()
+    played = led["bit"][np.isfinite(led["bit"])].astype(int)
+    assert np.all(code[played] == (led["level"][np.isfinite(led["bit"])] > 0))
+    # After the code the LED is left lit, by a command.
+    assert np.isnan(led["bit"][-1]) and led["level"][-1] == 200
+
+
+def test_record_refuses_a_duration_shorter_than_its_blink(tmp_path: Path) -> None:
+    with pytest.raises(RigError, match="shorter than the blink"):
+        run_cli("board", "record", "--port=loop://", f"--out={tmp_path / 'run'}", "--duration=1", "--blink")
+    assert not (tmp_path / "run").exists()
 
 
 def test_encoder_stream_matches_scripted_pendulum(recording: Path, world) -> None:
