@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 
 from analysis.cycles import DEFAULT_LATENCY_RANGE_S, CycleResolution, resolve_cycles, unwrap_near
@@ -113,15 +114,15 @@ def _swings(crops: Sequence[np.ndarray]) -> bool:
     half that frame's peak. A blinking LED, or a sphere jittering with the tracker's noise, stays
     within its size; a swinging one does not.
     """
-    stack = np.stack(crops).astype(np.float32)
+    stack = np.stack(crops)
     lifted = stack - stack.min(axis=0)
-    peaks = lifted.max(axis=(1, 2))
+    peaks = lifted.max(axis=(1, 2)).astype(np.float64)
     places, sizes = [], []
     for image, peak in zip(lifted, peaks):
         if peak > 0 and peak >= 0.5 * peaks.max():
-            rows, columns = np.nonzero(image >= 0.5 * peak)
-            places.append((columns.mean(), rows.mean()))
-            sizes.append(math.sqrt(rows.size))
+            moments = cv2.moments((image >= 0.5 * peak).view(np.uint8), binaryImage=True)
+            places.append((moments["m10"] / moments["m00"], moments["m01"] / moments["m00"]))
+            sizes.append(math.sqrt(moments["m00"]))
     if len(places) < 2:
         return False
     travel = float(np.max(np.ptp(np.array(places), axis=0)))
@@ -132,7 +133,7 @@ def _shows_motion(images: Sequence[np.ndarray], given: tuple[Roi, Roi] | None) -
     """Whether both blobs swing in these frames: in the given ROIs, or in the two largest moving
     regions (those ``_auto_models`` takes)."""
     samples = images[:: max(1, len(images) // SWING_SAMPLES)]
-    regions = list(given) if given is not None else find_moving_regions(images)[:2]
+    regions = list(given) if given is not None else find_moving_regions(samples)[:2]
     return len(regions) == 2 and all(_swings([region.crop(image) for image in samples]) for region in regions)
 
 

@@ -5,7 +5,8 @@ cameras 60 to 480 fps, displays 60 to 144 Hz, swings of 5 to 45 degrees, quality
 latencies from a predicting renderer's few ms to 450 ms (beyond half the period of a 0.6 s
 pendulum, where -150 ms is as plausible), and impairments: sensor noise, defocus blur, a dim sphere, the sphere missing from 5 %
 of frames. The values are spread over the cases by seeded shuffles, so every value of every axis
-occurs and combinations vary; a few named cases add the hard ones.
+occurs and combinations vary; a few named cases add the hard ones (one, the unresolvable swing
+filmed from its release, which the start of swing resolves).
 
 Every case is analysed with every method. Errors are against the simulation's true latency, in
 ms and in camera frame intervals; coverage is the fraction of cases whose 95 % interval holds the
@@ -82,7 +83,15 @@ class Case:
 
 
 def _config(
-    period: float, fps: float, display: float, amplitude: float, quality: float, target_ms: float, impairment: str, seed: int
+    period: float,
+    fps: float,
+    display: float,
+    amplitude: float,
+    quality: float,
+    target_ms: float,
+    impairment: str,
+    seed: int,
+    release_s: float | None = None,
 ) -> SimulationConfig:
     predictor = "slerp" if target_ms == 0.0 else "hold"
     transport = 0.004 if target_ms == 0.0 else max(0.0, target_ms - HOLD_BASE_MS) / 1e3
@@ -95,7 +104,7 @@ def _config(
     return SimulationConfig(
         duration_s=max(6.0, 4.0 * period),
         seed=seed,
-        pendulum=PendulumConfig(period_s=period, amplitude_deg=amplitude, quality=quality),
+        pendulum=PendulumConfig(period_s=period, amplitude_deg=amplitude, quality=quality, release_s=release_s),
         tracker=TrackerConfig(transport_delay_s=transport),
         display=DisplayConfig(refresh_hz=display),
         camera=camera,
@@ -104,13 +113,26 @@ def _config(
     )
 
 
-def _case(index: int, period: float, fps: float, display: float, amplitude: float, quality: float, target: float, impairment: str, label: str = "") -> Case:
+def _case(
+    index: int,
+    period: float,
+    fps: float,
+    display: float,
+    amplitude: float,
+    quality: float,
+    target: float,
+    impairment: str,
+    label: str = "",
+    release_s: float | None = None,
+) -> Case:
     name = label or f"case{index:02d}"
+    released = f" released at {release_s:g}s" if release_s is not None else ""
     description = (
         f"{name}: T={period:g}s {fps:g}fps {display:g}Hz {amplitude:g}deg Q={quality:g} "
-        f"target {target:g}ms {impairment}"
+        f"target {target:g}ms {impairment}{released}"
     )
-    return Case(description, _config(period, fps, display, amplitude, quality, target, impairment, index), target, impairment)
+    config = _config(period, fps, display, amplitude, quality, target, impairment, index, release_s)
+    return Case(description, config, target, impairment)
 
 
 def grid(count: int = DEFAULT_CASES, seed: int = 0) -> list[Case]:
@@ -128,6 +150,7 @@ def grid(count: int = DEFAULT_CASES, seed: int = 0) -> list[Case]:
         (0.6, 120.0, 144.0, 45.0, 50.0, 450.0, "none", "beyond-half-wide"),
         (0.6, 240.0, 60.0, 5.0, 500.0, 450.0, "none", "beyond-half-unresolvable"),
         (1.0, 240.0, 60.0, 20.0, 200.0, 480.0, "none", "near-half-period"),
+        (0.6, 240.0, 60.0, 5.0, 500.0, 450.0, "none", "beyond-half-filmed-release", 1.0),
     ]
     return cases + [_case(count + i, *values) for i, values in enumerate(named)]
 

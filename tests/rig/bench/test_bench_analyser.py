@@ -52,5 +52,6 @@ def test_grid_covers_every_axis_value_and_the_hard_cases() -> None:
     assert {case.impairment for case in cases[:24]} == set(analyser.IMPAIRMENTS)
     beyond_half = [case for case in cases if case.target_ms > case.config.pendulum.period_s * 500]
     assert beyond_half
+    assert any(case.config.pendulum.release_s is not None for case in beyond_half)
     assert all(c.camera.fps * c.camera.subsamples >= analyser.SUBSAMPLE_RATE for c in configs)
     assert analyser.grid(24) == cases
