@@ -42,7 +42,8 @@ CALIBRATION_SECONDS = 1.5
 CALIBRATION_MIN_FRAMES = 120
 CALIBRATION_FRAMES_UNKNOWN_RATE = 360
 # A clip that starts with the pendulum at rest (a lab films, then releases it) is held further,
-# until its last that many frames show both blobs move, but never more than this many bytes of it.
+# until both blobs swing from the start of the frames calibrated on (see _calibration_window), but
+# never more than this many bytes of it.
 CALIBRATION_MAX_BYTES = 1024 * 2**20
 # A track must have a blob in at least this fraction of frames; any frame without one is reported.
 MIN_VALID = 0.5
