@@ -19,6 +19,7 @@ cut off: that frame's position is not valid (``clipped``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -206,11 +207,10 @@ def _blob_reach(diffs: np.ndarray, threshold: float, min_peak: float) -> float:
     above-threshold piece that holds the brightest pixel, 90th percentile over frames with a blob."""
     reaches = []
     for diff in diffs:
-        _, peak, _, (px, py) = cv2.minMaxLoc(diff)
+        _, peak, _, top = cv2.minMaxLoc(diff)
         if peak < min_peak:
             continue
-        _, labels, stats, _ = cv2.connectedComponentsWithStats((diff > threshold).view(np.uint8), connectivity=8)
-        _, _, w, h, _ = stats[labels[py, px]]
+        _, _, _, (_, _, w, h) = cv2.floodFill((diff > threshold).view(np.uint8), None, top, 2, flags=8)
         reaches.append(max(w, h) / 2 + 1)
     return float(np.percentile(reaches, 90)) if reaches else float(max(diffs.shape[1:]))
 
@@ -250,10 +250,28 @@ def calibrate_blob(roi: Roi, frames: Sequence[np.ndarray], name: str) -> BlobMod
 
 
 class BlobTracker:
-    """Follows one blob from frame to frame in a window around where it is expected."""
+    """Follows one blob from frame to frame in a window around where it is expected.
+
+    It runs for every frame on the thread that reads the video, alongside the decoding, so its
+    per-frame work is a handful of small array operations on the window: the model's numbers are
+    held as plain attributes, and differences are taken against a signed copy of the background
+    (int16 for 8-bit frames: exact, and the core test becomes an integer comparison; float32
+    otherwise, as OpenCV would compute them).
+    """
 
     def __init__(self, model: BlobModel) -> None:
         self.model = model
+        roi = model.roi
+        self._rows = slice(roi.y, roi.y + roi.height)
+        self._cols = slice(roi.x, roi.x + roi.width)
+        integer = model.background.dtype == np.uint8
+        self._background = model.background.astype(np.int16 if integer else np.float32)
+        # An integer difference exceeds the threshold exactly when it exceeds its floor.
+        self._core_level = math.floor(model.threshold) if integer else float(model.threshold)
+        self._strong_level = 2 * model.threshold
+        self._min_peak = model.min_peak
+        self._reach = model.reach
+        self._spread = 2 * model.reach + 2
         self._grow = max(2, round(SUPPORT_GROWTH * model.reach))
         self._kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (2 * self._grow + 1, 2 * self._grow + 1))
         self._position: tuple[float, float] | None = None
@@ -261,20 +279,19 @@ class BlobTracker:
 
     def locate(self, frame: np.ndarray) -> Detection:
         """The blob in one frame (frame pixel coordinates)."""
-        model = self.model
-        crop = model.roi.crop(frame)
+        crop = frame[self._rows, self._cols]
+        position = self._position
         found = None
-        if self._position is not None:
-            centre = (self._position[0] + self._step[0], self._position[1] + self._step[1])
-            half = model.reach + max(abs(self._step[0]), abs(self._step[1])) + WINDOW_MARGIN_PX
-            found = self._measure(crop, centre, half)
+        if position is not None:
+            step_x, step_y = self._step
+            centre = (position[0] + step_x, position[1] + step_y)
+            found = self._measure(crop, centre, self._reach + max(abs(step_x), abs(step_y)) + WINDOW_MARGIN_PX)
         if found is None:
-            diff = cv2.subtract(crop, model.background)
-            _, peak, _, (px, py) = cv2.minMaxLoc(diff)
-            if peak < model.min_peak:
+            _, peak, _, (px, py) = cv2.minMaxLoc(cv2.subtract(crop, self.model.background))
+            if peak < self._min_peak:
                 self._position = None
                 return Detection(np.nan, np.nan, peak, False, False)
-            found = self._measure(crop, (float(px), float(py)), model.reach + WINDOW_MARGIN_PX)
+            found = self._measure(crop, (float(px), float(py)), self._reach + WINDOW_MARGIN_PX)
         if found is None:
             self._position = None
             return Detection(np.nan, np.nan, 0.0, False, False)
@@ -282,18 +299,15 @@ class BlobTracker:
         if clipped:
             self._position = None
             return Detection(np.nan, np.nan, peak, False, True)
-        if self._position is not None:
-            self._step = (x - self._position[0], y - self._position[1])
-        else:
-            self._step = (0.0, 0.0)
+        self._step = (x - position[0], y - position[1]) if position is not None else (0.0, 0.0)
         self._position = (x, y)
-        return Detection(model.roi.x + x, model.roi.y + y, peak, True, False)
+        return Detection(self._cols.start + x, self._rows.start + y, peak, True, False)
 
     def _measure(
         self, crop: np.ndarray, centre: tuple[float, float], half: float
     ) -> tuple[float, float, float, bool] | None:
         """(x, y, peak, clipped) in ROI coordinates of the blob near ``centre``, or None if none there."""
-        model = self.model
+        background = self._background
         height, width = crop.shape
         grow = self._grow
         cx, cy = centre
@@ -302,11 +316,11 @@ class BlobTracker:
             x1, y1 = min(width, int(cx + half) + 2), min(height, int(cy + half) + 2)
             if x1 <= x0 or y1 <= y0:
                 return None
-            diff = cv2.subtract(crop[y0:y1, x0:x1], model.background[y0:y1, x0:x1], dtype=cv2.CV_32F)
-            peak = cv2.minMaxLoc(diff)[1]
-            if peak < model.min_peak:
+            diff = crop[y0:y1, x0:x1] - background[y0:y1, x0:x1]
+            _, peak, _, top = cv2.minMaxLoc(diff)
+            if peak < self._min_peak:
                 return None
-            mask, (bx, by, bw, bh) = self._blob_mask(diff)
+            mask, (bx, by, bw, bh) = self._blob_mask(diff, top)
             sx0, sy0, sx1, sy1 = bx - grow, by - grow, bx + bw + grow, by + bh + grow
             cut = (sx0 < 0 < x0) or (sy0 < 0 < y0) or (sx1 > x1 - x0 and x1 < width) or (sy1 > y1 - y0 and y1 < height)
             if not cut:
@@ -314,30 +328,40 @@ class BlobTracker:
                 sx0, sy0, sx1, sy1 = max(sx0, 0), max(sy0, 0), min(sx1, x1 - x0), min(sy1, y1 - y0)
                 weights = diff[sy0:sy1, sx0:sx1]
                 if mask is not None:
-                    weights = np.where(cv2.dilate(mask[sy0:sy1, sx0:sx1], self._kernel) > 0, weights, 0.0)
+                    weights = np.where(cv2.dilate(mask[sy0:sy1, sx0:sx1], self._kernel) > 0, weights, 0)
                 moments = cv2.moments(weights)
                 mass = moments["m00"]
+                if mass <= 0:
+                    # signed weights: a blob barely above the threshold can sum to nothing with its noise
+                    return None
                 return x0 + sx0 + moments["m10"] / mass, y0 + sy0 + moments["m01"] / mass, peak, clipped
             cx, cy = x0 + bx + bw / 2, y0 + by + bh / 2
             half *= 2
         return self._measure(crop, (width / 2, height / 2), max(width, height))
 
-    def _blob_mask(self, diff: np.ndarray) -> tuple[np.ndarray | None, tuple[int, int, int, int]]:
-        """(mask, bounding box) of the blob's core in a window: the pixels above the threshold in
-        connected pieces that reach twice the threshold somewhere (so a stray noise pixel is not
-        part of the blob, while the fainter image of a double exposure is). Pieces are only looked
-        for when the pixels spread wider than the blob's calibrated reach or touch the window's
-        edge; the mask is None when the whole box around the core is the blob's."""
-        threshold = self.model.threshold
-        mask = cv2.compare(diff, threshold, cv2.CMP_GT)
+    def _blob_mask(
+        self, diff: np.ndarray, top: tuple[int, int]
+    ) -> tuple[np.ndarray | None, tuple[int, int, int, int]]:
+        """(mask, bounding box) of the blob's core in a window whose brightest pixel is ``top``: the
+        pixels above the threshold in connected (8-neighbour) pieces that reach twice the threshold
+        somewhere (so a stray noise pixel is not part of the blob, while the fainter image of a
+        double exposure is). Pieces are only looked for when the pixels spread wider than the
+        blob's calibrated reach or touch the window's edge; the mask is None when the whole box
+        around the core is the blob's. The pieces are flood-filled from their strong pixels, the
+        brightest first (OpenCV's connected components would wake its thread pool for every
+        frame, which then spins on the cores the decoding threads need)."""
+        mask = (diff > self._core_level).view(np.uint8)
         box = cv2.boundingRect(mask)
         x, y, w, h = box
-        inside = x > 0 and y > 0 and x + w < diff.shape[1] and y + h < diff.shape[0]
-        if inside and max(w, h) <= 2 * self.model.reach + 2:
+        rows, cols = diff.shape
+        if x > 0 and y > 0 and x + w < cols and y + h < rows and max(w, h) <= self._spread:
             return None, box
-        count, labels, _, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
-        if count <= 2:
+        filled = mask.copy()
+        if cv2.floodFill(filled, None, top, 2, flags=8)[0] == cv2.countNonZero(mask):
             return None, box
-        strong = [k for k in range(1, count) if cv2.minMaxLoc(diff, (labels == k).view(np.uint8))[1] >= 2 * threshold]
-        kept = np.isin(labels, strong).view(np.uint8)
+        for index in np.flatnonzero((diff >= self._strong_level) & (filled == 1)):
+            seed_y, seed_x = divmod(int(index), cols)
+            if filled[seed_y, seed_x] == 1:
+                cv2.floodFill(filled, None, (seed_x, seed_y), 2, flags=8)
+        kept = (filled == 2).view(np.uint8)
         return kept, cv2.boundingRect(kept)

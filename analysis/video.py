@@ -8,31 +8,35 @@ trusts is decided afterwards from all the stamps (see ``analysis.timing``).
 
 Motion-JPEG files are read as raw packets and decoded straight to grayscale with ``cv2.imdecode``:
 libjpeg then skips chroma upsampling and colour conversion, which makes decoding about 1.7x faster
-than ``VideoCapture.read`` followed by a grey conversion. Packets and image files are decoded by a
-few threads ahead of the tracker (OpenCV releases the GIL while decoding). Any other codec is read
-the ordinary way.
+than ``VideoCapture.read`` followed by a grey conversion. Packets and image files are decoded a few
+frames ahead of the tracker by a few threads, the tracker's own among them (OpenCV releases the GIL
+while decoding). Any other codec is read the ordinary way.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import re
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol, TypeVar
+from typing import Generic, Protocol, TypeVar
 
 import cv2
 import numpy as np
 
 from analysis.errors import AnalysisError
 
-# Threads decoding frames, and how many frames they may run ahead of the consumer (enough to keep
-# them busy while the consumer finds the ROIs in the first frames).
+# Threads decoding frames, the consumer's among them, and how many frames they may run ahead of the
+# consumer (enough to keep them busy while the consumer finds the ROIs in the first frames).
 DECODE_THREADS = min(4, os.cpu_count() or 1)
 READ_AHEAD = 64
+# Frames handed to a thread at a time: threads exchange work once per batch, not once per frame.
+DECODE_BATCH = 8
 IMAGE_SUFFIXES = frozenset({".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".webp"})
 # Frame rates outside this range are not believed when a container states them.
 PLAUSIBLE_FPS = (1.0, 10_000.0)
@@ -98,30 +102,56 @@ def checked_fps(fps: float | None) -> float | None:
     return value
 
 
+@dataclass
+class _Batch(Generic[_Item]):
+    """Consecutive items, the worker's task mapping them, and their results if the consumer mapped them."""
+
+    items: list[_Item]
+    task: Future[list[np.ndarray | None]]
+    results: list[np.ndarray | None] | None = None
+
+
 def _ordered_map(
     function: Callable[[_Item], np.ndarray | None], items: Iterable[_Item], describe: Callable[[int], str]
 ) -> Iterator[np.ndarray]:
-    """function(item) for each item, computed by worker threads a few items ahead, yielded in order.
+    """function(item) for each item, computed a few items ahead, yielded in order.
 
+    Items are handed to worker threads DECODE_BATCH at a time. The consumer maps items too: while
+    the batch it needs next is still being mapped, it takes the earliest batch that no worker has
+    started and maps it itself. So no core idles while the consumer works on a frame (tracking),
+    and no more threads compete for the cores than there are (an extra one would be preempted
+    while it holds the GIL, stalling the others).
     A None result is a frame that cannot be decoded: AnalysisError naming it via ``describe``.
     """
-    with ThreadPoolExecutor(max_workers=DECODE_THREADS) as pool:
-        pending: deque[Future[np.ndarray | None]] = deque()
+
+    def run(batch: list[_Item]) -> list[np.ndarray | None]:
+        return [function(item) for item in batch]
+
+    iterator = iter(items)
+    batches = iter(lambda: list(itertools.islice(iterator, DECODE_BATCH)), [])
+    pending: deque[_Batch[_Item]] = deque()
+    pool = ThreadPoolExecutor(max_workers=max(1, DECODE_THREADS - 1))
+    try:
         index = 0
-        iterator = iter(items)
-        more = True
-        while more or pending:
-            if more:
-                item = next(iterator, None)
-                more = item is not None
-                if item is not None:
-                    pending.append(pool.submit(function, item))
-            if pending and (not more or len(pending) > READ_AHEAD):
-                frame = pending.popleft().result()
+        while True:
+            while len(pending) * DECODE_BATCH < READ_AHEAD and (batch := next(batches, None)) is not None:
+                pending.append(_Batch(batch, pool.submit(run, batch)))
+            if not pending:
+                return
+            head = pending[0]
+            while head.results is None and not head.task.done():
+                unstarted = next((b for b in pending if b.results is None and b.task.cancel()), None)
+                if unstarted is None:
+                    break
+                unstarted.results = run(unstarted.items)
+            pending.popleft()
+            for frame in head.task.result() if head.results is None else head.results:
                 if frame is None:
                     raise AnalysisError(f"{describe(index)} is corrupt; re-record it or leave it out")
                 yield frame
                 index += 1
+    finally:
+        pool.shutdown(cancel_futures=True)
 
 
 class FrameArray:

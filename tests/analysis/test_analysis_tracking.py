@@ -1,12 +1,13 @@
 """Blob tracking and ROI detection against known blob positions."""
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
 from analysis.errors import AnalysisError
-from analysis.tracking import BlobTracker, Roi, calibrate_blob, find_moving_regions
+from analysis.tracking import BlobModel, BlobTracker, Roi, calibrate_blob, find_moving_regions
 
 WIDTH, HEIGHT = 64, 48
 
@@ -179,3 +180,56 @@ def test_static_clutter_is_not_a_moving_region(scene, render_video):
     clip = scene(duration_s=2.5, clutter=((60.0, 20.0, 400.0), (120.0, 100.0, 300.0)))
     regions = find_moving_regions(list(render_video(clip)[: int(1.5 * clip.fps)]))
     assert len(regions) == 2
+
+
+def test_double_image_in_two_separate_pieces_gives_the_weighted_position():
+    # Sharp images 9 px apart do not touch above the threshold: both pieces reach twice the
+    # threshold, so both count, each by its exposure.
+    xs, ys, _ = sweep(150.0)
+    sharp = frames_of([gaussian(x, y, 150.0, sigma=1.5) for x, y in zip(xs, ys, strict=True)])
+    model = calibrate_blob(FULL, sharp, "sphere")
+    images = 0.6 * gaussian(27.0, 24.0, 150.0, sigma=1.5) + 0.4 * gaussian(36.0, 24.0, 150.0, sigma=1.5)
+    double = frames_of([images], seed=4)[0]
+    x, y, _, valid = locate(model, double)
+    assert valid
+    assert x == pytest.approx(0.6 * 27.0 + 0.4 * 36.0, abs=0.1)
+    assert y == pytest.approx(24.0, abs=0.1)
+
+
+def test_faint_speck_apart_from_the_blob_is_not_part_of_it():
+    # A 2x2 speck above the threshold but never reaching twice it, 9 px from the blob: counted, it
+    # would pull the centroid by about 0.2 px.
+    _, _, frames = sweep(150.0)
+    model = calibrate_blob(FULL, frames, "sphere")
+    blob = gaussian(30.0, 24.0, 150.0)
+    speck = np.zeros_like(blob)
+    speck[23:25, 39:41] = 1.5 * model.threshold
+    alone, beside = frames_of([blob], seed=6)[0], frames_of([blob + speck], seed=6)[0]
+    x, y, _, valid = locate(model, beside)
+    assert valid
+    assert (x, y) == pytest.approx(locate(model, alone)[:2], abs=0.04)
+    assert (x, y) == pytest.approx((30.0, 24.0), abs=0.1)
+
+
+def test_8bit_frames_are_located_exactly_as_their_float_copies():
+    # 8-bit frames take an integer path (int16 differences); it must give what float arithmetic gives.
+    _, _, frames = sweep(150.0)
+    model = calibrate_blob(FULL, frames, "sphere")
+    float_model = dataclasses.replace(model, background=model.background.astype(np.float32))
+    extra = [gaussian(30.0, 24.0, 150.0) + 0.5 * gaussian(37.0, 24.0, 150.0), np.zeros((HEIGHT, WIDTH))]
+    sequence = frames + frames_of(extra, seed=8) + frames[::-1]
+    tracker, float_tracker = BlobTracker(model), BlobTracker(float_model)
+    found = [tracker.locate(frame) for frame in sequence]
+    float_found = [float_tracker.locate(frame.astype(np.float32)) for frame in sequence]
+    assert np.array_equal(np.array(found, dtype=float), np.array(float_found, dtype=float), equal_nan=True)
+
+
+def test_a_window_whose_signed_weights_sum_to_nothing_holds_no_blob():
+    """One hot pixel in a frame darker than the background everywhere else: the centroid's mass,
+    over the support around it, is negative, so there is no position to give."""
+    background = np.full((40, 40), 100, dtype=np.uint8)
+    model = BlobModel(Roi(0, 0, 40, 40), background, threshold=20.0, min_peak=60.0, typical_peak=150.0, reach=3.0)
+    frame = np.full((40, 40), 50, dtype=np.uint8)
+    frame[20, 20] = 255
+    detection = BlobTracker(model).locate(frame)
+    assert not detection.valid and math.isnan(detection.x)

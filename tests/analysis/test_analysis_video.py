@@ -1,11 +1,21 @@
 """Opening videos, image folders and frame arrays: frames, their stamps, and the errors a user can cause."""
 
+import threading
+
 import cv2
 import numpy as np
 import pytest
 
 from analysis import AnalysisError, analyse
-from analysis.video import FrameArray, ImageFolder, VideoFile, open_frames
+from analysis.video import (
+    DECODE_BATCH,
+    READ_AHEAD,
+    FrameArray,
+    ImageFolder,
+    VideoFile,
+    _ordered_map,
+    open_frames,
+)
 
 
 def moving_squares(count: int = 12, width: int = 48, height: int = 32) -> np.ndarray:
@@ -165,3 +175,44 @@ def test_image_folder_with_a_frame_of_another_size_raises(tmp_path):
     cv2.imwrite(str(tmp_path / "shots" / "frame_00004.png"), np.zeros((10, 10), dtype=np.uint8))
     with pytest.raises(AnalysisError, match="10x10"):
         list(open_frames(tmp_path / "shots", fps=30.0).frames())
+
+
+def test_corrupt_image_in_a_later_batch_is_named(tmp_path):
+    write_images(tmp_path / "shots", moving_squares(count=20), range(1, 21))
+    (tmp_path / "shots" / "frame_00013.png").write_bytes(b"not a png" * 50)
+    frames = open_frames(tmp_path / "shots", fps=30.0).frames()
+    with pytest.raises(AnalysisError, match="frame_00013.png is corrupt"):
+        list(frames)
+
+
+def test_items_come_in_order_when_the_consumer_maps_some_itself():
+    # Each side's first item waits until the other side has mapped one: the consumer must then map
+    # a batch that no worker had started, while a worker maps another.
+    mapped_by = {}
+    worker_started, consumer_started = threading.Event(), threading.Event()
+
+    def square(item: int) -> np.ndarray:
+        consumer = threading.current_thread() is threading.main_thread()
+        mine, other = (consumer_started, worker_started) if consumer else (worker_started, consumer_started)
+        mine.set()
+        assert other.wait(timeout=30), "the other side never mapped an item"
+        mapped_by[item] = consumer
+        return np.array([item * item])
+
+    count = 3 * READ_AHEAD + 5
+    results = list(_ordered_map(square, range(count), str))
+    assert [int(r[0]) for r in results] == [i * i for i in range(count)]
+    assert set(mapped_by.values()) == {True, False}
+
+
+def test_closing_the_frames_early_stops_the_decoding():
+    mapped = []
+
+    def record(item: int) -> np.ndarray:
+        mapped.append(item)
+        return np.array([item])
+
+    results = _ordered_map(record, range(100 * READ_AHEAD), str)
+    assert int(next(results)[0]) == 0
+    results.close()
+    assert len(mapped) <= READ_AHEAD + DECODE_BATCH
