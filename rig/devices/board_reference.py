@@ -62,10 +62,10 @@ class BoardReference:
     def departures(self, led_track: Track) -> dict[str, float]:
         """The encoder's departure from rest on the video's clock, by EVENT_NAME; empty when the
         recording shows none (the pendulum was already swinging when it started)."""
+        interval = float(np.median(np.diff(led_track.t)))
         self.alignment = align_blink_code(
-            led_track.t + 0.5 * _frame_interval(led_track), lit_frames(led_track), self.led_times, self.led_levels,
-            exposure_s=_frame_interval(led_track),
-        )  # fmt: skip
+            led_track.t + 0.5 * interval, lit_frames(led_track), self.led_times, self.led_levels, exposure_s=interval
+        )
         offset = self.alignment.offset_s
         # The board recorded from its first event on; the encoder rests until its first edge.
         first = min(float(self.led_times[0]), float(self.encoder.times[0]))
@@ -89,10 +89,6 @@ class BoardReference:
             "blink_transitions_used": None if alignment is None else alignment.transitions_used,
             "encoder_departure_board_s": self.departure_board_s,
         }
-
-
-def _frame_interval(track: Track) -> float:
-    return float(np.median(np.diff(track.t)))
 
 
 def lit_frames(led_track: Track) -> np.ndarray:
