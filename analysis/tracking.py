@@ -347,9 +347,9 @@ class BlobTracker:
         somewhere (so a stray noise pixel is not part of the blob, while the fainter image of a
         double exposure is). Pieces are only looked for when the pixels spread wider than the
         blob's calibrated reach or touch the window's edge; the mask is None when the whole box
-        around the core is the blob's. The pieces are flood-filled from their strong pixels, the
-        brightest first (OpenCV's connected components would wake its thread pool for every
-        frame, which then spins on the cores the decoding threads need)."""
+        around the core is the blob's. The pieces are flood-filled: the brightest pixel's first, then
+        from every strong pixel no fill has reached (OpenCV's connected components would wake its
+        thread pool for every frame, which then spins on the cores the decoding threads need)."""
         mask = (diff > self._core_level).view(np.uint8)
         box = cv2.boundingRect(mask)
         x, y, w, h = box
