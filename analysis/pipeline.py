@@ -1,7 +1,8 @@
 """The analysis chain: frames -> ROIs -> blob tracks -> frame times -> swing signals -> latency.
 
 The video is decoded once. Its first frames are held to find the ROIs and their backgrounds, then
-every frame is tracked (and its row written to the tracks CSV) as it is decoded. With all tracks in
+every frame is tracked (and its row written to the tracks CSV) as it is decoded; from then on only
+the rectangle around both ROIs is decoded (``analysis.video.Crop``). With all tracks in
 hand the frame times are decided, the swing frequency and per-period phases are measured, the
 whole number of periods in the latency is chosen (``analysis.cycles``), and the requested
 estimators run, each taking the same whole number of periods.
@@ -30,7 +31,7 @@ from analysis.result import DEFAULT_METHOD, METHODS, LatencyResult, MethodResult
 from analysis.signals import SwingSignals, swing_signals
 from analysis.timing import check_count, frame_times, implausible_period_warning, repeated_frames
 from analysis.tracking import BlobModel, BlobTracker, Detection, Roi, Track, calibrate_blob, find_moving_regions
-from analysis.video import Frame, FrameSource, VideoFile, open_frames
+from analysis.video import Crop, Frame, FrameSource, VideoFile, open_frames
 from analysis.windows import WindowPhases, damping_rate, gain_ratio, window_phases, windowed_latency
 from analysis.xcorr import xcorr_latency
 
@@ -152,6 +153,14 @@ def _calibration_window(
             break
         window.extend(more)
     return window
+
+
+def _bounds(first: Roi, second: Roi) -> tuple[slice, slice]:
+    """The rows and columns of the smallest rectangle holding both ROIs: all the tracker looks at,
+    so all that is decoded of each frame after calibration."""
+    rows = slice(min(first.y, second.y), max(first.y + first.height, second.y + second.height))
+    cols = slice(min(first.x, second.x), max(first.x + first.width, second.x + second.width))
+    return rows, cols
 
 
 class _Tracked:
@@ -399,8 +408,9 @@ def analyse(
         progress = None
     warnings: list[str] = []
     started = time.perf_counter()
+    crop = Crop()
     with contextlib.ExitStack() as stack:
-        stream = stack.enter_context(contextlib.closing(video.frames()))
+        stream = stack.enter_context(contextlib.closing(video.frames(crop)))
         rows = stack.enter_context(TrackStream(tracks_csv)) if tracks_csv is not None else None
         first = next(stream)
         rate = video.fps
@@ -417,9 +427,12 @@ def analyse(
             sphere_model = calibrate_blob(given[1], images, "sphere")
             roi_source, led_rule = "given", "given"
         del images
+        band_rows, band_cols = _bounds(led_model.roi, sphere_model.roi)
+        crop.to(band_rows, band_cols)
+        origin = (band_cols.start, band_rows.start)
         tracked = _track_frames(
-            itertools.chain(window, stream),
-            (BlobTracker(led_model), BlobTracker(sphere_model)),
+            itertools.chain(((stamp, crop.cut(image)) for stamp, image in window), stream),
+            (BlobTracker(led_model, origin), BlobTracker(sphere_model, origin)),
             video.frame_count,
             progress,
             rows,

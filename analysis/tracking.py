@@ -259,11 +259,14 @@ class BlobTracker:
     otherwise, as OpenCV would compute them).
     """
 
-    def __init__(self, model: BlobModel) -> None:
+    def __init__(self, model: BlobModel, origin: tuple[int, int] = (0, 0)) -> None:
+        """``origin`` is the (x, y) in the frame of the first pixel of the images ``locate`` will
+        get: (0, 0) for whole frames, the corner of the rectangle for cropped ones."""
         self.model = model
         roi = model.roi
-        self._rows = slice(roi.y, roi.y + roi.height)
-        self._cols = slice(roi.x, roi.x + roi.width)
+        self._rows = slice(roi.y - origin[1], roi.y - origin[1] + roi.height)
+        self._cols = slice(roi.x - origin[0], roi.x - origin[0] + roi.width)
+        self._corner = (float(roi.x), float(roi.y))
         integer = model.background.dtype == np.uint8
         self._background = model.background.astype(np.int16 if integer else np.float32)
         # An integer difference exceeds the threshold exactly when it exceeds its floor.
@@ -278,7 +281,7 @@ class BlobTracker:
         self._step = (0.0, 0.0)
 
     def locate(self, frame: np.ndarray) -> Detection:
-        """The blob in one frame (frame pixel coordinates)."""
+        """The blob in one frame, or in its rectangle from the tracker's origin (frame pixel coordinates)."""
         crop = frame[self._rows, self._cols]
         position = self._position
         found = None
@@ -301,7 +304,7 @@ class BlobTracker:
             return Detection(np.nan, np.nan, peak, False, True)
         self._step = (x - position[0], y - position[1]) if position is not None else (0.0, 0.0)
         self._position = (x, y)
-        return Detection(self._cols.start + x, self._rows.start + y, peak, True, False)
+        return Detection(self._corner[0] + x, self._corner[1] + y, peak, True, False)
 
     def _measure(
         self, crop: np.ndarray, centre: tuple[float, float], half: float

@@ -1,5 +1,6 @@
 """Opening videos, image folders and frame arrays: frames, their stamps, and the errors a user can cause."""
 
+import itertools
 import threading
 
 import cv2
@@ -10,6 +11,7 @@ from analysis import AnalysisError, analyse
 from analysis.video import (
     DECODE_BATCH,
     READ_AHEAD,
+    Crop,
     FrameArray,
     ImageFolder,
     VideoFile,
@@ -216,3 +218,45 @@ def test_closing_the_frames_early_stops_the_decoding():
     assert int(next(results)[0]) == 0
     results.close()
     assert len(mapped) <= READ_AHEAD + DECODE_BATCH
+
+
+@pytest.mark.parametrize("fourcc", ["MJPG", "FFV1"], ids=["decoded in rectangles", "read whole and cut"])
+def test_frames_after_the_crop_is_set_are_its_rectangle(tmp_path, fourcc):
+    count = READ_AHEAD + 3 * DECODE_BATCH + 5
+    frames = moving_squares(count=count, width=320, height=64)
+    video = VideoFile(write_video(tmp_path / "clip.avi", frames, fourcc))
+    whole = [frame for _, frame in video.frames()]
+    crop = Crop()
+    stream = video.frames(crop)
+    before = [frame for _, frame in itertools.islice(stream, 5)]
+    crop.to(slice(6, 20), slice(3, 300))
+    after = [frame for _, frame in stream]
+    assert [frame.shape for frame in before] == [(64, 320)] * 5
+    assert [frame.shape for frame in after] == [(14, 297)] * (count - 5)
+    assert all(np.array_equal(frame, w[6:20, 3:300]) for frame, w in zip(after, whole[5:], strict=True))
+    # Frames read ahead before the crop was set are cut from whole frames (views); later MJPEG
+    # frames are decoded as rectangles (their own pixels).
+    assert not after[0].flags.owndata
+    assert after[-1].flags.owndata == (fourcc == "MJPG")
+
+
+def test_an_array_of_frames_is_cut_once_the_crop_is_set():
+    frames = moving_squares(count=6)
+    crop = Crop()
+    stream = FrameArray(frames, 30.0).frames(crop)
+    assert next(stream)[1].shape == (32, 48)
+    crop.to(slice(4, 20), slice(10, 30))
+    assert all(np.array_equal(frame, whole[4:20, 10:30]) for (_, frame), whole in zip(stream, frames[1:], strict=True))
+
+
+def test_analysing_a_file_in_rectangles_gives_the_tracks_of_its_whole_frames(tmp_path, scene, render_video, mjpg_file):
+    clip = scene(duration_s=3.2, period_s=0.8)
+    path = mjpg_file(tmp_path / "clip.avi", render_video(clip), clip.fps)
+    decoded = np.stack([frame for _, frame in VideoFile(path).frames()])
+    from_file, from_array = analyse(path), analyse(decoded, fps=clip.fps)
+    for name in ("led_track", "sphere_track"):
+        file_track, array_track = getattr(from_file, name), getattr(from_array, name)
+        assert np.array_equal(file_track.x, array_track.x, equal_nan=True)
+        assert np.array_equal(file_track.y, array_track.y, equal_nan=True)
+    # Frame times come from the container for one and from the index for the other: equal to rounding.
+    assert from_file.latency_ms == pytest.approx(from_array.latency_ms, abs=1e-6)
