@@ -279,6 +279,10 @@ class BlobTracker:
         self._kernel = cv2.getStructuringElement(cv2.MORPH_RECT, (2 * self._grow + 1, 2 * self._grow + 1))
         self._position: tuple[float, float] | None = None
         self._step = (0.0, 0.0)
+        # The window around the expected place reaches as far as the blob has ever moved in one
+        # frame: a display holding each pose for several refreshes shows a still sphere that then
+        # jumps, and a frame exposed across the jump holds both images, both of which count.
+        self._longest_step = 0.0
 
     def locate(self, frame: np.ndarray) -> Detection:
         """The blob in one frame, or in its rectangle from the tracker's origin (frame pixel coordinates)."""
@@ -288,7 +292,7 @@ class BlobTracker:
         if position is not None:
             step_x, step_y = self._step
             centre = (position[0] + step_x, position[1] + step_y)
-            found = self._measure(crop, centre, self._reach + max(abs(step_x), abs(step_y)) + WINDOW_MARGIN_PX)
+            found = self._measure(crop, centre, self._reach + max(abs(step_x), abs(step_y), self._longest_step) + WINDOW_MARGIN_PX)
         if found is None:
             _, peak, _, (px, py) = cv2.minMaxLoc(cv2.subtract(crop, self.model.background))
             if peak < self._min_peak:
@@ -303,6 +307,7 @@ class BlobTracker:
             self._position = None
             return Detection(np.nan, np.nan, peak, False, True)
         self._step = (x - position[0], y - position[1]) if position is not None else (0.0, 0.0)
+        self._longest_step = max(self._longest_step, abs(self._step[0]), abs(self._step[1]))
         self._position = (x, y)
         return Detection(self._corner[0] + x, self._corner[1] + y, peak, True, False)
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from analysis.errors import AnalysisError
-from analysis.tracking import BlobModel, BlobTracker, Roi, calibrate_blob, find_moving_regions
+from analysis.tracking import WINDOW_MARGIN_PX, BlobModel, BlobTracker, Roi, calibrate_blob, find_moving_regions
 
 WIDTH, HEIGHT = 64, 48
 
@@ -245,3 +245,20 @@ def test_a_tracker_given_cropped_frames_finds_what_it_finds_in_whole_frames():
     found_cropped = [cropped.locate(frame[3:47, 7:62]) for frame in frames]
     assert sum(d.valid for d in found) > len(frames) // 2
     assert np.array_equal(np.array(found, dtype=float), np.array(found_cropped, dtype=float), equal_nan=True)
+
+
+def test_a_sphere_that_jumps_between_held_frames_keeps_both_images_of_the_jump():
+    """A display holding each pose for several refreshes shows the sphere still, then jumps it
+    farther than the tracker's window around a still blob. In a frame exposed across the jump the
+    camera sees both images, and the centroid must weight both (linear in the switch time); missing
+    the new one delays every switch, which read as a millisecond of latency on the simulated rig."""
+    _, _, calibration = sweep(150.0)
+    model = calibrate_blob(FULL, calibration, "sphere")
+    old, new = 28.0, 44.0
+    held = [gaussian(12.0, 24.0, 150.0)] * 4 + [gaussian(old, 24.0, 150.0)] * 4
+    straddling = 0.6 * gaussian(old, 24.0, 150.0) + 0.4 * gaussian(new, 24.0, 150.0)
+    assert new - old > model.reach + WINDOW_MARGIN_PX
+    tracker = BlobTracker(model)
+    found = [tracker.locate(frame) for frame in frames_of([*held, straddling], seed=9)]
+    assert all(d.valid for d in found)
+    assert found[-1].x == pytest.approx(0.6 * old + 0.4 * new, abs=0.15)
