@@ -2,7 +2,9 @@
 
 The video is decoded once. Its first frames are held to find the ROIs and their backgrounds, then
 every frame is tracked (and its row written to the tracks CSV) as it is decoded; from then on only
-the rectangle around both ROIs is decoded (``analysis.video.Crop``). With all tracks in
+the rectangle around both ROIs is decoded (``analysis.video.Crop``). A video that can skip frames
+and decode rectangles cheaply (Motion-JPEG) is instead calibrated on a sample of its first frames
+and then read again from the start, every frame's rectangle alone. With all tracks in
 hand the frame times are decided, the swing frequency and per-period phases are measured, the
 whole number of periods in the latency is chosen (``analysis.cycles``), and the requested
 estimators run, each taking the same whole number of periods.
@@ -42,6 +44,10 @@ CALIBRATION_SECONDS = 1.5
 # frame rate is not yet known...
 CALIBRATION_MIN_FRAMES = 120
 CALIBRATION_FRAMES_UNKNOWN_RATE = 360
+# ...but where frames left out cost nothing and a crop is decoded alone (Motion-JPEG), every n-th
+# frame of those, about this many, is decoded whole and calibrated on, and the video is then read
+# again from the start, only the ROIs' rectangle decoded for tracking...
+CALIBRATION_SAMPLED_FRAMES = 120
 # A clip that starts with the pendulum at rest (a lab films, then releases it) is held further,
 # until both blobs swing from the start of the frames calibrated on (see _calibration_window), but
 # never more than this many bytes of it.
@@ -409,14 +415,16 @@ def analyse(
     warnings: list[str] = []
     started = time.perf_counter()
     crop = Crop()
+    rate = video.fps
+    wanted = (
+        max(CALIBRATION_MIN_FRAMES, round(CALIBRATION_SECONDS * rate)) if rate is not None else CALIBRATION_FRAMES_UNKNOWN_RATE
+    )
+    every = max(1, wanted // CALIBRATION_SAMPLED_FRAMES) if video.decodes_in_part else 1
+    wanted = math.ceil(wanted / every)
     with contextlib.ExitStack() as stack:
-        stream = stack.enter_context(contextlib.closing(video.frames(crop)))
+        stream = stack.enter_context(contextlib.closing(video.frames(crop, every)))
         rows = stack.enter_context(TrackStream(tracks_csv)) if tracks_csv is not None else None
         first = next(stream)
-        rate = video.fps
-        wanted = (
-            max(CALIBRATION_MIN_FRAMES, round(CALIBRATION_SECONDS * rate)) if rate is not None else CALIBRATION_FRAMES_UNKNOWN_RATE
-        )
         window = _calibration_window(first, stream, wanted, CALIBRATION_MAX_BYTES // first[1].nbytes, given)
         images = [image for _, image in window[-wanted:]]
         if given is None:
@@ -428,6 +436,10 @@ def analyse(
             roi_source, led_rule = "given", "given"
         del images
         band_rows, band_cols = _bounds(led_model.roi, sphere_model.roi)
+        if every > 1:
+            stream.close()
+            window = []
+            stream = stack.enter_context(contextlib.closing(video.frames(crop)))
         crop.to(band_rows, band_cols)
         origin = (band_cols.start, band_rows.start)
         tracked = _track_frames(

@@ -84,8 +84,16 @@ class FrameSource(Protocol):
         """Where the frames' stamps come from, for messages."""
         ...
 
-    def frames(self, crop: Crop | None = None) -> Iterator[Frame]:
-        """Stamped grey frames in order; once ``crop`` is set, only its rectangle of each."""
+    @property
+    def decodes_in_part(self) -> bool:
+        """Whether frames left out (``every``) cost nothing to skip and a crop's rectangle is decoded
+        alone, so that reading a sample of frames, then the video again in rectangles, is cheaper
+        than decoding the frames whole."""
+        ...
+
+    def frames(self, crop: Crop | None = None, every: int = 1) -> Iterator[Frame]:
+        """Stamped grey frames in order, or every ``every``-th of them from the first; once ``crop``
+        is set, only its rectangle of each."""
         ...
 
 
@@ -119,6 +127,12 @@ def _cut(frames: Generator[Frame, None, None], crop: Crop | None) -> Iterator[Fr
     with contextlib.closing(frames):
         for stamp, frame in frames:
             yield stamp, frame if crop is None else crop.cut(frame)
+
+
+def _checked_every(every: int) -> int:
+    if every < 1:
+        raise ValueError(f"every must be a positive number of frames, not {every}")
+    return every
 
 
 def _decode_jpeg(packet: np.ndarray, crop: Crop | None) -> np.ndarray | None:
@@ -250,13 +264,17 @@ class FrameArray:
     def stamp_origin(self) -> str:
         return "array index"
 
-    def frames(self, crop: Crop | None = None) -> Iterator[Frame]:
-        return _cut(self._grey_frames(), crop)
+    @property
+    def decodes_in_part(self) -> bool:
+        return False
 
-    def _grey_frames(self) -> Generator[Frame, None, None]:
+    def frames(self, crop: Crop | None = None, every: int = 1) -> Iterator[Frame]:
+        return _cut(self._grey_frames(_checked_every(every)), crop)
+
+    def _grey_frames(self, every: int) -> Generator[Frame, None, None]:
         dtype = np.uint8 if self._frames.dtype == np.uint8 else np.float32
-        for index, frame in enumerate(self._frames):
-            grey = frame.astype(dtype, copy=False)
+        for index in range(0, len(self._frames), every):
+            grey = self._frames[index].astype(dtype, copy=False)
             yield index / self._fps, cv2.cvtColor(grey, cv2.COLOR_BGR2GRAY) if grey.ndim == 3 else grey
 
 
@@ -325,16 +343,21 @@ class ImageFolder:
     def stamp_origin(self) -> str:
         return "image number"
 
-    def frames(self, crop: Crop | None = None) -> Iterator[Frame]:
-        return _cut(self._grey_frames(), crop)
+    @property
+    def decodes_in_part(self) -> bool:
+        return False
 
-    def _grey_frames(self) -> Generator[Frame, None, None]:
+    def frames(self, crop: Crop | None = None, every: int = 1) -> Iterator[Frame]:
+        return _cut(self._grey_frames(_checked_every(every)), crop)
+
+    def _grey_frames(self, every: int) -> Generator[Frame, None, None]:
+        paths = self._paths[::every]
         decoded = _ordered_map(
             lambda path: cv2.imread(str(path), cv2.IMREAD_GRAYSCALE),
-            self._paths,
-            lambda index: f"image {self._paths[index]}",
+            paths,
+            lambda index: f"image {paths[index]}",
         )
-        for number, frame in zip(self._numbers, decoded, strict=False):
+        for number, frame in zip(self._numbers[::every], decoded, strict=False):
             if (frame.shape[1], frame.shape[0]) != self._frame_size:
                 raise AnalysisError(
                     f"image number {number} in {self._folder} is {frame.shape[1]}x{frame.shape[0]}, not "
@@ -410,25 +433,34 @@ class VideoFile:
         grey = cv2.imdecode(packet.reshape(-1), cv2.IMREAD_GRAYSCALE)
         return grey is not None and (grey.shape[1], grey.shape[0]) == self._frame_size
 
-    def frames(self, crop: Crop | None = None) -> Iterator[Frame]:
-        return _cut(self._grey_frames(crop), crop)
+    @property
+    def decodes_in_part(self) -> bool:
+        """True for Motion-JPEG: a packet left out is never decoded, and a crop is decoded alone."""
+        return self._raw_jpeg
 
-    def _grey_frames(self, crop: Crop | None) -> Generator[Frame, None, None]:
+    def frames(self, crop: Crop | None = None, every: int = 1) -> Iterator[Frame]:
+        return _cut(self._grey_frames(crop, _checked_every(every)), crop)
+
+    def _grey_frames(self, crop: Crop | None, every: int) -> Generator[Frame, None, None]:
         capture = cv2.VideoCapture(str(self._path))
         try:
             if self._raw_jpeg and capture.set(cv2.CAP_PROP_FORMAT, -1):
                 stamps: deque[float] = deque()
-                packets = self._packets(capture, stamps)
+                packets = self._packets(capture, stamps, every)
                 decoded = _ordered_map(
                     lambda packet: _decode_jpeg(packet, crop),
                     packets,
-                    lambda index: f"frame {index} of {self._path}",
+                    lambda index: f"frame {index * every} of {self._path}",
                 )
                 for frame in decoded:
                     yield stamps.popleft(), frame
                 return
-            while True:
-                ok, frame = capture.read()
+            for index in itertools.count():
+                if not capture.grab():
+                    return
+                if index % every:
+                    continue
+                ok, frame = capture.retrieve()
                 if not ok:
                     return
                 stamp = capture.get(cv2.CAP_PROP_POS_MSEC) / 1e3
@@ -437,9 +469,14 @@ class VideoFile:
             capture.release()
 
     @staticmethod
-    def _packets(capture: cv2.VideoCapture, stamps: deque[float]) -> Iterator[np.ndarray]:
-        """Raw packets in order; each one's presentation time (s) is appended to ``stamps``."""
-        while True:
+    def _packets(capture: cv2.VideoCapture, stamps: deque[float], every: int) -> Iterator[np.ndarray]:
+        """Every ``every``-th raw packet in order, from the first; each one's presentation time (s)
+        is appended to ``stamps``. Packets left out are read past, not copied."""
+        for index in itertools.count():
+            if index % every:
+                if not capture.grab():
+                    return
+                continue
             ok, packet = capture.read()
             if not ok or packet is None:
                 return

@@ -249,14 +249,38 @@ def test_an_array_of_frames_is_cut_once_the_crop_is_set():
     assert all(np.array_equal(frame, whole[4:20, 10:30]) for (_, frame), whole in zip(stream, frames[1:], strict=True))
 
 
-def test_analysing_a_file_in_rectangles_gives_the_tracks_of_its_whole_frames(tmp_path, scene, render_video, mjpg_file):
+def test_a_file_calibrated_on_a_sample_of_its_frames_is_tracked_as_its_whole_frames_are(
+    tmp_path, scene, render_video, mjpg_file
+):
+    # At 240 fps a Motion-JPEG file is calibrated on every third of its first frames, then read
+    # again in rectangles; the same frames held in memory are calibrated on all of them, whole.
+    # The backgrounds then come from other frames, whose noise moves a centroid by hundredths of
+    # a pixel (measured: 0.07 px at most, 0.006 ms of latency).
     clip = scene(duration_s=3.2, period_s=0.8)
     path = mjpg_file(tmp_path / "clip.avi", render_video(clip), clip.fps)
+    assert VideoFile(path).decodes_in_part
     decoded = np.stack([frame for _, frame in VideoFile(path).frames()])
     from_file, from_array = analyse(path), analyse(decoded, fps=clip.fps)
+    assert from_file.frames == from_array.frames == len(decoded)
     for name in ("led_track", "sphere_track"):
         file_track, array_track = getattr(from_file, name), getattr(from_array, name)
-        assert np.array_equal(file_track.x, array_track.x, equal_nan=True)
-        assert np.array_equal(file_track.y, array_track.y, equal_nan=True)
-    # Frame times come from the container for one and from the index for the other: equal to rounding.
-    assert from_file.latency_ms == pytest.approx(from_array.latency_ms, abs=1e-6)
+        assert np.array_equal(file_track.valid, array_track.valid)
+        assert np.nanmax(np.abs(file_track.x - array_track.x)) < 0.15
+        assert np.nanmax(np.abs(file_track.y - array_track.y)) < 0.15
+    assert from_file.latency_ms == pytest.approx(from_array.latency_ms, abs=0.02)
+
+
+@pytest.mark.parametrize("source", ["MJPG", "FFV1", "array", "images"])
+def test_every_nth_frame_comes_with_its_own_stamp(tmp_path, source):
+    frames = moving_squares(count=14)
+    if source == "array":
+        video = FrameArray(frames, 30.0)
+    elif source == "images":
+        write_images(tmp_path / "shots", frames, range(1, 15))
+        video = ImageFolder(tmp_path / "shots", 30.0)
+    else:
+        video = VideoFile(write_video(tmp_path / "clip.avi", frames, source, fps=30.0))
+    stamps, whole = zip(*video.frames(), strict=True)
+    every_third = list(video.frames(every=3))
+    assert [stamp for stamp, _ in every_third] == list(stamps[::3])
+    assert all(np.array_equal(frame, w) for (_, frame), w in zip(every_third, whole[::3], strict=True))
