@@ -7,16 +7,18 @@ rate, an array index over the frame rate), or NaN where there is none. Which tim
 trusts is decided afterwards from all the stamps (see ``analysis.timing``).
 
 A consumer that needs only part of each frame (the tracker, once it knows its ROIs) says so with a
-``Crop``: every frame yielded after the crop is set holds only that rectangle.
+``Crop``: every frame yielded after the crop is set holds only that rectangle. One that needs only
+a sample of the frames asks for every n-th; a source whose ``decodes_in_part`` is true then skips
+the others without decoding them.
 
 Motion-JPEG files are read as raw packets and decoded straight to grayscale with ``cv2.imdecode``:
 libjpeg then skips chroma upsampling and colour conversion, which makes decoding about 1.7x faster
 than ``VideoCapture.read`` followed by a grey conversion. Once a crop is set, a packet is decoded
-only as far as the crop needs (``analysis._jpeg_region``): on the simulated rig's videos, whose ROIs
-span a quarter of the rows, that takes about 0.4 of a whole grey decode. Packets and image files
-are decoded a few frames ahead of the tracker by a few threads, the tracker's own among them
-(OpenCV and the region decoder release the GIL while decoding). Any other codec is read the
-ordinary way and cropped afterwards.
+only as far as the crop needs (``analysis._jpeg_region``): the tracking then costs less than the
+decoding it saves (``rig bench analyser`` compares the analysis with decoding whole frames alone).
+Packets and image files are decoded a few frames ahead of the tracker by a few threads, the
+tracker's own among them (OpenCV and the region decoder release the GIL while decoding). Any other
+codec is read the ordinary way and cropped afterwards.
 """
 
 from __future__ import annotations
