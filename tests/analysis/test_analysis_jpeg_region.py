@@ -60,6 +60,25 @@ def test_a_rectangle_is_the_same_pixels_as_the_whole_grey_decode(name, rectangle
     assert np.array_equal(region(data, top, left, height, width), whole[top : top + height, left : left + width])
 
 
+def without_huffman_tables(data: np.ndarray) -> np.ndarray:
+    """The JPEG with its DHT segments taken out, as many USB cameras send Motion-JPEG frames."""
+    data, kept, index = data.tobytes(), bytearray(data[:2].tobytes()), 2
+    while data[index + 1] != 0xDA:  # every segment up to the start of scan
+        length = int.from_bytes(data[index + 2 : index + 4], "big")
+        if data[index + 1] != 0xC4:
+            kept += data[index : index + 2 + length]
+        index += 2 + length
+    return np.frombuffer(bytes(kept + data[index:]), dtype=np.uint8)
+
+
+def test_a_motion_jpeg_frame_without_huffman_tables_uses_the_standard_ones():
+    data = without_huffman_tables(encoded("colour 4:2:0"))
+    assert data.size < encoded("colour 4:2:0").size
+    whole = cv2.imdecode(data, cv2.IMREAD_GRAYSCALE)
+    assert np.array_equal(whole, cv2.imdecode(encoded("colour 4:2:0"), cv2.IMREAD_GRAYSCALE))
+    assert np.array_equal(region(data, 20, 40, 60, 100), whole[20:80, 40:140])
+
+
 def test_the_whole_image_as_a_rectangle_is_the_whole_decode():
     data = encoded("colour 4:2:0")
     assert np.array_equal(region(data, 0, 0, HEIGHT, WIDTH), cv2.imdecode(data, cv2.IMREAD_GRAYSCALE))
