@@ -1,13 +1,13 @@
 """The analysis chain: frames -> ROIs -> blob tracks -> frame times -> swing signals -> latency.
 
-The video is decoded once. Its first frames are held to find the ROIs and their backgrounds, then
-every frame is tracked (and its row written to the tracks CSV) as it is decoded; from then on only
-the rectangle around both ROIs is decoded (``analysis.video.Crop``). A video that can skip frames
-and decode rectangles cheaply (Motion-JPEG) is instead calibrated on a sample of its first frames
-and then read again from the start, every frame's rectangle alone. With all tracks in
-hand the frame times are decided, the swing frequency and per-period phases are measured, the
-whole number of periods in the latency is chosen (``analysis.cycles``), and the requested
-estimators run, each taking the same whole number of periods.
+Most videos are decoded once. Their first frames are held to find the ROIs and their
+backgrounds, then every frame is tracked (and its row written to the tracks CSV) as it is decoded;
+from then on only the rectangle around both ROIs is decoded (``analysis.video.Crop``). A video
+that can skip frames and decode rectangles cheaply (Motion-JPEG) is instead calibrated on a sample
+of its first frames and then read again from the start, every frame's rectangle alone. With all
+tracks in hand the frame times are decided, the swing frequency and per-period phases are
+measured, the whole number of periods in the latency is chosen (``analysis.cycles``), and the
+requested estimators run, each taking the same whole number of periods.
 """
 
 from __future__ import annotations

@@ -292,7 +292,7 @@ class BlobTracker:
         if position is not None:
             step_x, step_y = self._step
             centre = (position[0] + step_x, position[1] + step_y)
-            found = self._measure(crop, centre, self._reach + max(abs(step_x), abs(step_y), self._longest_step) + WINDOW_MARGIN_PX)
+            found = self._measure(crop, centre, self._reach + self._longest_step + WINDOW_MARGIN_PX)
         if found is None:
             _, peak, _, (px, py) = cv2.minMaxLoc(cv2.subtract(crop, self.model.background))
             if peak < self._min_peak:
