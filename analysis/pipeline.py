@@ -262,10 +262,18 @@ def _checked_track(track: Track, name: str, warnings: list[str]) -> None:
         )
     missing = int(np.count_nonzero(~track.valid))
     if missing:
+        # Dark: nothing near the blob's brightness anywhere in the ROI (an LED switched off for a
+        # blink code, a hand in front of it), as opposed to a blob seen but not measurable.
+        dark = int(np.count_nonzero(~track.valid & ~track.clipped & (track.peak < 0.5 * np.median(track.peak[track.valid]))))
         cut = int(np.count_nonzero(track.clipped))
-        reason = f", {cut} of them cut off by the ROI's edge" if cut else ""
+        reasons = []
+        if dark:
+            reasons.append(f"{dark} dark (off or hidden)")
+        if cut:
+            reasons.append(f"{cut} cut off by the ROI's edge")
+        detail = f", of them {' and '.join(reasons)}" if reasons else ""
         warnings.append(
-            f"the {name} was missing in {missing} frames ({1 - found:.1%}){reason}; those frames were left out"
+            f"the {name} was missing in {missing} frames ({1 - found:.1%}){detail}; those frames were left out"
         )
 
 

@@ -299,9 +299,9 @@ class BlobTracker:
                 self._position = None
                 return Detection(np.nan, np.nan, peak, False, False)
             found = self._measure(crop, (float(px), float(py)), self._reach + WINDOW_MARGIN_PX)
-        if found is None:
-            self._position = None
-            return Detection(np.nan, np.nan, 0.0, False, False)
+            if found is None:
+                self._position = None
+                return Detection(np.nan, np.nan, peak, False, False)
         x, y, peak, clipped = found
         if clipped:
             self._position = None

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from analysis import AnalysisError, analyse
+from analysis.pipeline import _checked_track
 from analysis.plots import plot_tracks
+from analysis.tracking import Track
 
 # sinefit's error on these clean clips stays far below a tenth of a camera frame...
 FRAMES_TOLERANCE = 0.1
@@ -148,7 +150,8 @@ def test_missing_detections_are_left_out_and_reported(scene, render_video):
     assert result.frames_used == clip.frame_count - hidden.size
     assert not result.sphere_track.valid[hidden].any()
     assert result.warnings == [
-        f"the sphere was missing in {hidden.size} frames (5.0%); those frames were left out"
+        f"the sphere was missing in {hidden.size} frames (5.0%), of them {hidden.size} dark (off or hidden); "
+        "those frames were left out"
     ]
     assert result.diagnostics["detection_rate"]["sphere"] == pytest.approx(0.95, abs=0.005)
 
@@ -344,3 +347,21 @@ def test_wrong_frame_rate_gives_an_implausible_period_warning(scene, render_vide
     assert result.period_s == pytest.approx(6.4, rel=1e-2)
     assert any("slow motion" in w for w in result.warnings)
     assert math.isfinite(result.latency_ms)
+
+
+def test_missing_frames_are_told_apart_as_dark_or_cut_off():
+    # A blink code switches the LED off (dark); a blob at the ROI's edge is cut off; a blob seen
+    # but not measurable is neither.
+    valid = np.ones(200, dtype=bool)
+    valid[[10, 11, 12, 50, 51, 120]] = False
+    clipped = np.zeros(200, dtype=bool)
+    clipped[[50, 51]] = True
+    peak = np.full(200, 250.0)
+    peak[[10, 11, 12]] = 3.0
+    track = Track(np.arange(200) / 100, np.where(valid, 1.0, np.nan), np.where(valid, 1.0, np.nan), valid, peak, clipped)
+    warnings = []
+    _checked_track(track, "LED", warnings)
+    assert warnings == [
+        "the LED was missing in 6 frames (3.0%), of them 3 dark (off or hidden) and 2 cut off by the ROI's edge; "
+        "those frames were left out"
+    ]
