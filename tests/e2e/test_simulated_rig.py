@@ -73,3 +73,9 @@ def test_a_board_recording_fixes_a_latency_beyond_half_a_period(tmp_path: Path, 
     low, high = report["board"]["offset_interval_s"]
     assert low <= 37.5 <= high
     assert report["cycles"]["events_ms"]["board encoder start"] == pytest.approx(run.truth["latency_ms"], abs=20.0)
+    assert main(argv[:-1]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    board = next(line for line in lines if line.startswith("board: "))
+    assert f"offset {report['board']['offset_s']:.4f} s" in board
+    lag_ms = report["cycles"]["events_ms"]["board encoder start"]
+    assert board.endswith(f"the sphere left rest {lag_ms:.0f} ms after the encoder did")
