@@ -274,17 +274,23 @@ static void led_apply(uint8_t level, uint16_t bit)
 {
 	if (level == app.led_level)
 		return;
-	if (level == 0 || level == 255) {
-		TCCR0A &= ~_BV(COM0A1);
-		if (level)
-			PORTD |= _BV(BOARD_LED_BIT);
-		else
-			PORTD &= ~_BV(BOARD_LED_BIT);
-	} else {
-		OCR0A = level;
-		TCCR0A |= _BV(COM0A1);
+	rig_msg_led_t change = {0, level, bit};
+	/* The pin is set and the clock read with interrupts held off: a handler run in between would
+	 * date the change late by as long as it took (up to about 10 us). */
+	ATOMIC_BLOCK(ATOMIC_RESTORESTATE)
+	{
+		if (level == 0 || level == 255) {
+			TCCR0A &= ~_BV(COM0A1);
+			if (level)
+				PORTD |= _BV(BOARD_LED_BIT);
+			else
+				PORTD &= ~_BV(BOARD_LED_BIT);
+		} else {
+			OCR0A = level;
+			TCCR0A |= _BV(COM0A1);
+		}
+		change.tick = clock_read(NULL);
 	}
-	rig_msg_led_t change = {clock_now(NULL), level, bit};
 	app.led_level = level;
 	send_frame(RIG_MSG_LED, &change, sizeof change);
 }

@@ -269,7 +269,9 @@ def test_blink_code_is_played_on_the_led_pin_and_reported(board) -> None:
     pin = [line.split(",") for line in board.led_log.read_text().splitlines()[1:]]
     pin_times = np.array([float(t) for t, source, _ in pin if source == "pin" and float(t) > start])
     assert pin_times.size == len(changes)
-    assert np.max(np.abs(pin_times - [change.board_time for change in changes])) < 5e-6
+    # The board dates a change by reading its clock with interrupts held off since the pin changed:
+    # a few cycles and the 0.5 us tick. An interrupt in between would add about 10 us.
+    assert np.max(np.abs(pin_times - [change.board_time for change in changes])) < 2e-6
     # On the rig clock, each change happened before the host had word of it (give or take the
     # 0.15 ms the emulator may run ahead of the wall clock), and not long before: more than a few
     # milliseconds only if the emulator stood still on a busy machine after the clocks were synced.
