@@ -237,23 +237,8 @@ def _play_blink(board: Microcontroller, args: argparse.Namespace, out: Path | No
     if out is not None:
         (out / "blink.json").write_text(json.dumps(_blink_report(board, schedule), indent=2) + "\n")
     _wait(board, _blink_seconds(args), progress)
-    _wait_for_board_clock(board, schedule.start_board_time + schedule.bits * schedule.bit_s + BLINK_TAIL_S)
+    board.wait_for_board_time(schedule.start_board_time + schedule.bits * schedule.bit_s + BLINK_TAIL_S, BOARD_CLOCK_LIMIT_S)
     return schedule
-
-
-def _wait_for_board_clock(board: Microcontroller, board_time: float) -> None:
-    """Waits until the board's own clock, asked, has passed `board_time`: a board that lags the
-    wall clock (an emulator on a busy machine) would otherwise still be playing what the caller
-    believes is over."""
-    deadline = time.monotonic() + BOARD_CLOCK_LIMIT_S
-    pause = threading.Event()
-    while (now := board.status().board_time) < board_time:
-        if time.monotonic() > deadline:
-            raise RigError(
-                f"the board's clock reads {now:.3f} s, still short of {board_time:.3f} s after "
-                f"{BOARD_CLOCK_LIMIT_S:g} s more: is the board running?"
-            )
-        pause.wait(min(POLL_S, board_time - now))
 
 
 def _blink_seconds(args: argparse.Namespace) -> float:

@@ -303,6 +303,20 @@ class Microcontroller:
         fields = self._request("RIG_CMD_STATUS", expects=("RIG_MSG_STATUS",)).answer("RIG_MSG_STATUS")
         return self._status_event(fields, (fields["epoch"] << 32) | fields["tick"])
 
+    def wait_for_board_time(self, board_time: float, limit_s: float, poll_s: float = 0.02) -> None:
+        """Waits until the board's own clock, asked rather than estimated, has passed `board_time`;
+        raises RigError after `limit_s`. A board behind the wall clock (an emulator on a busy
+        machine) would otherwise still be doing what the caller believes is done."""
+        deadline = time.monotonic() + limit_s
+        pause = threading.Event()
+        while (now := self.status().board_time) < board_time:
+            if time.monotonic() > deadline:
+                raise RigError(
+                    f"the board's clock reads {now:.3f} s, still short of {board_time:.3f} s after "
+                    f"{limit_s:g} s: is the board running?"
+                )
+            pause.wait(min(poll_s, board_time - now))
+
     def sync(self, round_trips: int | None = None) -> OffsetInterval:
         """Measures the clock offset: intersects the intervals of `round_trips` round trips."""
         spec = self.spec

@@ -40,11 +40,6 @@ def run_cli(*argv: str) -> int:
     return args.func(args)
 
 
-def wait_for_board_time(link: Microcontroller, board_time: float) -> None:
-    """Waits until the board's own clock (asked, not estimated) passes board_time."""
-    wait_until(lambda: link.status().board_time > board_time, WALL_LIMIT_S, f"board time {board_time:.2f} s")
-
-
 def wait_until(condition, timeout: float, what: str) -> None:
     """Polls `condition` until it holds; fails after `timeout` seconds."""
     deadline = time.monotonic() + timeout
@@ -100,7 +95,7 @@ def recording(board, tmp_path_factory: pytest.TempPathFactory) -> Path:
             link.configure_photodiode(RISE, FALL)
             start = link.status().board_time
             link.stream(encoder=True, photodiode=True)
-            wait_for_board_time(link, start + RECORD_S)
+            link.wait_for_board_time(start + RECORD_S, WALL_LIMIT_S)
             link.stream()
     finally:
         recorder.close()
@@ -252,7 +247,7 @@ def test_blink_code_is_played_on_the_led_pin_and_reported(board) -> None:
         # Another test may have left the LED lit; the blink starts from dark.
         link.set_led(0)
         schedule = link.blink(bits=24, bit_s=0.02, seed=0xACE1, start_in_s=0.1)
-        wait_for_board_time(link, schedule.start_board_time + schedule.bits * schedule.bit_s + 0.01)
+        link.wait_for_board_time(schedule.start_board_time + schedule.bits * schedule.bit_s + 0.01, WALL_LIMIT_S)
     start = schedule.start_board_time - 1e-3
     arrivals = [arrival for arrival, change in zip(arrivals, changes) if change.board_time > start]
     changes = [change for change in changes if change.board_time > start]
@@ -305,7 +300,7 @@ def test_recording_survives_line_noise_and_a_dropped_connection(start_board, wor
             link.configure_photodiode(RISE, FALL)
             link.stream(encoder=True, photodiode=True)
             wait_until(lambda: "configured" in kinds, WALL_LIMIT_S, "the board set up again after the drop")
-            wait_for_board_time(link, 5.5)
+            link.wait_for_board_time(5.5, WALL_LIMIT_S)
             status = link.status()
             counters = link.counters
     finally:

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import pytest
 
-from rig.commands import board as board_command
 from rig.commands.board import PORT_VARIABLE, add_parser
 from rig.devices import BoardRecorder, EncoderEdge, PhotodiodePassage
 from rig.devices.protocol import protocol
@@ -83,27 +82,3 @@ def test_latency_of_a_folder_that_is_no_recording(tmp_path: Path) -> None:
     with pytest.raises(RigError, match="encoder.csv"):
         args.func(args)
 
-
-class LaggingBoard:
-    """A board whose clock, asked, reads each of `readings` in turn."""
-
-    def __init__(self, readings: list[float]) -> None:
-        self.readings = iter(readings)
-        self.asked = 0
-
-    def status(self) -> argparse.Namespace:
-        self.asked += 1
-        return argparse.Namespace(board_time=next(self.readings))
-
-
-def test_a_blink_is_over_only_when_the_boards_own_clock_says_so(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(board_command, "POLL_S", 0.0)
-    lagging = LaggingBoard([9.2, 9.7, 10.05, 10.3])
-    board_command._wait_for_board_clock(lagging, 10.0)
-    assert lagging.asked == 3
-
-
-def test_a_board_whose_clock_stands_still_is_reported(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(board_command, "BOARD_CLOCK_LIMIT_S", -1.0)
-    with pytest.raises(RigError, match="board's clock reads 9.200 s, still short of 10.000 s"):
-        board_command._wait_for_board_clock(LaggingBoard([9.2] * 100), 10.0)

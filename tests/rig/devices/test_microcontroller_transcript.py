@@ -62,6 +62,17 @@ def ack(command: str, fields: dict[str, Any] | None = None, status: int = SPEC["
     return Exchange(command, fields, answer)
 
 
+def status(board_time: float) -> Exchange:
+    """A status answer whose clock reads board_time, whatever the scripted clock says."""
+
+    def answer(seq: int, fields: dict[str, Any], board: ScriptedBoard) -> list[tuple[str, dict[str, Any]]]:
+        tick = round(board_time * HZ)
+        return [("RIG_MSG_STATUS", dict(reply_to=seq, unsolicited=0, epoch=tick >> 32, tick=tick & 0xFFFF_FFFF, stream=0, rx_frames=0,
+                                        rx_corrupt=0, rx_unknown=0, rx_overflow=0, tx_dropped=0, event_overflow=0, quad_invalid=0))]
+
+    return Exchange("RIG_CMD_STATUS", {}, answer)
+
+
 def silent(command: str) -> Exchange:
     return Exchange(command, None, lambda seq, fields, board: [])
 
@@ -282,6 +293,21 @@ def test_events_are_placed_on_the_full_board_time_line_and_the_rig_clock() -> No
     assert edges[1].rig_time == pytest.approx(edges[1].board_time - offset, abs=1e-9)
     passage = events.of(PhotodiodePassage)[0]
     assert (passage.start_tick, passage.board_tick, passage.end_tick) == (anchor + 0xFE, anchor + 0x120, anchor + 0x140)
+
+
+def test_waiting_for_board_time_asks_the_board_until_its_clock_gets_there() -> None:
+    board = ScriptedBoard(connecting() + [status(9.2), status(9.7), status(10.05)])
+    with link_to(board) as link:
+        link.wait_for_board_time(10.0, limit_s=5.0, poll_s=0.0)
+    board.check_all_used()
+
+
+def test_a_board_clock_that_stands_still_is_reported() -> None:
+    board = ScriptedBoard(connecting() + [status(9.2)])
+    with link_to(board) as link:
+        with pytest.raises(RigError, match="board's clock reads 9.200 s, still short of 10.000 s after -1 s"):
+            link.wait_for_board_time(10.0, limit_s=-1.0)
+    board.check_all_used()
 
 
 def test_bad_frames_are_counted_and_skipped() -> None:
