@@ -81,4 +81,3 @@ def test_latency_of_a_folder_that_is_no_recording(tmp_path: Path) -> None:
     args = parse("board", "latency", str(tmp_path))
     with pytest.raises(RigError, match="encoder.csv"):
         args.func(args)
-

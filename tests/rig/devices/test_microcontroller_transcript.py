@@ -20,6 +20,8 @@ SPEC = protocol()
 HZ = SPEC["RIG_TICK_HZ"]
 OFFSET_S = 1000.0  # board time - rig time
 SYNCS = 4
+# The counters of a status message, all zero.
+ZERO_COUNTERS = dict(rx_frames=0, rx_corrupt=0, rx_unknown=0, rx_overflow=0, tx_dropped=0, event_overflow=0, quad_invalid=0)
 
 Answer = Callable[[int, dict[str, Any], "ScriptedBoard"], list[tuple[str, dict[str, Any]]]]
 
@@ -67,8 +69,7 @@ def status(board_time: float) -> Exchange:
 
     def answer(seq: int, fields: dict[str, Any], board: ScriptedBoard) -> list[tuple[str, dict[str, Any]]]:
         tick = round(board_time * HZ)
-        return [("RIG_MSG_STATUS", dict(reply_to=seq, unsolicited=0, epoch=tick >> 32, tick=tick & 0xFFFF_FFFF, stream=0, rx_frames=0,
-                                        rx_corrupt=0, rx_unknown=0, rx_overflow=0, tx_dropped=0, event_overflow=0, quad_invalid=0))]
+        return [("RIG_MSG_STATUS", dict(reply_to=seq, unsolicited=0, epoch=tick >> 32, tick=tick & 0xFFFF_FFFF, stream=0) | ZERO_COUNTERS)]
 
     return Exchange("RIG_CMD_STATUS", {}, answer)
 
@@ -279,8 +280,7 @@ def test_events_are_placed_on_the_full_board_time_line_and_the_rig_clock() -> No
     with link_to(board) as link:
         link.add_listener(events)
         anchor = (3 << 32) | 0xFFFF_FF00
-        board.send("RIG_MSG_STATUS", dict(reply_to=0, unsolicited=1, epoch=3, tick=0xFFFF_FF00, stream=1, rx_frames=0,
-                                         rx_corrupt=0, rx_unknown=0, rx_overflow=0, tx_dropped=0, event_overflow=0, quad_invalid=0))
+        board.send("RIG_MSG_STATUS", dict(reply_to=0, unsolicited=1, epoch=3, tick=0xFFFF_FF00, stream=1) | ZERO_COUNTERS)
         board.send("RIG_MSG_ENCODER", dict(tick=0xFFFF_FFF0, count=-5, edges=1, step=-1))
         board.send("RIG_MSG_ENCODER", dict(tick=0x0000_0010, count=-6, edges=1, step=-1))
         board.send("RIG_MSG_PASSAGE", dict(start_tick=0xFFFF_FFFE, centroid_tick=0x20, end_tick=0x40, peak=700))
