@@ -3,7 +3,7 @@
     rig board info                  who the board is, its counters and the clock offset
     rig board sync                  measure the clock offset (and, repeated, its drift)
     rig board record --out DIR --duration S [--blink]
-                                    record encoder, photodiode and LED events as CSV (rig/devices/recording.py);
+                                    record encoder, photodiode and LED events as CSV (analysis/board/recording.py);
                                     with --blink, play the blink code first (for `rig analyse --board DIR`)
     rig board blink                 play the LED blink code (to align a camera to the board)
     rig board latency DIR           the latency from a recording's photodiode passages and encoder
@@ -23,12 +23,12 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from analysis.board.blink_code import BlinkSchedule
+from analysis.board.photodiode_latency import estimate_from_recording, plot_board_latency
+from rig.board.clock_sync import OffsetInterval
+from rig.board.microcontroller import Microcontroller
+from rig.board.recording import BoardRecorder
 from rig.commands.options import non_negative_float, non_negative_int, positive_float
-from rig.devices.blink_code import BlinkSchedule
-from rig.devices.clock_sync import OffsetInterval
-from rig.devices.microcontroller import Microcontroller
-from rig.devices.photodiode_latency import estimate_from_recording, plot_board_latency
-from rig.devices.recording import BoardRecorder
 from rig.errors import RigError
 from rig.progress import ProgressBar
 

@@ -15,11 +15,12 @@ import numpy as np
 import pytest
 import serial
 
+from analysis.board.blink_code import BlinkSchedule
+from analysis.board.recording import load_table
+from rig.board import BoardIdentity, BoardRecorder, LedChange, LinkChange, Microcontroller
+from rig.board.framing import FrameDecoder, encode_frame
+from rig.board.protocol import protocol
 from rig.commands.board import add_parser
-from rig.devices import BlinkSchedule, BoardIdentity, BoardRecorder, LedChange, LinkChange, Microcontroller
-from rig.devices.framing import FrameDecoder, encode_frame
-from rig.devices.protocol import protocol
-from rig.devices.recording import load_table
 from rig.errors import RigError
 
 RISE, FALL = 512, 256

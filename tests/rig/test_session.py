@@ -9,8 +9,8 @@ import cv2
 import numpy as np
 import pytest
 
-from rig.devices.blink_code import align_blink_code
-from rig.devices.recording import load_table
+from analysis.board.blink_code import align_blink_code
+from analysis.board.recording import load_table
 from rig.errors import ConfigError, RigError
 from rig.session import Simulation, SimulationConfig, simulate
 from rig.sim.board import SimulatedBoardConfig, encoder_count

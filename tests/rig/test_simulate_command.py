@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from analysis.board.recording import load_table
 from rig.cli import main
-from rig.devices.recording import load_table
 
 
 def test_a_held_release_and_a_board_from_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

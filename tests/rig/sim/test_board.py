@@ -9,9 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rig.devices.blink_code import lfsr_bits
-from rig.devices.protocol import protocol
-from rig.devices.recording import FILES, load_table
+from analysis.board.blink_code import lfsr_bits
+from analysis.board.recording import load_table
+from rig.board.protocol import protocol
+from rig.board.recording import FILES
 from rig.errors import ConfigError, RigError
 from rig.sim.board import SimulatedBoard, SimulatedBoardConfig, encoder_count
 from rig.sim.pendulum import Pendulum, PendulumConfig

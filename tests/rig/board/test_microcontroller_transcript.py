@@ -11,9 +11,9 @@ from typing import Any, Callable
 import pytest
 import serial
 
-from rig.devices import EncoderEdge, LinkChange, Microcontroller, PhotodiodePassage
-from rig.devices.framing import FrameDecoder, encode_frame
-from rig.devices.protocol import protocol
+from rig.board import EncoderEdge, LinkChange, Microcontroller, PhotodiodePassage
+from rig.board.framing import FrameDecoder, encode_frame
+from rig.board.protocol import protocol
 from rig.errors import ConfigError, RigError
 
 SPEC = protocol()

@@ -1,11 +1,15 @@
-"""Reading the protocol from firmware/include/protocol.h (tests/firmware/test_protocol_header.py
-checks the parse against the C compiler)."""
+"""Reading the protocol from protocol.h, the firmware's header shipped in rig.board
+(tests/firmware/test_protocol_header.py checks the parse against the C compiler)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
-from rig.devices.protocol import HEADER_PATH, parse_protocol_header, protocol
+from analysis.board.blink_code import LFSR_TAPS
+from analysis.board.recording import TICK_HZ
+from rig.board.protocol import HEADER_FILE, parse_protocol_header, protocol
 from rig.errors import RigError
 
 HEADER = """
@@ -65,7 +69,7 @@ def test_malformed_headers_are_rejected(header: str, message: str) -> None:
 def test_real_header_defines_every_message_the_link_uses() -> None:
     spec = protocol()
     assert protocol() is spec
-    assert HEADER_PATH.name == "protocol.h"
+    assert HEADER_FILE.name == "protocol.h"
     for name in ("IDENTIFY", "SYNC", "STATUS", "LED", "BLINK", "ENCODER", "PHOTODIODE", "STREAM"):
         assert spec.type_id(f"RIG_CMD_{name}") in spec.layouts
     for name in ("ACK", "IDENTITY", "SYNC", "SYNC_SENT", "STATUS", "ENCODER", "CROSSING", "PASSAGE", "SAMPLE", "LED"):
@@ -73,3 +77,16 @@ def test_real_header_defines_every_message_the_link_uses() -> None:
     assert spec.status_name(spec["RIG_STATUS_BAD_VALUE"]) == "bad value"
     with pytest.raises(KeyError):
         spec.type_id("RIG_TICK_HZ")
+
+
+def test_the_packaged_header_is_the_firmwares() -> None:
+    firmware_header = Path(__file__).resolve().parents[3] / "firmware" / "include" / "protocol.h"
+    assert HEADER_FILE.read_bytes() == firmware_header.read_bytes()
+
+
+def test_the_analysis_library_reads_recordings_with_the_headers_values() -> None:
+    """analysis.board cannot read the header (it never imports rig), so it states the two values it
+    needs; they must be the header's."""
+    spec = protocol()
+    assert TICK_HZ == spec["RIG_TICK_HZ"]
+    assert LFSR_TAPS == spec["RIG_BLINK_LFSR_TAPS"]

@@ -5,7 +5,7 @@ pendulum. Both are timed by the board's one clock, so no clock sync enters. The 
 time from the pendulum passing an angle to the display showing the sphere at that angle.
 
 For each passage of the sphere the board reports the centroid of the photodiode signal, the moment
-the sphere was centred on the photodiode (firmware/include/protocol.h, rig_msg_passage_t). With
+the sphere was centred on the photodiode (rig/board/protocol.h, rig_msg_passage_t). With
 the photodiode at encoder angle p (in counts, unknown) and angle(t) the encoder's count
 interpolated between edges (an edge from c - step to c is the boundary c - step / 2):
 
@@ -31,9 +31,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize_scalar
 
-from rig.devices.protocol import protocol
-from rig.devices.recording import load_table
-from rig.errors import RigError
+from analysis.board.recording import ENCODER, PASSAGES, TICK_HZ, load_table
+from analysis.errors import AnalysisError
 
 VELOCITY_WINDOW_S = 0.005
 # Passages lasting more than this many times the median happen near a turning point, where an
@@ -82,7 +81,7 @@ def encoder_trajectory(edge_times: ArrayLike, counts: ArrayLike, steps: ArrayLik
     times, angles = times[order], angles[order]
     keep = np.append(np.diff(times) > 0, True)
     if keep.sum() < 10:
-        raise RigError("the recording has fewer than 10 encoder edges: was the pendulum swinging?")
+        raise AnalysisError("the recording has fewer than 10 encoder edges: was the pendulum swinging?")
     return EncoderTrajectory(times[keep], angles[keep])
 
 
@@ -91,7 +90,7 @@ def _period(trajectory: EncoderTrajectory) -> float:
     centred = trajectory.angles - np.mean(trajectory.angles)
     upward = np.flatnonzero((centred[:-1] < 0) & (centred[1:] >= 0))
     if upward.size < 2:
-        raise RigError("the encoder recording spans less than one pendulum period: record longer")
+        raise AnalysisError("the encoder recording spans less than one pendulum period: record longer")
     return float(np.median(np.diff(trajectory.times[upward])))
 
 
@@ -138,19 +137,19 @@ def estimate_board_latency(
     period = _period(trajectory)
     limit = DEFAULT_MAX_LATENCY_PERIODS * period if max_latency_s is None else max_latency_s
     if not 0 < limit < 0.5 * period:
-        raise RigError(
+        raise AnalysisError(
             f"the largest latency searched must lie between 0 and half the pendulum period ({500 * period:.1f} ms), "
             f"got {1e3 * limit:.1f} ms: beyond it a latency D and D + T/2 look the same"
         )
     centroids = np.asarray(centroid_times, dtype=np.float64)
     lasted = np.asarray(durations, dtype=np.float64)
     if centroids.shape != lasted.shape or centroids.size < MIN_PASSAGES:
-        raise RigError(f"need at least {MIN_PASSAGES} passages of the sphere over the photodiode, got {centroids.size}")
+        raise AnalysisError(f"need at least {MIN_PASSAGES} passages of the sphere over the photodiode, got {centroids.size}")
     usable = lasted <= SLOW_PASSAGE_FACTOR * np.median(lasted)
     usable &= centroids - limit - VELOCITY_WINDOW_S >= trajectory.times[0]
     usable &= centroids + VELOCITY_WINDOW_S <= trajectory.times[-1]
     if usable.sum() < MIN_PASSAGES:
-        raise RigError(
+        raise AnalysisError(
             f"only {usable.sum()} passages of the sphere fall within the encoder recording at a good speed; "
             f"need {MIN_PASSAGES}: record longer, or place the photodiode where the pendulum moves fast"
         )
@@ -158,7 +157,7 @@ def estimate_board_latency(
     grid = np.arange(0.0, limit + GRID_STEP_S, GRID_STEP_S)
     costs = np.array([fit.cost(delay) for delay in grid])
     if not np.isfinite(costs).any():
-        raise RigError("the passages over the photodiode do not fit the pendulum: they need both directions of swing")
+        raise AnalysisError("the passages over the photodiode do not fit the pendulum: they need both directions of swing")
     best = int(np.argmin(costs))
     refined = minimize_scalar(
         fit.cost,
@@ -184,9 +183,9 @@ def estimate_board_latency(
 
 def estimate_from_recording(out_dir: Path, *, max_latency_s: float | None = None) -> BoardLatency:
     """The latency of a `rig board record` folder (its encoder.csv and passages.csv)."""
-    encoder = load_table(out_dir, "encoder.csv")
-    passages = load_table(out_dir, "passages.csv")
-    tick_s = 1.0 / protocol()["RIG_TICK_HZ"]
+    encoder = load_table(out_dir, ENCODER.name)
+    passages = load_table(out_dir, PASSAGES.name)
+    tick_s = 1.0 / TICK_HZ
     return estimate_board_latency(
         encoder["board_time_s"],
         encoder["count"],
@@ -201,10 +200,10 @@ def plot_board_latency(out_dir: Path, latency: BoardLatency, path: Path) -> Path
     """A PNG for people: the encoder's angle over the recording, with every passage of the sphere
     moved back by the latency (each should sit on the swing, at the photodiode's angle), and each
     passage's residual."""
-    from matplotlib.figure import Figure  # imported here so that importing rig.devices stays light
+    from matplotlib.figure import Figure  # imported here so that importing analysis.board stays light
 
-    encoder = load_table(out_dir, "encoder.csv")
-    passages = load_table(out_dir, "passages.csv")
+    encoder = load_table(out_dir, ENCODER.name)
+    passages = load_table(out_dir, PASSAGES.name)
     trajectory = encoder_trajectory(encoder["board_time_s"], encoder["count"], encoder["step"])
     shown = passages["board_time_s"] - latency.latency_s
     speed = trajectory.velocity(shown)
@@ -222,5 +221,5 @@ def plot_board_latency(out_dir: Path, latency: BoardLatency, path: Path) -> Path
     try:
         figure.savefig(path, dpi=100)
     except OSError as error:
-        raise RigError(f"cannot write the plot {path}: {error}") from None
+        raise AnalysisError(f"cannot write the plot {path}: {error}") from None
     return Path(path)

@@ -1,5 +1,5 @@
-"""Shared by the device tests: a synthetic board recording of a pendulum and a late display, with
-the truth known."""
+"""Shared by the board estimator tests (and by tests/rig/board, for `rig board latency`): a synthetic
+board recording of a pendulum and a late display, with the truth known."""
 
 from __future__ import annotations
 
@@ -8,8 +8,6 @@ from typing import Callable
 
 import numpy as np
 import pytest
-
-
 
 
 @dataclass(frozen=True)

@@ -26,10 +26,10 @@ import numpy as np
 
 from analysis.onset import departure_time
 from analysis.tracking import Track
-from rig.devices.blink_code import BlinkAlignment, align_blink_code
-from rig.devices.photodiode_latency import EncoderTrajectory, encoder_trajectory
-from rig.devices.recording import load_table
-from rig.errors import RigError
+from analysis.board.blink_code import BlinkAlignment, align_blink_code
+from analysis.board.photodiode_latency import EncoderTrajectory, encoder_trajectory
+from analysis.board.recording import ENCODER, LED, load_table
+from analysis.errors import AnalysisError
 
 EVENT_NAME = "board encoder start"
 LIT_FRACTION = 0.5
@@ -50,12 +50,12 @@ class BoardReference:
 
     @classmethod
     def load(cls, recording: Path) -> BoardReference:
-        led = load_table(recording, "led.csv")
-        encoder = load_table(recording, "encoder.csv")
+        led = load_table(recording, LED.name)
+        encoder = load_table(recording, ENCODER.name)
         if led["board_time_s"].size < 2:
-            raise RigError(f"{recording}/led.csv holds no blink: record with `rig board record --blink`")
+            raise AnalysisError(f"{recording}/led.csv holds no blink: record with `rig board record --blink`")
         if encoder["board_time_s"].size < 2:
-            raise RigError(f"{recording}/encoder.csv holds no encoder edges: did the pendulum swing while recording?")
+            raise AnalysisError(f"{recording}/encoder.csv holds no encoder edges: did the pendulum swing while recording?")
         trajectory = encoder_trajectory(encoder["board_time_s"], encoder["count"], encoder["step"])
         return cls(Path(recording), led["board_time_s"], led["level"], trajectory)
 
@@ -72,7 +72,7 @@ class BoardReference:
         start = max(float(led_track.t[0]), first - offset)
         end = min(float(led_track.t[-1]), float(self.encoder.times[-1]) - offset)
         if end <= start:
-            raise RigError(f"the board recording {self.recording} does not overlap the video in time")
+            raise AnalysisError(f"the board recording {self.recording} does not overlap the video in time")
         times = np.arange(start, end, ENCODER_SAMPLE_S)
         angles = self.encoder.angle(times + offset)
         departure = departure_time(times, angles, np.zeros_like(angles))
@@ -94,6 +94,6 @@ class BoardReference:
 def lit_frames(led_track: Track) -> np.ndarray:
     """Whether the LED is lit in each frame: its peak above LIT_FRACTION of its typical peak."""
     if not np.any(led_track.valid):
-        raise RigError("the LED was never found in the video, so its blink cannot be read")
+        raise AnalysisError("the LED was never found in the video, so its blink cannot be read")
     typical = float(np.median(led_track.peak[led_track.valid]))
     return led_track.peak > LIT_FRACTION * typical

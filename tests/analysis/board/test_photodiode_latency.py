@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rig.devices.photodiode_latency import estimate_board_latency
-from rig.errors import RigError
+from analysis.board.photodiode_latency import estimate_board_latency
+from analysis.errors import AnalysisError
 
 
 def estimate(recording, **options):
@@ -54,14 +54,14 @@ def test_latency_near_the_largest_searched(synthetic_recording) -> None:
 
 
 def test_a_latency_of_half_a_period_or_more_cannot_be_searched(synthetic_recording) -> None:
-    with pytest.raises(RigError, match="half the pendulum period"):
+    with pytest.raises(AnalysisError, match="half the pendulum period"):
         estimate(synthetic_recording(0.01), max_latency_s=0.7)
 
 
 def test_passages_in_one_direction_only_are_refused(synthetic_recording) -> None:
     recording = synthetic_recording(0.01)
     # Every other passage: the sphere always passing the same way.
-    with pytest.raises(RigError, match="both directions"):
+    with pytest.raises(AnalysisError, match="both directions"):
         estimate_board_latency(
             recording.edge_times, recording.counts, recording.steps, recording.centroids[::2], recording.durations[::2]
         )
@@ -69,10 +69,10 @@ def test_passages_in_one_direction_only_are_refused(synthetic_recording) -> None
 
 def test_too_little_data_is_refused(synthetic_recording) -> None:
     recording = synthetic_recording(0.01)
-    with pytest.raises(RigError, match="fewer than 10 encoder edges"):
+    with pytest.raises(AnalysisError, match="fewer than 10 encoder edges"):
         estimate_board_latency(recording.edge_times[:5], recording.counts[:5], recording.steps[:5], recording.centroids, recording.durations)
-    with pytest.raises(RigError, match="at least 4 passages"):
+    with pytest.raises(AnalysisError, match="at least 4 passages"):
         estimate_board_latency(recording.edge_times, recording.counts, recording.steps, recording.centroids[:3], recording.durations[:3])
     short = synthetic_recording(0.01, duration=1.0)
-    with pytest.raises(RigError, match="less than one pendulum period"):
+    with pytest.raises(AnalysisError, match="less than one pendulum period"):
         estimate(short)

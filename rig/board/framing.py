@@ -1,12 +1,12 @@
 """Frames of the board protocol: COBS byte stuffing, CRC-16/CCITT-FALSE, and a stream decoder that
-counts and skips every bad frame instead of failing (see firmware/include/protocol.h)."""
+counts and skips every bad frame instead of failing (see protocol.h)."""
 
 from __future__ import annotations
 
 import binascii
 from dataclasses import dataclass, field
 
-from rig.devices.protocol import ProtocolSpec
+from rig.board.protocol import ProtocolSpec
 
 _CRC_POLY_OF_CRC_HQX = 0x1021
 

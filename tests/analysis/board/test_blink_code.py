@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rig.devices.blink_code import BlinkSchedule, align_blink_code, lfsr_bits
-from rig.errors import RigError
+from analysis.board.blink_code import BlinkSchedule, align_blink_code, lfsr_bits
+from analysis.errors import AnalysisError
 
 SCHEDULE = BlinkSchedule(start_board_time=500.0, bit_s=0.05, seed=0xACE1, bits=64, level=255)
 
@@ -83,14 +83,14 @@ def test_video_without_the_code_is_refused() -> None:
     changes = board_changes(SCHEDULE)
     frames = np.arange(0.0, 5.0, 1 / 60)
     rng = np.random.default_rng(4)
-    with pytest.raises(RigError, match="not found"):
+    with pytest.raises(AnalysisError, match="not found"):
         align_blink_code(frames, rng.random(frames.size) < 0.5, *changes)
-    with pytest.raises(RigError, match="at least 16 camera frames"):
+    with pytest.raises(AnalysisError, match="at least 16 camera frames"):
         align_blink_code(frames[:5], np.zeros(5, dtype=bool), *changes)
 
 
 def test_a_code_too_short_to_place_is_refused() -> None:
     short = BlinkSchedule(start_board_time=10.0, bit_s=0.05, seed=0xACE1, bits=3, level=255)
     frames, lit = camera_view(short, 0.0, start=-2.0, seconds=4.0)
-    with pytest.raises(RigError, match="two offsets|not found"):
+    with pytest.raises(AnalysisError, match="two offsets|not found"):
         align_blink_code(frames, lit, *board_changes(short))

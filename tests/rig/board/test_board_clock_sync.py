@@ -7,15 +7,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rig.devices.clock_sync import (
-    CLOCK_RESTART_S,
-    ClockModel,
-    OffsetInterval,
-    RoundTrip,
-    TickUnwrapper,
-    consistent_intersection,
-    narrow,
-)
+from analysis.board.intervals import consistent_intersection
+from rig.board.clock_sync import CLOCK_RESTART_S, ClockModel, OffsetInterval, RoundTrip, TickUnwrapper, narrow
 
 BYTE_TIME = 10 / 500_000
 REQUEST_BYTES = 6

@@ -1,8 +1,11 @@
-"""The board's serial protocol, read from its one definition: firmware/include/protocol.h.
+"""The board's serial protocol, read from its one definition: protocol.h.
 
-Nothing here is a copy of the header: the constants and the payload layouts are parsed from it the
-first time `protocol()` is called, and a test compiles the header with the C compiler to check that
-the parse agrees with what the firmware sees.
+The header is the firmware's (firmware/include/protocol.h); rig/board/protocol.h links to it, so
+the file ships inside this package (package data, copied into a wheel) and is found with
+importlib.resources, from a checkout or an installed rig alike. Nothing here is a copy of the
+header: the constants and the payload layouts are parsed from it the first time `protocol()` is
+called, and a test compiles the header with the C compiler to check that the parse agrees with
+what the firmware sees.
 """
 
 from __future__ import annotations
@@ -11,12 +14,12 @@ import functools
 import re
 import struct
 from dataclasses import dataclass
-from pathlib import Path
+from importlib import resources
 from typing import Mapping
 
 from rig.errors import RigError
 
-HEADER_PATH = Path(__file__).resolve().parents[2] / "firmware" / "include" / "protocol.h"
+HEADER_FILE = resources.files("rig.board") / "protocol.h"
 
 _FIELD_FORMATS = {
     "uint8_t": "B",
@@ -101,11 +104,11 @@ def _struct_layout(name: str, body: str) -> PayloadLayout:
             continue
         match = _FIELD.match(line + ";")
         if match is None or match["type"] not in _FIELD_FORMATS:
-            raise RigError(f"{HEADER_PATH}: cannot read the field {line.strip()!r} of {name}")
+            raise RigError(f"{HEADER_FILE.name}: cannot read the field {line.strip()!r} of {name}")
         code = _FIELD_FORMATS[match["type"]]
         count = int(match["count"]) if match["count"] else None
         if (code == "s") != (count is not None):
-            raise RigError(f"{HEADER_PATH}: {match['name']} of {name}: only char fields may be, and must be, arrays")
+            raise RigError(f"{HEADER_FILE.name}: {match['name']} of {name}: only char fields may be, and must be, arrays")
         fields.append(match["name"])
         codes.append(f"{count}s" if code == "s" else code)
     return PayloadLayout(name=name, fields=tuple(fields), format="<" + "".join(codes))
@@ -123,28 +126,34 @@ def parse_protocol_header(text: str) -> ProtocolSpec:
             strings[name] = _STRING.match(value).group(1)
     type_names = {value: name for name, value in constants.items() if name.startswith(_MESSAGE_PREFIXES)}
     if len(type_names) != sum(name.startswith(_MESSAGE_PREFIXES) for name in constants):
-        raise RigError(f"{HEADER_PATH}: two message types share a number")
+        raise RigError(f"{HEADER_FILE.name}: two message types share a number")
     layouts = {value: PayloadLayout(name=name, fields=(), format="<") for value, name in type_names.items()}
     for match in _STRUCT.finditer(source):
         struct_name = match["name"]
         type_name = struct_name.removesuffix("_t").upper()
         if type_name not in constants or not type_name.startswith(_MESSAGE_PREFIXES):
-            raise RigError(f"{HEADER_PATH}: {struct_name} has no message type {type_name}")
+            raise RigError(f"{HEADER_FILE.name}: {struct_name} has no message type {type_name}")
         layout = _struct_layout(struct_name, match["body"])
         if layout.size > constants["RIG_FRAME_MAX_PAYLOAD"]:
-            raise RigError(f"{HEADER_PATH}: {struct_name} is longer than RIG_FRAME_MAX_PAYLOAD")
+            raise RigError(f"{HEADER_FILE.name}: {struct_name} is longer than RIG_FRAME_MAX_PAYLOAD")
         layouts[constants[type_name]] = layout
     return ProtocolSpec(constants=constants, strings=strings, layouts=layouts, type_names=type_names)
 
 
 @functools.cache
 def protocol() -> ProtocolSpec:
-    """The protocol of firmware/include/protocol.h, parsed on first use."""
+    """The protocol of protocol.h, parsed on first use."""
     try:
-        text = HEADER_PATH.read_text()
+        text = HEADER_FILE.read_text(encoding="utf-8")
     except OSError as error:
         raise RigError(
-            f"cannot read the board protocol {HEADER_PATH}: {error.strerror}; "
-            "the rig needs its source checkout's firmware/ folder"
+            f"cannot read the board protocol {HEADER_FILE}: {error.strerror}; reinstall latency-rig, "
+            "or in a checkout restore the link rig/board/protocol.h -> ../../firmware/include/protocol.h"
         ) from None
-    return parse_protocol_header(text)
+    spec = parse_protocol_header(text)
+    if "RIG_PROTOCOL_VERSION" not in spec.constants:
+        raise RigError(
+            f"{HEADER_FILE} defines no RIG_PROTOCOL_VERSION: it should be (a link to) firmware/include/protocol.h; "
+            "a checkout made without symbolic links (git config core.symlinks) holds the link's target path instead"
+        )
+    return spec

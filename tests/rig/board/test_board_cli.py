@@ -9,9 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from analysis.errors import AnalysisError
+from rig.board import BoardRecorder, EncoderEdge, PhotodiodePassage
+from rig.board.protocol import protocol
 from rig.commands.board import PORT_VARIABLE, add_parser
-from rig.devices import BoardRecorder, EncoderEdge, PhotodiodePassage
-from rig.devices.protocol import protocol
 from rig.errors import RigError
 
 
@@ -79,5 +80,5 @@ def test_latency_of_a_recording(tmp_path: Path, synthetic_recording, capsys: pyt
 
 def test_latency_of_a_folder_that_is_no_recording(tmp_path: Path) -> None:
     args = parse("board", "latency", str(tmp_path))
-    with pytest.raises(RigError, match="encoder.csv"):
+    with pytest.raises(AnalysisError, match="encoder.csv"):
         args.func(args)

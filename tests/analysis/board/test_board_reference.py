@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from analysis.board.blink_code import BlinkSchedule
+from analysis.board.reference import EVENT_NAME, BoardReference, lit_frames
+from analysis.errors import AnalysisError
 from analysis.onset import departure_time
 from analysis.tracking import Track
-from rig.devices.blink_code import BlinkSchedule
-from rig.devices.board_events import EncoderEdge, LedChange
-from rig.devices.board_reference import EVENT_NAME, BoardReference, lit_frames
-from rig.devices.recording import BoardRecorder
-from rig.errors import RigError
+from rig.board.events import EncoderEdge, LedChange
+from rig.board.recording import BoardRecorder
 
 FPS = 120.0
 OFFSET_S = 250.0
@@ -82,7 +82,7 @@ def test_a_video_that_misses_the_blink_is_refused(tmp_path: Path) -> None:
     late = led_track()
     start = np.searchsorted(late.t, 4.5)
     cut = Track(*(column[start:] for column in (late.t, late.x, late.y, late.valid, late.peak, late.clipped)))
-    with pytest.raises(RigError, match="blink code was not found"):
+    with pytest.raises(AnalysisError, match="blink code was not found"):
         board.departures(cut)
 
 
@@ -94,5 +94,5 @@ def test_half_lit_frames_read_as_the_nearer_level() -> None:
 
 def test_a_recording_without_a_blink_is_refused(tmp_path: Path) -> None:
     BoardRecorder(tmp_path / "rec").close()
-    with pytest.raises(RigError, match="no blink"):
+    with pytest.raises(AnalysisError, match="no blink"):
         BoardReference.load(tmp_path / "rec")

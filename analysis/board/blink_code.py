@@ -1,7 +1,7 @@
 """The LED's blink code, and finding where a camera's frames fall on the board's clock from it.
 
-The board plays a pseudo-random bit sequence on the LED (firmware/include/protocol.h gives the
-LFSR) and reports every change of the LED with its board time. A camera that films the LED sees
+The board plays a pseudo-random bit sequence on the LED (its protocol, rig/board/protocol.h, gives
+the LFSR) and reports every change of the LED with its board time. A camera that films the LED sees
 the code as a per-frame on/off sequence. `align_blink_code` finds the offset between the camera's
 clock and the board's (board time = camera time + offset): first the one offset at which the
 whole code matches (the code does not repeat, so there is one), then an interval of offsets from
@@ -15,9 +15,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rig.devices.clock_sync import consistent_intersection
-from rig.devices.protocol import protocol
-from rig.errors import RigError
+from analysis.board.intervals import consistent_intersection
+from analysis.errors import AnalysisError
+
+# RIG_BLINK_LFSR_TAPS of the board's protocol (rig/board/protocol.h); tests/rig/board checks that
+# the two agree.
+LFSR_TAPS = 0xB400
 
 # The coarse search accepts an offset when this share of the frames agree with the code ...
 MIN_AGREEMENT = 0.9
@@ -30,14 +33,13 @@ def lfsr_bits(seed: int, count: int) -> NDArray[np.bool_]:
     """The first `count` bits of the blink code from `seed` (the bit shifted out at each step)."""
     if not 0 < seed < 1 << 16:
         raise ValueError(f"seed must be 1..65535, got {seed}")
-    taps = protocol()["RIG_BLINK_LFSR_TAPS"]
     state = seed
     bits = np.empty(count, dtype=bool)
     for k in range(count):
         out = state & 1
         state >>= 1
         if out:
-            state ^= taps
+            state ^= LFSR_TAPS
         bits[k] = bool(out)
     return bits
 
@@ -126,18 +128,18 @@ def align_blink_code(
     exposure_s: the camera's exposure; a transition within half of it of a frame may show either way.
 
     Returns the offset with board time = camera time + offset, and the interval it must lie in.
-    Raises RigError when the code is not found or matches at more than one offset.
+    Raises AnalysisError when the code is not found or matches at more than one offset.
     """
     frames = np.asarray(frame_times, dtype=np.float64)
     on = np.asarray(led_on, dtype=bool)
     times = np.asarray(change_times, dtype=np.float64)
     levels = np.asarray(change_levels)
     if frames.ndim != 1 or frames.shape != on.shape or frames.size < MIN_FRAMES:
-        raise RigError(f"need at least {MIN_FRAMES} camera frames with one on/off value each, got {frames.size}")
+        raise AnalysisError(f"need at least {MIN_FRAMES} camera frames with one on/off value each, got {frames.size}")
     if np.any(np.diff(frames) <= 0):
-        raise RigError("camera frame times must increase")
+        raise AnalysisError("camera frame times must increase")
     if times.ndim != 1 or times.shape != levels.shape or times.size < 2:
-        raise RigError("need the board's LED changes (led.csv of a recording with a blink)")
+        raise AnalysisError("need the board's LED changes (led.csv of a recording with a blink)")
     if exposure_s < 0:
         raise ValueError(f"exposure_s must be >= 0, got {exposure_s}")
     order = np.argsort(times, kind="stable")
@@ -152,13 +154,13 @@ def align_blink_code(
     scores = _agreement(offsets, frames, on, times, lit, max(MIN_FRAMES, could_fit // 2))
     best = int(np.argmax(scores))
     if scores[best] < MIN_AGREEMENT:
-        raise RigError(
+        raise AnalysisError(
             f"the blink code was not found in the video: at best {scores[best]:.0%} of frames agree "
             "(is the LED in view, is the on/off threshold right, was the blink recorded?)"
         )
     far = np.abs(offsets - offsets[best]) > 2 * shortest_bit
     if np.any(far) and scores[far].max() > scores[best] - AMBIGUITY_MARGIN:
-        raise RigError("the blink code matches the video at two offsets: record a longer blink")
+        raise AnalysisError("the blink code matches the video at two offsets: record a longer blink")
     coarse = float(offsets[best])
 
     # Each transition between frames k-1 and k brackets a board change j of the same direction:
@@ -176,7 +178,7 @@ def align_blink_code(
         lows.append(times[j] - frames[k] - half)
         highs.append(times[j] - frames[k - 1] + half)
     if not lows:
-        raise RigError("the video shows no LED transitions to time the blink code by")
+        raise AnalysisError("the video shows no LED transitions to time the blink code by")
     low, high, members = consistent_intersection(lows, highs)
     board_times = frames + 0.5 * (low + high)
     inside = (board_times >= span[0]) & (board_times <= span[1])

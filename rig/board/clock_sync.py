@@ -20,6 +20,8 @@ from typing import Sequence
 
 import numpy as np
 
+from analysis.board.intervals import consistent_intersection
+
 # Offsets measured this far apart (rig seconds) give a drift rate; closer ones only noise.
 MIN_DRIFT_BASELINE_S = 1.0
 # A new interval this far from the offset predicted for it means the board clock restarted.
@@ -65,22 +67,6 @@ class RoundTrip:
         high = self.board_rx - self.sent - request_bytes * byte_time
         low = self.board_tx - self.received
         return OffsetInterval(low, high, 0.5 * (self.sent + self.received))
-
-
-def consistent_intersection(lows: Sequence[float], highs: Sequence[float]) -> tuple[float, float, list[int]]:
-    """The intersection of the largest set of intervals [lows[i], highs[i]] that share a point,
-    and the indices of that set. An interval that misses the others (a round trip during which
-    an emulated clock stalled, a misread frame) is left out instead of emptying the intersection."""
-    if not lows or len(lows) != len(highs):
-        raise ValueError("need as many lows as highs, and at least one")
-    best: list[int] = []
-    for point in (*lows, *highs):
-        members = [i for i, (low, high) in enumerate(zip(lows, highs)) if low <= point <= high]
-        if len(members) > len(best):
-            best = members
-    if not best:
-        raise ValueError("every interval is empty (low above high)")
-    return max(lows[i] for i in best), min(highs[i] for i in best), best
 
 
 def narrow(intervals: Sequence[OffsetInterval]) -> tuple[OffsetInterval, int]:

@@ -6,8 +6,8 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from rig.devices.framing import FrameDecoder, FrameError, cobs_decode, cobs_encode, crc16, encode_frame
-from rig.devices.protocol import protocol
+from rig.board.framing import FrameDecoder, FrameError, cobs_decode, cobs_encode, crc16, encode_frame
+from rig.board.protocol import protocol
 
 SPEC = protocol()
 MESSAGE_TYPES = sorted(value for value, name in SPEC.type_names.items() if name.startswith("RIG_MSG_"))

@@ -1,0 +1,1 @@
+../../firmware/include/protocol.h
