@@ -1,9 +1,9 @@
 /*
  * The serial protocol between the rig's microcontroller and the host: the one definition.
  *
- * The firmware includes this file; the Python side (rig/devices/protocol.py) parses it, and a
- * test compiles it with the host C compiler to check that both read the same values and payload
- * layouts. Keep to the forms that parser understands: `#define RIG_NAME <integer or "string">`
+ * The firmware includes this file; the Python side (rig/board/protocol.py) parses it, through
+ * the link rig/board/protocol.h that ships it in the rig package, and a test compiles it with the
+ * host C compiler to check that both read the same values and payload layouts. Keep to the forms that parser understands: `#define RIG_NAME <integer or "string">`
  * and `typedef struct RIG_PACKED { <fixed-width fields> } rig_<cmd|msg>_<name>_t;`, where the
  * struct for message type RIG_MSG_FOO is rig_msg_foo_t (a type with no struct has no payload).
  *
