@@ -10,7 +10,7 @@ the per-window phases this reads
     psi_led(t)    = alpha_led    + beta t - zeta h(t)
     psi_sphere(t) = alpha_sphere + beta t - zeta h(t - latency)
 
-(h as in ``analysis.swing_model``; damping gamma from the LED's amplitudes). Each candidate is
+(h as in ``analysis.fit.model``; damping gamma from the LED's amplitudes). Each candidate is
 fitted and the residual sums compared. A candidate wins when every other is worse by at least
 DECISIVE_CHI2 in chi-square (scaled by the best fit's residual variance) and the chirp makes the
 candidates differ by at least MIN_SEPARATION_S of apparent latency drift over the clip: a latency

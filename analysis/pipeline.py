@@ -331,7 +331,7 @@ def _estimates(
         latency = xcorr_latency(led, sphere, fps, period, cycles.reference_s)
         results["xcorr"] = MethodResult("xcorr", latency * 1e3, None, "sine", time.perf_counter() - started, {})
     if "sinefit" in names or "bayes" in names:
-        from analysis.sinefit import Guess, fit_sine
+        from analysis.fit.least_squares import Guess, fit_sine
 
         started = time.perf_counter()
         guess = Guess(frequency, damping, 0.0, cycles.reference_s, gain_ratio(windows))
@@ -366,7 +366,7 @@ def _estimates(
                 fit,
             )
         if "bayes" in names:
-            from analysis.bayes import sample_posterior
+            from analysis.fit.posterior import sample_posterior
 
             started = time.perf_counter()
             posterior = sample_posterior(fit, seed)

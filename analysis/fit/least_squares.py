@@ -1,6 +1,6 @@
 """The joint least-squares fit (``sinefit``): both swings with a shared frequency, damping and chirp.
 
-The model is in ``analysis.swing_model``; its lag parameter is the latency. The fit runs on the
+The model is in ``analysis.fit.model``; its lag parameter is the latency. The fit runs on the
 signals averaged in bins of a few frames (about BINS_PER_PERIOD bins per swing period; see
 ``analysis.signals.binned``), padded to a power-of-two length so that one JAX compilation serves
 every clip of similar length. Each bin is weighted by sqrt(frames in it) / (the signal's noise);
@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 import jax.numpy as jnp
 import numpy as np
 
-from analysis import swing_model as model
+from analysis.fit import model
 from analysis.signals import BinnedSignals, SwingSignals, binned
 
 BINS_PER_PERIOD = 16
@@ -114,6 +114,7 @@ class SineFit:
         """The chosen model's variance inflation of the latency: (se / white-noise se)^2."""
         return (self.se_s / self.naive_se_s) ** 2
 
+    @model.in_float64
     def curves(self) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """For the LED, then the sphere: (bin times, binned values, fitted values) over used bins."""
         data = self.problem.data
@@ -271,6 +272,7 @@ def _screened_bic(
     return approximate
 
 
+@model.in_float64
 def fit_sine(signals: SwingSignals, noise: tuple[float, float], guess: Guess) -> SineFit:
     """Fit the models, choose by BIC, and return the chosen model's latency with its uncertainty.
 

@@ -7,7 +7,7 @@ import pytest
 
 from analysis.cycles import chirp_shape
 from analysis.signals import SwingSignals
-from analysis.sinefit import Guess, fit_sine, frames_per_bin, long_run_variance
+from analysis.fit.least_squares import Guess, fit_sine, frames_per_bin, long_run_variance
 
 FPS = 120.0
 SECONDS = 6.0
@@ -24,7 +24,7 @@ def swing(
     seed: int = 0,
 ) -> SwingSignals:
     """LED and sphere signals: a damped swing whose frequency rises as it decays (the pendulum's
-    chirp, see analysis.swing_model), with a third harmonic of relative size ``wide`` decaying with
+    chirp, see analysis.fit.model), with a third harmonic of relative size ``wide`` decaying with
     the cube of the amplitude, and the same swing ``latency`` later."""
     rng = np.random.default_rng(seed)
     t = np.arange(int(SECONDS * FPS)) / FPS
@@ -111,7 +111,7 @@ def test_frames_are_binned_to_about_sixteen_per_period():
 
 
 def test_posterior_agrees_with_the_fit_and_reports_its_sampler():
-    from analysis.bayes import sample_posterior
+    from analysis.fit.posterior import sample_posterior
 
     fit = fit_sine(swing(0.06, decay=0.1, noise=(0.3, 0.5), seed=3), (0.3, 0.5), guess(0.06))
     posterior = sample_posterior(fit, seed=1, steps=300, burn_in=100)
@@ -123,3 +123,16 @@ def test_posterior_agrees_with_the_fit_and_reports_its_sampler():
     assert 0.1 < details["acceptance_fraction"] < 0.9
     assert 1 < details["autocorrelation_steps"] < posterior.steps / 5
     assert sample_posterior(fit, seed=1, steps=300, burn_in=100).median_s == posterior.median_s
+
+
+def test_the_fit_is_64_bit_in_a_process_whose_jax_is_32_bit():
+    import jax
+
+    with jax.enable_x64(False):
+        fit = fit_sine(swing(0.137, decay=0.15, chirp=0.01), (0.01, 0.01), guess(0.137))
+        curves = fit.curves()
+        assert not jax.config.jax_enable_x64
+    assert fit.problem.data.tau.dtype == fit.problem.data.y.dtype == np.float64
+    assert fit.params.dtype == fit.covariance.dtype == np.float64
+    assert all(values.dtype == np.float64 for curve in curves for values in curve)
+    assert fit.latency_s == pytest.approx(0.137, abs=2e-6)

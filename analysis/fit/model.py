@@ -1,9 +1,12 @@
 """The joint model of the LED and sphere swings, in JAX: what `sinefit` fits and `bayes` samples.
 
-Importing this module imports JAX and turns on its 64-bit mode for the whole process
-(``jax_enable_x64``): phases of a few hundred radians must keep sub-microradian precision. The
-analyser imports it only when a fit is asked for, so ``import analysis`` and the fft and xcorr
-methods never pay for JAX.
+The model needs 64-bit floats: phases of a few hundred radians must keep sub-microradian
+precision. Importing this module changes no JAX setting; instead each entry point that builds or
+fits the model's arrays (``least_squares.fit_sine``, ``SineFit.curves``,
+``posterior.sample_posterior``) runs under ``in_float64``, which turns on JAX's 64-bit mode for the
+calling thread and the duration of the call only, so a user's own JAX code in the same process
+keeps its setting. The analyser imports this module only when a fit is asked for, so
+``import analysis`` and the fft and xcorr methods never pay for JAX.
 
 Time tau is measured from the middle of the clip. With D = exp(-gamma tau) the damping envelope
 and Phi(tau) = omega tau - zeta h(tau) the swing's phase, the LED's displacement along its axis is
@@ -36,12 +39,11 @@ least-squares solution, so the optimiser and the sampler work in five dimensions
 from __future__ import annotations
 
 import warnings
-from typing import NamedTuple
+from collections.abc import Callable
+from typing import NamedTuple, TypeVar
 
 import jax
 import jax.numpy as jnp
-
-jax.config.update("jax_enable_x64", True)
 
 with warnings.catch_warnings():
     # jaxopt announces on import that it is no longer maintained; its LM solver is what we use.
@@ -60,6 +62,15 @@ _SERIES_BELOW = 1e-2
 # Levenberg-Marquardt: iterations and the relative step at which it stops.
 MAX_ITERATIONS = 60
 STEP_TOLERANCE = 1e-11
+
+_Function = TypeVar("_Function", bound=Callable)
+
+
+def in_float64(function: _Function) -> _Function:
+    """``function``, run with JAX in 64-bit mode (``jax.enable_x64``) in the calling thread for the
+    duration of each call; the thread's setting is restored afterwards. The model's arrays made
+    inside keep float64 when used later under this mode again."""
+    return jax.enable_x64(True)(function)
 
 
 class FitData(NamedTuple):

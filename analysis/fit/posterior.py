@@ -1,7 +1,7 @@
 """The posterior of the latency (``bayes``): emcee over the same model ``sinefit`` chose.
 
 The sampled parameters are the model's free non-linear ones (frequency, damping, chirp, lag, gain,
-in the scaled units of ``analysis.swing_model``) and the log noise scale of each signal; the linear
+in the scaled units of ``analysis.fit.model``) and the log noise scale of each signal; the linear
 coefficients are integrated out analytically (flat priors), so the walkers move in at most seven
 dimensions. Priors are flat over a box BOX_WIDTH least-squares standard errors wide around the
 fit (and within half a period for the lag: the whole number of periods was chosen before, see
@@ -30,8 +30,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from analysis import swing_model as model
-from analysis.sinefit import SineFit
+from analysis.fit import model
+from analysis.fit.least_squares import SineFit
 
 WALKERS = 32
 BURN_IN = 150
@@ -101,6 +101,7 @@ def _log_posterior(
     return jax.vmap(one)(walkers)
 
 
+@model.in_float64
 def sample_posterior(fit: SineFit, seed: int, steps: int = STEPS, burn_in: int = BURN_IN) -> Posterior:
     """Sample the latency's posterior under the fit's model, starting from the fit."""
     tempering = fit.lag_inflation * (fit.critical / NORMAL_95) ** 2
