@@ -33,7 +33,9 @@ from analysis.result import DEFAULT_METHOD, METHODS, LatencyResult, MethodResult
 from analysis.signals import SwingSignals, swing_signals
 from analysis.timing import check_count, frame_times, implausible_period_warning, repeated_frames
 from analysis.tracking import BlobModel, BlobTracker, Detection, Roi, Track, calibrate_blob, find_moving_regions
-from analysis.video import Crop, Frame, FrameSource, VideoFile, open_frames
+from analysis.video.file import VideoFile
+from analysis.video.frames import Crop, Frame, FrameSource
+from analysis.video.sources import open_frames
 from analysis.windows import WindowPhases, damping_rate, gain_ratio, window_phases, windowed_latency
 from analysis.xcorr import xcorr_latency
 

@@ -8,16 +8,12 @@ import numpy as np
 import pytest
 
 from analysis import AnalysisError, analyse
-from analysis.video import (
-    DECODE_BATCH,
-    READ_AHEAD,
-    Crop,
-    FrameArray,
-    ImageFolder,
-    VideoFile,
-    _ordered_map,
-    open_frames,
-)
+from analysis.video.array import FrameArray
+from analysis.video.decoding import DECODE_BATCH, READ_AHEAD, ordered_map
+from analysis.video.file import VideoFile
+from analysis.video.frames import Crop
+from analysis.video.images import ImageFolder
+from analysis.video.sources import open_frames
 
 
 def moving_squares(count: int = 12, width: int = 48, height: int = 32) -> np.ndarray:
@@ -202,7 +198,7 @@ def test_items_come_in_order_when_the_consumer_maps_some_itself():
         return np.array([item * item])
 
     count = 3 * READ_AHEAD + 5
-    results = list(_ordered_map(square, range(count), str))
+    results = list(ordered_map(square, range(count), str))
     assert [int(r[0]) for r in results] == [i * i for i in range(count)]
     assert set(mapped_by.values()) == {True, False}
 
@@ -214,7 +210,7 @@ def test_closing_the_frames_early_stops_the_decoding():
         mapped.append(item)
         return np.array([item])
 
-    results = _ordered_map(record, range(100 * READ_AHEAD), str)
+    results = ordered_map(record, range(100 * READ_AHEAD), str)
     assert int(next(results)[0]) == 0
     results.close()
     assert len(mapped) <= READ_AHEAD + DECODE_BATCH
