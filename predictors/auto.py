@@ -23,15 +23,44 @@ orientation filter, less than `kalman-cv` and `kalman-ca` together. Sample order
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
-from predictors.checks import finite_time, no_sample_yet, non_negative_parameter, positive_parameter, read_sample
-from predictors.kalman import ConstantAccelerationPosition, ConstantVelocityPosition, OrientationFilter
+from predictors.checks import finite_time, no_sample_yet, read_sample
+from predictors.kalman import (
+    ACCELERATION_NOISE,
+    ANGULAR_ACCELERATION_NOISE,
+    ANGULAR_VELOCITY_DAMPING,
+    JERK_NOISE,
+    ORIENTATION_NOISE,
+    POSITION_NOISE,
+    ConstantAccelerationPosition,
+    ConstantVelocityPosition,
+    OrientationFilter,
+)
+from predictors.params import LOG, MAX_GAP, MAX_HORIZON, POSITIVE, Param, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
 
 POSITION_MODELS = ("none", "constant-velocity", "constant-acceleration")
 ORIENTATION_MODELS = ("none", "filter")
+
+# Tuning fits auto's filters as kalman-cv's, which has no jerk.
+AUTO_JERK_NOISE = replace(
+    JERK_NOISE, trainable=False, doc=f"{JERK_NOISE.doc} Tuning auto leaves it as given: tune kalman-ca for it."
+)
+# Both choose between models, so tuning searches them on a grid (log-spaced: both act multiplicatively).
+MEMORY = Param(
+    "memory", 2.0, "seconds",
+    "Time constant of the error scores, and how long a cold start uses the simplest models before choosing.",
+    POSITIVE, LOG, trainable=True,
+)
+MARGIN = Param(
+    "margin", 0.1, "",
+    "A fraction: a simpler model is used while its RMS error is at most (1 + margin) times the best "
+    "one's plus the tracker's noise.",
+    POSITIVE, LOG, trainable=True,
+)
 
 
 @dataclass(frozen=True)
@@ -55,50 +84,23 @@ def _simplest_within(mean_squares: list[float], margin: float, noise: float) -> 
     return last
 
 
+@declare_params(
+    POSITION_NOISE, ACCELERATION_NOISE, AUTO_JERK_NOISE, ORIENTATION_NOISE, ANGULAR_ACCELERATION_NOISE,
+    ANGULAR_VELOCITY_DAMPING, MARGIN, MEMORY, MAX_GAP, MAX_HORIZON,
+)
 class Auto:
     """Chooses per scene between no prediction, constant velocity and constant acceleration for
     position, and whether to filter orientation at all (`auto`).
 
-    Parameters:
-        position_noise, acceleration_noise, orientation_noise, angular_acceleration_noise,
-        angular_velocity_damping: as `kalman-cv` (m, m/s^1.5, rad, rad/s^1.5, 1/s).
-        jerk_noise: m/s^2.5, as `kalman-ca`.
-        margin: fraction (> 0); a simpler model is used while its RMS error is at most
-            (1 + margin) times the best one's plus the tracker's noise.
-        memory: s, time constant of the error scores, and how long a cold start uses the simplest
-            models before choosing.
-        max_gap, max_horizon: s, as `kalman-cv`.
+    The filters' parameters are those of `kalman-cv` and `kalman-ca`.
     """
 
     name = "auto"
+    params: ClassVar[ParamSet]
 
-    def __init__(
-        self,
-        position_noise: float = 0.0005,
-        acceleration_noise: float = 1.0,
-        jerk_noise: float = 20.0,
-        orientation_noise: float = 0.002,
-        angular_acceleration_noise: float = 5.0,
-        angular_velocity_damping: float = 0.0,
-        margin: float = 0.1,
-        memory: float = 2.0,
-        max_gap: float = 1.0,
-        max_horizon: float = 0.5,
-    ) -> None:
-        self.position_noise = positive_parameter(position_noise, self.name, "position_noise", "metres")
-        self.acceleration_noise = positive_parameter(acceleration_noise, self.name, "acceleration_noise", "m/s^1.5")
-        self.jerk_noise = positive_parameter(jerk_noise, self.name, "jerk_noise", "m/s^2.5")
-        self.orientation_noise = positive_parameter(orientation_noise, self.name, "orientation_noise", "radians")
-        self.angular_acceleration_noise = positive_parameter(
-            angular_acceleration_noise, self.name, "angular_acceleration_noise", "rad/s^1.5"
-        )
-        self.angular_velocity_damping = non_negative_parameter(
-            angular_velocity_damping, self.name, "angular_velocity_damping", "1/s"
-        )
-        self.margin = positive_parameter(margin, self.name, "margin", "fractions of the best error")
-        self.memory = positive_parameter(memory, self.name, "memory", "seconds")
-        self.max_gap = positive_parameter(max_gap, self.name, "max_gap", "seconds")
-        self.max_horizon = positive_parameter(max_horizon, self.name, "max_horizon", "seconds")
+    def __init__(self, **values: Any) -> None:
+        """Parameters as keyword arguments, each then an attribute (the class docstring lists them)."""
+        self.params.assign(self, values)
         self.reset()
 
     def reset(self) -> None:

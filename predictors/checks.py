@@ -69,36 +69,3 @@ def read_sample(sample: Any, name: str) -> tuple[float, Vector, Quaternion]:
 def _components(values: Any) -> Any:
     """An array's values as Python floats (tolist is much faster than iterating an array)."""
     return values.tolist() if isinstance(values, np.ndarray) else values
-
-
-def positive_parameter(value: Any, predictor: str, parameter: str, unit: str) -> float:
-    """value as a positive finite float, or PredictorError naming the parameter and its unit."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
-    if not (isfinite(number) and number > 0.0):
-        raise PredictorError(f"{predictor}: {parameter} must be a positive number of {unit}, got {value!r}")
-    return number
-
-
-def non_negative_parameter(value: Any, predictor: str, parameter: str, unit: str) -> float:
-    """value as a finite float >= 0, or PredictorError naming the parameter and its unit."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
-    if not (isfinite(number) and number >= 0.0):
-        raise PredictorError(f"{predictor}: {parameter} must be zero or a positive number of {unit}, got {value!r}")
-    return number
-
-
-def fraction_parameter(value: Any, predictor: str, parameter: str) -> float:
-    """value as a float strictly between 0 and 1, or PredictorError naming the parameter."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
-    if not 0.0 < number < 1.0:
-        raise PredictorError(f"{predictor}: {parameter} must be a number between 0 and 1 (exclusive), got {value!r}")
-    return number

@@ -22,16 +22,31 @@ the newest one's time replaces it (the step is redone with the later arrival); a
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
-from predictors.checks import finite_time, fraction_parameter, no_sample_yet, positive_parameter, read_sample
+from predictors.checks import finite_time, no_sample_yet, read_sample
+from predictors.params import LOGIT, MAX_GAP, MAX_HORIZON, OPEN_UNIT, POSITIVE, Param, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
 
 # Weight of the newest interval in the running mean of the sample interval (about 20 samples).
 INTERVAL_RATE = 0.05
 
 Vector = tuple[float, float, float]
+
+POSITION_ALPHA = Param(
+    "position_alpha", 0.5, "", "Smoothing factor for position; larger follows faster.",
+    OPEN_UNIT, LOGIT, trainable=True, acts_on="position",
+)
+ORIENTATION_ALPHA = Param(
+    "orientation_alpha", 0.5, "", "Smoothing factor for orientation; larger follows faster.",
+    OPEN_UNIT, LOGIT, trainable=True, acts_on="orientation",
+)
+SAMPLE_INTERVAL = Param(
+    "sample_interval", None, "seconds",
+    "The tracker's sample interval, which turns a horizon into samples; None estimates it from the samples.",
+    POSITIVE,
+)
 
 
 class _Smoothed:
@@ -43,36 +58,16 @@ class _Smoothed:
         self.s1, self.s2, self.q1, self.q2 = s1, s2, q1, q2
 
 
+@declare_params(POSITION_ALPHA, ORIENTATION_ALPHA, SAMPLE_INTERVAL, MAX_GAP, MAX_HORIZON)
 class DoubleExponentialSmoothing:
-    """LaViola's double exponential smoothing predictor (`desp`).
-
-    Parameters:
-        position_alpha: smoothing factor for position, in (0, 1); larger follows faster.
-        orientation_alpha: smoothing factor for orientation, in (0, 1).
-        sample_interval: s, the tracker's sample interval, which turns a horizon into samples;
-            None (default) estimates it from the samples.
-        max_gap: s, a longer gap between samples restarts the smoothing.
-        max_horizon: s, predictions further than this from the newest sample are made for this
-            horizon.
-    """
+    """LaViola's double exponential smoothing predictor (`desp`)."""
 
     name = "desp"
+    params: ClassVar[ParamSet]
 
-    def __init__(
-        self,
-        position_alpha: float = 0.5,
-        orientation_alpha: float = 0.5,
-        sample_interval: float | None = None,
-        max_gap: float = 1.0,
-        max_horizon: float = 0.5,
-    ) -> None:
-        self.position_alpha = fraction_parameter(position_alpha, self.name, "position_alpha")
-        self.orientation_alpha = fraction_parameter(orientation_alpha, self.name, "orientation_alpha")
-        self.sample_interval = (
-            None if sample_interval is None else positive_parameter(sample_interval, self.name, "sample_interval", "seconds")
-        )
-        self.max_gap = positive_parameter(max_gap, self.name, "max_gap", "seconds")
-        self.max_horizon = positive_parameter(max_horizon, self.name, "max_horizon", "seconds")
+    def __init__(self, **values: Any) -> None:
+        """Parameters as keyword arguments, each then an attribute (the class docstring lists them)."""
+        self.params.assign(self, values)
         self.reset()
 
     def reset(self) -> None:

@@ -12,22 +12,35 @@ Both answer any finite time, before or after the newest sample.
 from __future__ import annotations
 
 import math
+from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
 from predictors.checks import finite_time, no_sample_yet, read_sample
-from predictors.errors import PredictorError
+from predictors.params import POSITIVE, Param, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
 
+MIN_INTERVAL = Param(
+    "min_interval", 1e-6, "seconds",
+    "A sample less than this after the newest one counts as a duplicate: it replaces the newest and "
+    "the older, distinct sample is kept, so the two samples used are always at least this far apart "
+    "and a repeated timestamp never divides by zero or amplifies jitter into a wild velocity.",
+    POSITIVE,
+)
 
+
+@declare_params()
 class HoldLast:
     """No prediction: every answer is the newest sample's pose, stamped with the asked time.
 
-    The baseline every other predictor must beat. Parameters: none.
+    The baseline every other predictor must beat.
     """
 
     name = "hold"
+    params: ClassVar[ParamSet]
 
-    def __init__(self) -> None:
+    def __init__(self, **values: Any) -> None:
+        """No parameters: any keyword argument is refused, naming the predictor."""
+        self.params.assign(self, values)
         self._newest: PoseSample | None = None
         self._t = 0.0
 
@@ -89,6 +102,7 @@ class _Motion:
         )
 
 
+@declare_params(MIN_INTERVAL)
 class SlerpExtrapolator:
     """Linear prediction from the two newest samples (Smit et al. 2010, section 3.2).
 
@@ -96,29 +110,17 @@ class SlerpExtrapolator:
     position p0 + u (p1 - p0) and orientation slerp(q0, q1, u), u = (t - t0) / (t1 - t0): constant
     linear and angular velocity, the rotation taken the short way (so q1 and -q1 predict alike).
     With a single sample it holds that sample.
-
-    Parameters:
-        min_interval: seconds (> 0, default 1 microsecond). A sample less than this after the
-            newest one counts as a duplicate: it replaces the newest and the older, distinct
-            sample is kept, so the two samples used are always at least this far apart and a
-            repeated timestamp never divides by zero or amplifies jitter into a wild velocity.
     """
 
     name = "slerp"
+    params: ClassVar[ParamSet]
     _older: _Reading | None
     _newest: _Reading | None
     _motion: _Motion | None
 
-    def __init__(self, min_interval: float = 1e-6) -> None:
-        try:
-            min_interval = float(min_interval)
-        except (TypeError, ValueError):
-            raise PredictorError(f"slerp: min_interval must be seconds, got {min_interval!r}") from None
-        if not (math.isfinite(min_interval) and min_interval > 0.0):
-            raise PredictorError(
-                f"slerp: min_interval must be a positive number of seconds, got {min_interval!r}"
-            )
-        self.min_interval = min_interval
+    def __init__(self, **values: Any) -> None:
+        """Parameters as keyword arguments, each then an attribute (the class docstring lists them)."""
+        self.params.assign(self, values)
         self.reset()
 
     def update(self, sample: PoseSample) -> None:

@@ -43,15 +43,53 @@ says little about the motion after it.
 
 from __future__ import annotations
 
+from typing import Any, ClassVar
+
 from predictors import scalar_quaternion as squat
-from predictors.checks import finite_time, no_sample_yet, non_negative_parameter, positive_parameter, read_sample
+from predictors.checks import finite_time, no_sample_yet, read_sample
 from predictors.kinematic_covariance import KinematicCovariance, damped_reach, damped_step
+from predictors.params import LOG, MAX_GAP, MAX_HORIZON, NON_NEGATIVE, POSITIVE, Param, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
 
 # Prior spread of the motion at a cold start or after a drop-out (the first sample gives the pose).
 INITIAL_SPEED_STD = 1.0  # m/s
 INITIAL_ACCELERATION_STD = 10.0  # m/s^2
 INITIAL_ANGULAR_SPEED_STD = 3.0  # rad/s
+
+# The parameters of the Kalman predictors, which `auto` shares. Only the process noises and the
+# damping are fitted: the predicted means depend on the noises only through their ratio, so the
+# measurement noises stay as the tracker's datasheet (or the default) gives them.
+POSITION_NOISE = Param(
+    "position_noise", 0.0005, "metres", "Standard deviation of the tracker's position noise per axis.",
+    POSITIVE, LOG, acts_on="position",
+)
+ACCELERATION_NOISE = Param(
+    "acceleration_noise", 1.0, "m/s^1.5",
+    "Square root of the spectral density of the white acceleration that drives the velocity "
+    "(velocity wanders by this times sqrt(seconds)).",
+    POSITIVE, LOG, trainable=True, acts_on="position",
+)
+JERK_NOISE = Param(
+    "jerk_noise", 20.0, "m/s^2.5",
+    "Square root of the spectral density of the white jerk that drives the acceleration.",
+    POSITIVE, LOG, trainable=True, acts_on="position",
+)
+ORIENTATION_NOISE = Param(
+    "orientation_noise", 0.002, "radians", "Standard deviation of the tracker's orientation noise per axis.",
+    POSITIVE, LOG, acts_on="orientation",
+)
+ANGULAR_ACCELERATION_NOISE = Param(
+    "angular_acceleration_noise", 5.0, "rad/s^1.5",
+    "Square root of the spectral density of the white angular acceleration that drives the angular velocity.",
+    POSITIVE, LOG, trainable=True, acts_on="orientation",
+)
+ANGULAR_VELOCITY_DAMPING = Param(
+    "angular_velocity_damping", 0.0, "1/s",
+    "The rate at which the angular velocity reverts to rest between its random changes (see "
+    "`predictors.kalman`); 0 keeps it constant. From 0, tuning starts at a rate slow against the "
+    "horizons tuned for, which predicts almost as the undamped model while giving the loss a slope in it.",
+    NON_NEGATIVE, LOG, trainable=True, acts_on="orientation", tune_from=1.0,
+)
 
 
 class ConstantVelocityPosition:
@@ -180,33 +218,18 @@ class OrientationFilter:
 
 
 class _KalmanPredictor:
-    """Position filter + orientation filter behind the predictor protocol."""
+    """Position filter + orientation filter behind the predictor protocol; a subclass names its
+    position model and the parameter that drives it."""
 
     name = "kalman"
+    params: ClassVar[ParamSet]
+    _position_model: type[ConstantVelocityPosition] | type[ConstantAccelerationPosition]
+    _position_drive_param: Param
 
-    def __init__(
-        self,
-        position_model: type[ConstantVelocityPosition] | type[ConstantAccelerationPosition],
-        position_noise: float,
-        position_drive: float,
-        orientation_noise: float,
-        angular_acceleration_noise: float,
-        angular_velocity_damping: float,
-        max_gap: float,
-        max_horizon: float,
-    ) -> None:
-        self.position_noise = positive_parameter(position_noise, self.name, "position_noise", "metres")
-        self.orientation_noise = positive_parameter(orientation_noise, self.name, "orientation_noise", "radians")
-        self.angular_acceleration_noise = positive_parameter(
-            angular_acceleration_noise, self.name, "angular_acceleration_noise", "rad/s^1.5"
-        )
-        self.angular_velocity_damping = non_negative_parameter(
-            angular_velocity_damping, self.name, "angular_velocity_damping", "1/s"
-        )
-        self.max_gap = positive_parameter(max_gap, self.name, "max_gap", "seconds")
-        self.max_horizon = positive_parameter(max_horizon, self.name, "max_horizon", "seconds")
-        self._position_model = position_model
-        self._position_drive = position_drive
+    def __init__(self, **values: Any) -> None:
+        """Parameters as keyword arguments, each then an attribute (the class docstring lists them)."""
+        self.params.assign(self, values)
+        self._position_drive = getattr(self, self._position_drive_param.name)
         self._position: ConstantVelocityPosition | ConstantAccelerationPosition | None = None
         self._orientation: OrientationFilter | None = None
         self._t: float | None = None
@@ -248,78 +271,34 @@ class _KalmanPredictor:
         self._t = None
 
 
+@declare_params(
+    POSITION_NOISE, ACCELERATION_NOISE, ORIENTATION_NOISE, ANGULAR_ACCELERATION_NOISE, ANGULAR_VELOCITY_DAMPING,
+    MAX_GAP, MAX_HORIZON,
+)
 class KalmanCV(_KalmanPredictor):
     """Kalman filter, constant velocity in position and orientation (`kalman-cv`).
 
-    Parameters (defaults suit a head-mounted tracker at 60 to 1000 Hz):
-        position_noise: m, standard deviation of the tracker's position noise per axis.
-        acceleration_noise: m/s^1.5, square root of the spectral density of the white
-            acceleration that drives the velocity (velocity wanders by this times sqrt(seconds)).
-        orientation_noise: rad, standard deviation of the tracker's orientation noise per axis.
-        angular_acceleration_noise: rad/s^1.5, square root of the spectral density of the white
-            angular acceleration that drives the angular velocity.
-        angular_velocity_damping: 1/s, >= 0, the rate at which the angular velocity reverts to
-            rest between its random changes (see the module docstring); 0, the default, keeps it
-            constant. `rig tune` fits it.
-        max_gap: s, a longer gap between samples restarts the filter from the next sample.
-        max_horizon: s, predictions further than this from the newest sample (either way) are
-            made for this horizon: a drop-out holds the motion instead of flying away.
+    The defaults suit a head-mounted tracker at 60 to 1000 Hz; `rig tune` fits the process noises
+    and the damping to a recording.
     """
 
     name = "kalman-cv"
-
-    def __init__(
-        self,
-        position_noise: float = 0.0005,
-        acceleration_noise: float = 1.0,
-        orientation_noise: float = 0.002,
-        angular_acceleration_noise: float = 5.0,
-        angular_velocity_damping: float = 0.0,
-        max_gap: float = 1.0,
-        max_horizon: float = 0.5,
-    ) -> None:
-        self.acceleration_noise = positive_parameter(acceleration_noise, self.name, "acceleration_noise", "m/s^1.5")
-        super().__init__(
-            ConstantVelocityPosition,
-            position_noise,
-            self.acceleration_noise,
-            orientation_noise,
-            angular_acceleration_noise,
-            angular_velocity_damping,
-            max_gap,
-            max_horizon,
-        )
+    _position_model = ConstantVelocityPosition
+    _position_drive_param = ACCELERATION_NOISE
 
 
+@declare_params(
+    POSITION_NOISE, JERK_NOISE, ORIENTATION_NOISE, ANGULAR_ACCELERATION_NOISE, ANGULAR_VELOCITY_DAMPING,
+    MAX_GAP, MAX_HORIZON,
+)
 class KalmanCA(_KalmanPredictor):
     """Kalman filter, constant acceleration in position, constant angular velocity (`kalman-ca`).
 
-    Parameters as `kalman-cv`, with `jerk_noise` (m/s^2.5, square root of the spectral density of
-    the white jerk that drives the acceleration) instead of acceleration_noise. Orientation keeps
-    the (optionally damped) constant-angular-velocity model: angular acceleration is too noisy to
-    extrapolate.
+    As `kalman-cv`, with white jerk driving the acceleration instead of white acceleration driving
+    the velocity. Orientation keeps the (optionally damped) constant-angular-velocity model:
+    angular acceleration is too noisy to extrapolate.
     """
 
     name = "kalman-ca"
-
-    def __init__(
-        self,
-        position_noise: float = 0.0005,
-        jerk_noise: float = 20.0,
-        orientation_noise: float = 0.002,
-        angular_acceleration_noise: float = 5.0,
-        angular_velocity_damping: float = 0.0,
-        max_gap: float = 1.0,
-        max_horizon: float = 0.5,
-    ) -> None:
-        self.jerk_noise = positive_parameter(jerk_noise, self.name, "jerk_noise", "m/s^2.5")
-        super().__init__(
-            ConstantAccelerationPosition,
-            position_noise,
-            self.jerk_noise,
-            orientation_noise,
-            angular_acceleration_noise,
-            angular_velocity_damping,
-            max_gap,
-            max_horizon,
-        )
+    _position_model = ConstantAccelerationPosition
+    _position_drive_param = JERK_NOISE

@@ -6,21 +6,22 @@ A predictor is a small stateful object driven once per tracker sample and once p
     predictor.update(sample)        # every tracker sample, in any order
     pose = predictor.predict(t)     # the pose expected at time t (s, rig clock)
 
-A new predictor slots in by adding its class to `_PREDICTORS`; `make` passes keyword parameters to
-its constructor after checking their names against the constructor's signature.
+A new predictor slots in by adding its class to `_PREDICTORS`, under its `name`, once it declares
+its parameters (`predictors.params.declare_params`): `make` passes keyword parameters to the
+constructor, which checks them against that declaration.
 """
 
 from __future__ import annotations
 
-import inspect
 from types import MappingProxyType
-from typing import Callable, Mapping, Protocol, runtime_checkable
+from typing import Any, Mapping, Protocol, runtime_checkable
 
 from predictors.auto import Auto
 from predictors.desp import DoubleExponentialSmoothing
 from predictors.errors import PredictorError
 from predictors.extrapolators import HoldLast, SlerpExtrapolator
 from predictors.kalman import KalmanCA, KalmanCV
+from predictors.params import ParamSet
 from predictors.pose import Pose, PoseSample
 
 
@@ -40,14 +41,10 @@ class Predictor(Protocol):
         """Forget every sample, as if newly made."""
 
 
-_PREDICTORS: Mapping[str, Callable[..., Predictor]] = MappingProxyType(
+_PREDICTORS: Mapping[str, Any] = MappingProxyType(
     {
-        "hold": HoldLast,
-        "slerp": SlerpExtrapolator,
-        "kalman-cv": KalmanCV,
-        "kalman-ca": KalmanCA,
-        "desp": DoubleExponentialSmoothing,
-        "auto": Auto,
+        cls.name: cls
+        for cls in (HoldLast, SlerpExtrapolator, KalmanCV, KalmanCA, DoubleExponentialSmoothing, Auto)
     }
 )
 
@@ -57,19 +54,23 @@ def names() -> tuple[str, ...]:
     return tuple(_PREDICTORS)
 
 
-def make(name: str, **params: object) -> Predictor:
-    """A new predictor called `name`, built with keyword `params` (see the class for units)."""
+def _predictor_class(name: str) -> Any:
     try:
-        factory = _PREDICTORS[name]
+        return _PREDICTORS[name]
     except (KeyError, TypeError):
         raise PredictorError(f"unknown predictor {name!r}; known predictors: {', '.join(names())}") from None
-    accepted = [
-        p.name
-        for p in inspect.signature(factory).parameters.values()
-        if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
-    ]
-    unknown = sorted(set(params) - set(accepted))
-    if unknown:
-        takes = ", ".join(accepted) if accepted else "no parameters"
-        raise PredictorError(f"predictor {name!r} has no parameter {', '.join(unknown)}; it takes: {takes}")
-    return factory(**params)
+
+
+def params_of(name: str) -> ParamSet:
+    """The parameters predictor `name` takes: each one's unit, default, range and whether tuning fits it."""
+    return _predictor_class(name).params
+
+
+def make(name: str, **params: object) -> Predictor:
+    """A new predictor called `name`, built with keyword `params`.
+
+    Names and values are checked against the predictor's declaration (`params_of(name)`): an
+    unknown name or a value outside its range is a PredictorError that lists the names taken or
+    states the allowed range and unit.
+    """
+    return _predictor_class(name)(**params)

@@ -1,0 +1,166 @@
+"""Predictor parameters, declared once (`predictors.params`): every predictor's constructor, docstring,
+`make` and tuning read the one declaration; transforms invert; bad values name their range."""
+
+import inspect
+import math
+import re
+
+import jax
+import numpy as np
+import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+
+from predictors import PredictorError, make, names
+from predictors.params import LOG, LOGIT, NON_NEGATIVE, OPEN_UNIT, POSITIVE, Param, Range, declare_params
+from predictors.registry import params_of
+
+laws = settings(deadline=None, max_examples=50, derandomize=True)
+DECLARED = [(name, param) for name in names() for param in params_of(name)]
+
+
+def outside(param: Param) -> float:
+    """A value just outside the parameter's range."""
+    return param.range.low if not param.range.includes_low else math.nextafter(param.range.low, -math.inf)
+
+
+@pytest.mark.parametrize(("name", "param"), DECLARED, ids=[f"{n}.{p.name}" for n, p in DECLARED])
+def test_each_parameter_becomes_an_attribute_with_its_declared_default(name, param):
+    assert getattr(make(name), param.name) == param.default
+    assert param.default is None or param.range.contains(param.default)
+
+
+@pytest.mark.parametrize(("name", "param"), DECLARED, ids=[f"{n}.{p.name}" for n, p in DECLARED])
+def test_a_value_outside_the_range_is_an_error_naming_the_parameter_range_and_unit(name, param):
+    value = outside(param)
+    message = f"{name}: {param.name} must be {param.range.describe(param.unit)}"
+    with pytest.raises(PredictorError, match=f"^{re.escape(message)}.*, got {re.escape(repr(value))}$"):
+        make(name, **{param.name: value})
+    if param.unit:
+        assert f"of {param.unit}" in message
+
+
+@pytest.mark.parametrize(("name", "param"), DECLARED, ids=[f"{n}.{p.name}" for n, p in DECLARED])
+def test_only_a_parameter_that_defaults_to_none_takes_none(name, param):
+    if param.default is None:
+        assert getattr(make(name, **{param.name: None}), param.name) is None
+    else:
+        with pytest.raises(PredictorError, match=f"{param.name} must be"):
+            make(name, **{param.name: None})
+
+
+@pytest.mark.parametrize("name", names())
+def test_the_class_signature_and_docstring_come_from_the_declaration(name):
+    declared = params_of(name)
+    cls = type(make(name))
+    signature = inspect.signature(cls)
+    assert [(p.name, p.default, p.kind) for p in signature.parameters.values()] == [
+        (param.name, param.default, inspect.Parameter.KEYWORD_ONLY) for param in declared
+    ]
+    doc = " ".join(inspect.getdoc(cls).split())
+    for param in declared:
+        assert f"{param.name}: {param.range.describe(param.unit)}" in doc
+
+
+@pytest.mark.parametrize(("name", "param"), DECLARED, ids=[f"{n}.{p.name}" for n, p in DECLARED])
+def test_tuning_can_start_a_trainable_parameter_from_anywhere_in_its_range(name, param):
+    if not param.trainable:
+        return
+    transform = param.transform
+    assert transform is not None
+    edge_needs_a_start = param.range.includes_low and not transform.domain.contains(param.range.low)
+    assert not edge_needs_a_start or transform.domain.contains(param.tune_from)
+
+
+def test_values_are_floats_and_unknown_names_list_the_accepted_ones():
+    assert params_of("desp").resolve({"position_alpha": 1 / 4}) == {
+        "position_alpha": 0.25, "orientation_alpha": 0.5, "sample_interval": None, "max_gap": 1.0, "max_horizon": 0.5,
+    }
+    assert type(make("kalman-cv", max_gap=2).max_gap) is float
+    with pytest.raises(PredictorError, match="predictor 'desp' has no parameter alpha, beta; it takes: position_alpha, "):
+        params_of("desp").resolve({"beta": 1.0, "alpha": 0.5})
+    with pytest.raises(PredictorError, match="unknown predictor 'kalman'"):
+        params_of("kalman")
+
+
+@pytest.mark.parametrize(
+    ("allowed", "unit", "words"),
+    [
+        (POSITIVE, "metres", "a positive number of metres"),
+        (NON_NEGATIVE, "1/s", "zero or a positive number of 1/s"),
+        (OPEN_UNIT, "", "a number between 0 and 1 (exclusive)"),
+        (Range(0.0, 1.0, includes_low=True), "", "a number from 0 (inclusive) to 1 (exclusive)"),
+        (Range(2.0), "seconds", "a number of seconds above 2"),
+        (Range(2.0, includes_low=True), "seconds", "a number of seconds at least 2"),
+    ],
+)
+def test_a_range_says_what_it_allows(allowed, unit, words):
+    assert allowed.describe(unit) == words
+
+
+@given(st.floats(allow_nan=True))
+@example(0.0)
+@example(1.0)
+@example(math.inf)
+@laws
+def test_a_range_holds_exactly_what_it_describes(value):
+    assert POSITIVE.contains(value) == (0.0 < value < math.inf)
+    assert NON_NEGATIVE.contains(value) == (0.0 <= value < math.inf)
+    assert OPEN_UNIT.contains(value) == (0.0 < value < 1.0)
+
+
+@given(st.floats(1e-12, 1e12))
+@laws
+def test_log_maps_positive_values_there_and_back(value):
+    assert LOG.to_natural(LOG.to_unconstrained(value)) == pytest.approx(value, rel=1e-14)
+
+
+@given(st.floats(1e-9, 1.0 - 1e-9))
+@example(0.5)
+@laws
+def test_logit_maps_smoothing_factors_there_and_back(value):
+    assert LOGIT.to_natural(LOGIT.to_unconstrained(value)) == pytest.approx(value, rel=1e-9)
+
+
+@given(st.floats(-30.0, 30.0))
+@example(0.0)
+@laws
+def test_the_jax_inverses_are_the_numpy_ones(x):
+    with jax.enable_x64(True):
+        for transform in (LOG, LOGIT):
+            assert float(transform.to_natural_jax(np.float64(x))) == pytest.approx(float(transform.to_natural(x)), rel=1e-15)
+
+
+def test_a_trainable_parameter_needs_a_transform_and_a_set_no_repeats():
+    with pytest.raises(ValueError, match="'gain' is trainable, so it needs a transform"):
+        Param("gain", 0.5, "", "Share of each innovation taken.", OPEN_UNIT, trainable=True)
+    gain = Param("gain", 0.5, "", "Share of each innovation taken.", OPEN_UNIT, LOGIT, trainable=True)
+    with pytest.raises(ValueError, match="declares a parameter twice"):
+
+        @declare_params(gain, gain)
+        class Twice:
+            name = "twice"
+
+
+def test_a_new_predictor_declares_its_parameters_once():
+    gain = Param("gain", 0.5, "", "Share of each innovation taken.", OPEN_UNIT, LOGIT, trainable=True)
+    delay = Param("delay", 0.01, "seconds", "Transport delay to add.", NON_NEGATIVE)
+
+    @declare_params(gain, delay)
+    class Toy:
+        """A toy predictor."""
+
+        name = "toy"
+
+        def __init__(self, **values):
+            self.params.assign(self, values)
+
+    toy = Toy(delay=0.02)
+    assert (toy.gain, toy.delay) == (0.5, 0.02)
+    assert [p.name for p in Toy.params.trainable] == ["gain"]
+    assert str(inspect.signature(Toy)) == "(*, gain=0.5, delay=0.01)"
+    assert "delay: zero or a positive number of seconds; default 0.01. Transport delay to add." in Toy.__doc__
+    with pytest.raises(PredictorError, match="toy: gain must be a number between 0 and 1 \\(exclusive\\), got 1.5"):
+        Toy(gain=1.5)
+    with pytest.raises(PredictorError, match="predictor 'toy' has no parameter gian; it takes: gain, delay"):
+        Toy(gian=0.4)
