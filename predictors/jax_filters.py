@@ -9,7 +9,9 @@ Each function takes parameters (a NamedTuple of scalars, in natural units) and o
 in arrival order, and returns the pose predicted at `query_times[k]` after taking sample k, exactly
 what `predictors.evaluation.replay` records for the real-time predictor. Everything is jittable,
 differentiable in the parameters and vmappable over parameter sets and (equal-length) traces; pad
-shorter traces with `valid` False, which makes a step a no-op.
+shorter traces with `valid` False, which makes a step a no-op. `predictions` runs the twin of a
+predictor by name, its NamedTuple built from the parameter values by their declared names
+(`predictors.registry.params_of`).
 
 They implement the same models and sample rules as the real-time classes (see `predictors.kalman`
 and `predictors.desp`), with the covariance in the textbook form P <- F P F^T + Q and
@@ -18,19 +20,35 @@ P <- P - K H P instead of the factored form: the two agree to rounding, which th
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, Mapping, NamedTuple
 
 import jax
 import jax.numpy as jnp
 from jax import lax
 
-from predictors.desp import INTERVAL_RATE
-from predictors.kalman import INITIAL_ACCELERATION_STD, INITIAL_ANGULAR_SPEED_STD, INITIAL_SPEED_STD
+from predictors.desp import INTERVAL_RATE, ORIENTATION_ALPHA, POSITION_ALPHA, SAMPLE_INTERVAL
+from predictors.errors import PredictorError
+from predictors.kalman import (
+    ACCELERATION_NOISE,
+    ANGULAR_ACCELERATION_NOISE,
+    ANGULAR_VELOCITY_DAMPING,
+    INITIAL_ACCELERATION_STD,
+    INITIAL_ANGULAR_SPEED_STD,
+    INITIAL_SPEED_STD,
+    JERK_NOISE,
+    ORIENTATION_NOISE,
+    POSITION_NOISE,
+)
 from predictors.kinematic_covariance import SERIES_BELOW
+from predictors.params import MAX_GAP, MAX_HORIZON
 
 jax.config.update("jax_enable_x64", True)
 
 Array = jax.Array
+
+# The predictors that have a twin here, and the Kalman filters' orders.
+TWINNED = ("kalman-cv", "kalman-ca", "desp")
+_KALMAN_ORDERS = {"kalman-cv": 2, "kalman-ca": 3}
 
 _SMALL = 1e-8  # below this angle (rad) the series forms of sin(x)/x and x/sin(x) are exact in float64
 
@@ -60,6 +78,34 @@ class DespParams(NamedTuple):
     sample_interval: Array
     max_gap: Array
     max_horizon: Array
+
+
+def kalman_params(order: int, values: Mapping[str, Any]) -> KalmanParams:
+    """The twin's parameters from every parameter of `kalman-cv` (order 2) or `kalman-ca` (order 3)
+    by its declared name, as numbers or JAX scalars (traced ones too), in natural units."""
+    drive = ACCELERATION_NOISE if order == 2 else JERK_NOISE
+    return KalmanParams(
+        jnp.asarray(values[POSITION_NOISE.name]),
+        jnp.asarray(values[drive.name]),
+        jnp.asarray(values[ORIENTATION_NOISE.name]),
+        jnp.asarray(values[ANGULAR_ACCELERATION_NOISE.name]),
+        jnp.asarray(values[MAX_GAP.name]),
+        jnp.asarray(values[MAX_HORIZON.name]),
+        jnp.asarray(values[ANGULAR_VELOCITY_DAMPING.name]),
+    )
+
+
+def desp_params(values: Mapping[str, Any]) -> DespParams:
+    """The twin's parameters from every parameter of `desp` by its declared name (a sample_interval
+    of None, estimate it, becomes 0)."""
+    interval = values[SAMPLE_INTERVAL.name]
+    return DespParams(
+        jnp.asarray(values[POSITION_ALPHA.name]),
+        jnp.asarray(values[ORIENTATION_ALPHA.name]),
+        jnp.asarray(0.0 if interval is None else interval),
+        jnp.asarray(values[MAX_GAP.name]),
+        jnp.asarray(values[MAX_HORIZON.name]),
+    )
 
 
 class TraceArrays(NamedTuple):
@@ -351,3 +397,15 @@ def desp_predictions(params: DespParams, trace: TraceArrays) -> tuple[Array, Arr
 
     _, (positions, orientations) = lax.scan(step, empty, jnp.arange(n))
     return positions, orientations
+
+
+def predictions(predictor: str, values: Mapping[str, Any], trace: TraceArrays) -> tuple[Array, Array]:
+    """Predicted positions (N, 3) and orientations (N, 4) of the twin of `predictor` (one of
+    `TWINNED`), given every one of its parameters by declared name (`params_of(predictor).resolve`
+    gives them; any may be a traced JAX scalar)."""
+    if predictor == "desp":
+        return desp_predictions(desp_params(values), trace)
+    if predictor not in _KALMAN_ORDERS:
+        raise PredictorError(f"{predictor!r} has no JAX twin; twinned predictors: {', '.join(TWINNED)}")
+    order = _KALMAN_ORDERS[predictor]
+    return kalman_predictions(order, kalman_params(order, values), trace)

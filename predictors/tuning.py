@@ -5,19 +5,20 @@ The loss is the mean squared position error (m^2) plus the mean squared angular 
 sample of the training traces, each term divided by its value at the starting parameters so that
 metres and radians weigh alike (a trace without position motion drops its position term). It is
 computed by the JAX twins (`predictors.jax_filters`), vmapped over the traces, and minimised by
-`predictors.optimizer` in unconstrained coordinates:
+`predictors.optimizer` in unconstrained coordinates. What is fitted, and how, each predictor's
+parameter declaration says (`predictors.registry.params_of`): the `trainable` parameters, mapped
+by their `transform` (log or logit) and started from `tune_from` where the transform cannot take
+the value given (a damping of 0); the rest stay as given. A trained parameter is reported as
+fitted only where the part of the pose it `acts_on` moved in the traces.
 
-* `kalman-cv` / `kalman-ca`: the logarithms of the process noises (acceleration_noise or
-  jerk_noise, and angular_acceleration_noise) and of angular_velocity_damping. The predicted
-  means depend on process and measurement noise only through their ratio, so the measurement
-  noises stay as given (the tracker's datasheet values, or the defaults) and only the process
-  noises are fitted. The damping is a rate, not a noise: it shapes how far a velocity carries,
-  which no noise ratio can, and is fitted beside them (from `DAMPING_START` when the start has no
-  damping: log 0 is no starting point, and a one-second time constant predicts almost as the
-  undamped model at the horizons tuned for while giving the loss a slope in it);
-* `desp`: the logits of position_alpha and orientation_alpha;
-* `auto`: its filters' parameters as `kalman-cv` (jerk_noise stays as given: tune `kalman-ca`
-  for it), then `memory` and `margin`, which choose between models and so move the loss in steps
+* `kalman-cv` / `kalman-ca`: the process noises (acceleration_noise or jerk_noise, and
+  angular_acceleration_noise) and angular_velocity_damping. The predicted means depend on process
+  and measurement noise only through their ratio, so the measurement noises stay as given (the
+  tracker's datasheet values, or the defaults). The damping is a rate, not a noise: it shapes how
+  far a velocity carries, which no noise ratio can;
+* `desp`: position_alpha and orientation_alpha;
+* `auto`: the parameters it shares with `kalman-cv`, fitted as kalman-cv's, then its other
+  trainable ones, `memory` and `margin`, which choose between models and so move the loss in steps
   that no gradient sees, by the same loss (scaled as the filters' fit scaled it) over a grid
   (`AUTO_MEMORY_GRID_S` x `AUTO_MARGIN_GRID` and the starting values), each point scored by
   replaying the real-time `auto`.
@@ -27,6 +28,7 @@ Importing this module imports JAX and switches it to float64 (see `predictors.ja
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Sequence
@@ -39,22 +41,17 @@ from predictors import jax_filters
 from predictors.errors import PredictorError
 from predictors.evaluation import replay
 from predictors.optimizer import minimise
-from predictors.registry import make
+from predictors.params import Transform
+from predictors.registry import make, params_of
 from predictors.trace import Trace
 
-TUNABLE = ("kalman-cv", "kalman-ca", "desp", "auto")
+TUNABLE = (*jax_filters.TWINNED, "auto")
 
-# Where the damping search starts when the starting parameters have none (1/s).
-DAMPING_START = 1.0
-# The parameters `auto` shares with `kalman-cv`, fitted as kalman-cv's.
-AUTO_FILTER_PARAMS = (
-    "position_noise", "acceleration_noise", "orientation_noise", "angular_acceleration_noise",
-    "angular_velocity_damping", "max_gap", "max_horizon",
-)
 # auto's score time constant (s) and margin (fraction), searched on this grid (log-spaced: both act
-# multiplicatively) plus the starting values.
+# multiplicatively) plus the starting values: its trainable parameters that kalman-cv has not.
 AUTO_MEMORY_GRID_S = (0.1, 0.2, 0.5, 1.0, 2.0)
 AUTO_MARGIN_GRID = (0.05, 0.1, 0.2, 0.4)
+AUTO_GRIDS = {"memory": AUTO_MEMORY_GRID_S, "margin": AUTO_MARGIN_GRID}
 
 
 @dataclass(frozen=True)
@@ -98,52 +95,48 @@ def _stacked(traces: Sequence[Trace], horizon_s: float) -> tuple[jax_filters.Tra
 
 
 class _Parameterisation:
-    """Maps an unconstrained vector to a predictor's parameters and its JAX predictions."""
+    """Maps an unconstrained vector to a predictor's parameters and its JAX predictions: the
+    trainable parameters (each with a transform, as `Param` ensures) through their transforms, the
+    others fixed at `base` or their defaults."""
 
     def __init__(self, predictor: str, base: Mapping[str, Any]) -> None:
+        declared = params_of(predictor)
         self.predictor = predictor
-        self.instance = make(predictor, **base)
+        self.values = declared.resolve(base)
         self.base = dict(base)
-        if predictor == "desp":
-            self.names: tuple[str, ...] = ("position_alpha", "orientation_alpha")
-        else:
-            drive = "acceleration_noise" if predictor == "kalman-cv" else "jerk_noise"
-            self.names = (drive, "angular_acceleration_noise", "angular_velocity_damping")
+        self.trained = declared.trainable
+        # Runs of consecutive trained parameters under one transform, each mapped as one slice of x:
+        # one vectorised transform per run is the computation (and so the rounding) of the fit.
+        self.runs: list[tuple[int, int, Transform]] = []
+        for transform, run in itertools.groupby(enumerate(self.trained), key=lambda item: item[1].transform):
+            indices = [i for i, _ in run]
+            self.runs.append((indices[0], indices[-1] + 1, transform))
 
     def start(self) -> np.ndarray:
-        values = np.array([getattr(self.instance, name) for name in self.names])
-        if self.predictor == "desp":
-            return np.log(values / (1.0 - values))
-        values[-1] = values[-1] or DAMPING_START
-        return np.log(values)
+        """The unconstrained starting point: each trained value, or its `tune_from` where the
+        transform cannot take it."""
+        start = []
+        for param in self.trained:
+            transform, value = param.transform, self.values[param.name]
+            if not transform.domain.contains(value):
+                value = param.tune_from
+            start.append(transform.to_unconstrained(value))
+        return np.array(start)
 
     def natural(self, x: np.ndarray) -> dict[str, float]:
-        values = 1.0 / (1.0 + np.exp(-x)) if self.predictor == "desp" else np.exp(x)
-        return {name: float(v) for name, v in zip(self.names, values)}
+        return {param.name: float(param.transform.to_natural(v)) for param, v in zip(self.trained, x)}
 
     def predictions(self) -> Callable[[jax.Array, jax_filters.TraceArrays], tuple[jax.Array, jax.Array]]:
-        p = self.instance
-        if self.predictor == "desp":
-            interval = 0.0 if p.sample_interval is None else p.sample_interval
+        fixed, trained, runs, predictor = self.values, self.trained, self.runs, self.predictor
 
-            def run_desp(x: jax.Array, trace: jax_filters.TraceArrays) -> tuple[jax.Array, jax.Array]:
-                alphas = jax.nn.sigmoid(x)
-                params = jax_filters.DespParams(alphas[0], alphas[1], jnp.asarray(interval), jnp.asarray(p.max_gap),
-                                                jnp.asarray(p.max_horizon))
-                return jax_filters.desp_predictions(params, trace)
+        def predict(x: jax.Array, trace: jax_filters.TraceArrays) -> tuple[jax.Array, jax.Array]:
+            values = dict(fixed)
+            for start, stop, transform in runs:
+                natural = transform.to_natural_jax(x[start:stop])
+                values.update((trained[i].name, natural[i - start]) for i in range(start, stop))
+            return jax_filters.predictions(predictor, values, trace)
 
-            return run_desp
-        order = 2 if self.predictor == "kalman-cv" else 3
-
-        def run_kalman(x: jax.Array, trace: jax_filters.TraceArrays) -> tuple[jax.Array, jax.Array]:
-            values = jnp.exp(x)
-            params = jax_filters.KalmanParams(
-                jnp.asarray(p.position_noise), values[0], jnp.asarray(p.orientation_noise), values[1],
-                jnp.asarray(p.max_gap), jnp.asarray(p.max_horizon), values[2],
-            )
-            return jax_filters.kalman_predictions(order, params, trace)
-
-        return run_kalman
+        return predict
 
 
 @dataclass(frozen=True)
@@ -182,10 +175,8 @@ def _fit(predictor: str, traces: Sequence[Trace], horizon_s: float, params: Mapp
 
     best = minimise(loss, x0, max_iterations=max_iterations)
     fitted = model.natural(best.x)
-    informed = tuple(
-        name for name in model.names
-        if (position_scale if name in ("acceleration_noise", "jerk_noise", "position_alpha") else angular_scale) > 0.0
-    )
+    scales = {"position": position_scale, "orientation": angular_scale, "pose": max(position_scale, angular_scale)}
+    informed = tuple(param.name for param in model.trained if scales[param.acts_on] > 0.0)
     values = {**model.base, **{name: fitted[name] for name in informed}}
     result = TuneResult(predictor, values, informed, float(horizon_s),
                         float(position_scale * position0 + angular_scale * angular0), best.value, best.iterations)
@@ -212,20 +203,18 @@ def _replayed_loss(predictor: str, params: Mapping[str, Any], traces: Sequence[T
 
 def _tune_auto(traces: Sequence[Trace], horizon_s: float, params: Mapping[str, Any], max_iterations: int) -> TuneResult:
     """auto's filters as kalman-cv's by gradient, then memory and margin on a grid (module docstring)."""
-    start = make("auto", **params)
-    shared = {name: value for name, value in params.items() if name in AUTO_FILTER_PARAMS}
+    start = params_of("auto").resolve(params)
+    filter_names = params_of("kalman-cv").names
+    shared = {name: value for name, value in params.items() if name in filter_names}
     filters = _fit("kalman-cv", traces, horizon_s, shared, max_iterations)
     scales = (filters.position_scale, filters.angular_scale)
     fitted = {name: filters.result.params[name] for name in filters.result.fitted}
-    candidates = [
-        {**params, **fitted, "memory": memory, "margin": margin}
-        for memory in sorted({*AUTO_MEMORY_GRID_S, start.memory})
-        for margin in sorted({*AUTO_MARGIN_GRID, start.margin})
-    ]
+    axes = [sorted({*grid, start[name]}) for name, grid in AUTO_GRIDS.items()]
+    candidates = [{**params, **fitted, **dict(zip(AUTO_GRIDS, point))} for point in itertools.product(*axes)]
     losses = [_replayed_loss("auto", candidate, traces, horizon_s, *scales) for candidate in candidates]
     best = int(np.argmin(losses))
     return TuneResult(
-        "auto", candidates[best], (*filters.result.fitted, "memory", "margin"), float(horizon_s),
+        "auto", candidates[best], (*filters.result.fitted, *AUTO_GRIDS), float(horizon_s),
         _replayed_loss("auto", params, traces, horizon_s, *scales), losses[best], filters.result.iterations,
     )
 

@@ -6,10 +6,19 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from predictors import Trace, make
+from predictors import PredictorError, Trace, make
 from predictors import quaternion as quat
 from predictors.evaluation import replay
-from predictors.jax_filters import DespParams, KalmanParams, TraceArrays, desp_predictions, kalman_predictions
+from predictors.jax_filters import (
+    TWINNED,
+    DespParams,
+    KalmanParams,
+    TraceArrays,
+    desp_predictions,
+    kalman_predictions,
+    predictions,
+)
+from predictors.registry import params_of
 from predictors.synthetic import head_motion
 
 HORIZON = 0.05
@@ -96,3 +105,24 @@ def test_the_damped_twin_has_the_gradient_of_its_finite_differences_through_dupl
         difference = (value_and_grad(log_damping + step)[0] - value_and_grad(log_damping - step)[0]) / (2 * step)
         assert np.isfinite(gradient)
         assert float(gradient) == pytest.approx(float(difference), rel=1e-5)
+
+
+@pytest.mark.parametrize(
+    ("name", "params"),
+    [
+        ("kalman-cv", {"acceleration_noise": 3.0, "angular_velocity_damping": 2.0}),
+        ("kalman-ca", {"jerk_noise": 5.0, "position_noise": 0.002}),
+        ("desp", {"position_alpha": 0.3, "orientation_alpha": 0.8}),
+        ("desp", {"sample_interval": 1.0 / 60.0}),
+    ],
+)
+def test_a_twin_built_from_the_declared_parameters_agrees_with_the_real_time_predictor(awkward, name, params):
+    assert name in TWINNED
+    values = params_of(name).resolve(params)
+    positions, orientations = jax.jit(lambda trace: predictions(name, values, trace))(arrays(awkward))
+    assert_agree(awkward, make(name, **params), positions, orientations)
+
+
+def test_only_twinned_predictors_have_twins(awkward):
+    with pytest.raises(PredictorError, match="'auto' has no JAX twin; twinned predictors: kalman-cv, kalman-ca, desp"):
+        predictions("auto", params_of("auto").resolve({}), arrays(awkward))

@@ -9,8 +9,9 @@ from scipy.signal import lfilter
 
 from predictors import Trace, evaluate
 from predictors import scalar_quaternion as squat
+from predictors.registry import params_of
 from predictors.synthetic import head_motion
-from predictors.tuning import AUTO_MARGIN_GRID, AUTO_MEMORY_GRID_S, tune
+from predictors.tuning import AUTO_GRIDS, AUTO_MARGIN_GRID, AUTO_MEMORY_GRID_S, tune
 
 
 @pytest.fixture(scope="module")
@@ -83,3 +84,9 @@ def test_tuning_auto_fits_its_filters_then_picks_memory_and_margin_from_the_grid
         for name, params in (("auto", result.params), ("auto", {"orientation_noise": NOISE}), ("slerp", {}))
     )
     assert tuned < start and tuned < slerp
+
+
+def test_auto_fits_as_kalman_cv_what_they_share_and_the_rest_of_its_trainables_on_the_grid():
+    kalman, auto = params_of("kalman-cv"), {p.name for p in params_of("auto").trainable}
+    assert auto - set(kalman.names) == set(AUTO_GRIDS)
+    assert auto & set(kalman.names) == {p.name for p in kalman.trainable}
