@@ -1,13 +1,35 @@
 """Video to latency: blob tracking, phase, correlation, fit and posterior estimators, reports.
 
 ``analyse(video)`` tracks the pendulum's LED and the rendered sphere, and measures by how much the
-sphere lags the LED; ``write_tracks_csv`` saves the tracks it used. JAX is imported only when a
-fit (sinefit, bayes) is asked for.
+sphere lags the LED. It is two parts, which can be called alone: ``track(video) -> Tracks`` (read,
+calibrate, track, time and check) and ``estimate(tracks, method) -> LatencyResult`` (the free
+swing, the whole number of periods, the estimators). ``write_tracks_csv`` saves tracks; the
+estimators are listed by ``methods()``, and ``register_estimator`` adds one (see
+``analysis.estimators``). JAX is imported only when a fit (sinefit, bayes) is asked for, and no
+import changes a JAX setting.
 """
 
 from analysis.errors import AnalysisError
+from analysis.estimation import estimate
+from analysis.estimators.contract import EstimationContext, Estimator
+from analysis.estimators.registry import methods, register_estimator, unregister_estimator
 from analysis.pipeline import analyse
 from analysis.report import write_tracks_csv
-from analysis.result import METHODS, LatencyResult, MethodResult
+from analysis.result import LatencyResult, MethodResult
+from analysis.tracks import Tracks, track
 
-__all__ = ["METHODS", "AnalysisError", "LatencyResult", "MethodResult", "analyse", "write_tracks_csv"]
+__all__ = [
+    "AnalysisError",
+    "EstimationContext",
+    "Estimator",
+    "LatencyResult",
+    "MethodResult",
+    "Tracks",
+    "analyse",
+    "estimate",
+    "methods",
+    "register_estimator",
+    "track",
+    "unregister_estimator",
+    "write_tracks_csv",
+]

@@ -9,9 +9,6 @@ from analysis.cycles import CycleResolution
 from analysis.tracking import Roi, Track
 from analysis.windows import WindowedLatency
 
-METHODS = ("fft", "xcorr", "sinefit", "bayes")
-DEFAULT_METHOD = "sinefit"
-
 
 @dataclass(frozen=True)
 class MethodResult:

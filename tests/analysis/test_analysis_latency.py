@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from analysis import AnalysisError, analyse
-from analysis.pipeline import _checked_track
 from analysis.plots import plot_tracks
 from analysis.tracking import Track
+from analysis.tracks import check_track
 
 # sinefit's error on these clean clips stays far below a tenth of a camera frame...
 FRAMES_TOLERANCE = 0.1
@@ -360,8 +360,22 @@ def test_missing_frames_are_told_apart_as_dark_or_cut_off():
     peak[[10, 11, 12]] = 3.0
     track = Track(np.arange(200) / 100, np.where(valid, 1.0, np.nan), np.where(valid, 1.0, np.nan), valid, peak, clipped)
     warnings = []
-    _checked_track(track, "LED", warnings)
+    check_track(track, "LED", warnings)
     assert warnings == [
         "the LED was missing in 6 frames (3.0%), of them 3 dark (off or hidden) and 2 cut off by the ROI's edge; "
         "those frames were left out"
     ]
+
+
+def test_a_sinefit_analysis_is_the_same_whatever_the_callers_jax_precision(scene, render_video):
+    import jax
+
+    frames = render_video(scene(latency_s=0.02, duration_s=4.1, fps=120.0))
+    with jax.enable_x64(False):
+        in_32_bit = analyse(frames, fps=120.0)
+        assert not jax.config.jax_enable_x64
+    with jax.enable_x64(True):
+        in_64_bit = analyse(frames, fps=120.0)
+    assert in_32_bit.methods["sinefit"].fit.problem.data.tau.dtype == np.float64
+    assert in_32_bit.latency_ms == in_64_bit.latency_ms
+    assert in_32_bit.ci95_ms == in_64_bit.ci95_ms

@@ -12,10 +12,13 @@ swings is a cosine of the lag, which a parabola would fit with a bias.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
 from analysis.errors import AnalysisError
+from analysis.estimators.contract import EstimationContext
+from analysis.result import MethodResult
 
 
 def pearson_at_lag(led: np.ndarray, sphere: np.ndarray, lag: int) -> float:
@@ -57,3 +60,17 @@ def xcorr_latency(led: np.ndarray, sphere: np.ndarray, fps: float, period_s: flo
     best = int(lags[near][np.argmax(values[near])])
     before, at, after = (pearson_at_lag(led, sphere, best + d) for d in (-1, 0, 1))
     return (best + cosine_peak(before, at, after)) / fps
+
+
+class CrossCorrelationEstimator:
+    """The lag of the cross-correlation peak nearest the chosen latency."""
+
+    name = "xcorr"
+    gives_interval = False
+
+    def estimate(self, context: EstimationContext) -> MethodResult:
+        started = time.perf_counter()
+        swing = context.swing
+        _, led, sphere = swing.uniform
+        latency = xcorr_latency(led, sphere, swing.fps, swing.period_s, context.cycles.reference_s)
+        return MethodResult(self.name, latency * 1e3, None, "sine", time.perf_counter() - started, {})

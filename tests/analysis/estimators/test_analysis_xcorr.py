@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from analysis.xcorr import cosine_peak, pearson_at_lag, xcorr_latency
+from analysis.estimators.xcorr import cosine_peak, pearson_at_lag, xcorr_latency
 
 
 @given(st.floats(-0.5, 0.5), st.floats(0.05, 1.0), st.floats(0.1, 10.0))

@@ -1,0 +1,67 @@
+"""The estimators ``estimate`` and ``analyse`` know, by name, in the order they run and are reported.
+
+The built-in ones are listed in ``_estimators`` below: adding one is its module in this package
+and one entry there. A lab's own estimator (or a test's) is added from outside the package with
+``register_estimator`` and taken away with ``unregister_estimator``; it then runs under its name
+and with ``method="all"``, after the built-in ones, and the command line offers it.
+"""
+
+from __future__ import annotations
+
+from analysis.errors import AnalysisError
+from analysis.estimators.bayes import BayesEstimator
+from analysis.estimators.contract import Estimator
+from analysis.estimators.fft import FftPhaseEstimator
+from analysis.estimators.sinefit import SineFitEstimator
+from analysis.estimators.xcorr import CrossCorrelationEstimator
+
+DEFAULT_METHOD = "sinefit"
+# The method that asks for every estimator; its result is the default method's.
+ALL = "all"
+
+_estimators: dict[str, Estimator] = {
+    estimator.name: estimator
+    for estimator in (
+        FftPhaseEstimator(),
+        CrossCorrelationEstimator(),
+        SineFitEstimator(),
+        BayesEstimator(),
+    )
+}
+
+
+def methods() -> tuple[str, ...]:
+    """The registered estimators' names, in the order they run."""
+    return tuple(_estimators)
+
+
+def estimators_for(method: str) -> tuple[Estimator, ...]:
+    """The estimators ``method`` asks for: the one of that name, or every one for ALL.
+    AnalysisError for a name no estimator has."""
+    if method == ALL:
+        return tuple(_estimators.values())
+    if method not in _estimators:
+        raise AnalysisError(f"unknown method {method!r}; choose one of {', '.join(_estimators)} or {ALL}")
+    return (_estimators[method],)
+
+
+def register_estimator(estimator: Estimator) -> None:
+    """Make ``estimator`` available under its name, after those already registered.
+
+    ValueError if the name is taken (or is ALL), or if the object does not meet the contract.
+    """
+    name = getattr(estimator, "name", None)
+    if not isinstance(name, str) or not name or name == ALL:
+        raise ValueError(f"an estimator needs a name other than {ALL!r}, not {name!r}")
+    if name in _estimators:
+        raise ValueError(f"an estimator named {name!r} is already registered; unregister it first")
+    if not isinstance(getattr(estimator, "gives_interval", None), bool) or not callable(getattr(estimator, "estimate", None)):
+        raise ValueError(f"estimator {name!r} needs a bool gives_interval and an estimate(context) method")
+    _estimators[name] = estimator
+
+
+def unregister_estimator(name: str) -> None:
+    """Take the estimator called ``name`` away; ValueError if none is registered under it."""
+    if name not in _estimators:
+        raise ValueError(f"no estimator named {name!r} is registered")
+    del _estimators[name]

@@ -1,0 +1,274 @@
+"""The first part of an analysis: a video in, both blobs' tracks out (``track`` -> ``Tracks``).
+
+Most videos are decoded once. Their first frames are held to find the ROIs and their backgrounds
+(``analysis.calibration``), then every frame is tracked (and its row written to the tracks CSV) as
+it is decoded; from then on only the rectangle around both ROIs is decoded
+(``analysis.video.frames.Crop``). A video that can skip frames and decode rectangles cheaply
+(Motion-JPEG) is instead calibrated on a sample of its first frames and then read again from the
+start, every frame's rectangle alone. With all detections in hand the frame times are decided
+(``analysis.timing``), frames the recorder repeated are left out, and each track is checked.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import itertools
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from analysis.calibration import (
+    CALIBRATION_MAX_BYTES,
+    SIDES,
+    Calibration,
+    calibrate,
+    calibration_plan,
+    calibration_window,
+)
+from analysis.errors import AnalysisError
+from analysis.report import TrackStream, write_tracks_csv
+from analysis.timing import FrameTimes, check_count, frame_times, repeated_frames
+from analysis.tracking import BlobTracker, Detection, Roi, Track
+from analysis.video.file import VideoFile
+from analysis.video.frames import Crop, Frame, FrameSource
+from analysis.video.sources import open_frames
+
+# A track must have a blob in at least this fraction of frames; any frame without one is reported.
+MIN_VALID = 0.5
+# A blob cut off by its ROI's edge in more than this fraction of frames has left its ROI.
+MAX_CLIPPED = 0.1
+PROGRESS_EVERY = 64
+# Clips shorter than this (by their stated length) report no progress: they are done at once.
+PROGRESS_MIN_SECONDS = 3.0
+
+
+@dataclass(frozen=True)
+class Tracks:
+    """Both blobs' tracks in one video and how they were found: what ``track`` gives ``estimate``.
+
+    stamps holds each frame's time as the source recorded it (s, NaN where none); ``times`` the
+    frame times decided from them, which are the tracks' t. roi_source says where the ROIs came
+    from ("given" or "auto"), led_rule how the LED was told from the sphere. warnings are for the
+    user, in the order they arose; diagnostics are JSON-ready facts about the reading (time source,
+    dropped and repeated frames, detection rates, clipped frames); seconds is how long reading and
+    tracking took.
+    """
+
+    led: Track
+    sphere: Track
+    stamps: np.ndarray
+    times: FrameTimes
+    led_roi: Roi
+    sphere_roi: Roi
+    roi_source: str
+    led_rule: str
+    warnings: tuple[str, ...]
+    diagnostics: dict[str, Any]
+    seconds: float
+
+
+class _Tracked:
+    """Per-frame detections of both blobs, as lists, while the video is read."""
+
+    def __init__(self) -> None:
+        self.stamps: list[float] = []
+        self.rows: tuple[list[Detection], list[Detection]] = ([], [])
+
+    def track(self, stamp: float, detections: tuple[Detection, Detection]) -> None:
+        self.stamps.append(stamp)
+        self.rows[0].append(detections[0])
+        self.rows[1].append(detections[1])
+
+    def track_of(self, which: int, times: np.ndarray, drop: np.ndarray) -> Track:
+        rows = self.rows[which]
+        x = np.array([d.x for d in rows], dtype=np.float64)
+        y = np.array([d.y for d in rows], dtype=np.float64)
+        valid = np.array([d.valid for d in rows], dtype=bool) & ~drop
+        return Track(
+            t=times,
+            x=np.where(valid, x, np.nan),
+            y=np.where(valid, y, np.nan),
+            valid=valid,
+            peak=np.array([d.peak for d in rows], dtype=np.float64),
+            clipped=np.array([d.clipped for d in rows], dtype=bool),
+        )
+
+    def positions(self, which: int) -> tuple[np.ndarray, np.ndarray]:
+        rows = self.rows[which]
+        return np.array([d.x for d in rows]), np.array([d.y for d in rows])
+
+
+def _track_frames(
+    frames: Iterable[Frame],
+    trackers: tuple[BlobTracker, BlobTracker],
+    total: int,
+    progress: Callable[[int, int], object] | None,
+    stream: TrackStream | None,
+) -> _Tracked:
+    tracked = _Tracked()
+    for index, (stamp, image) in enumerate(frames):
+        detections = (trackers[0].locate(image), trackers[1].locate(image))
+        tracked.track(stamp, detections)
+        if stream is not None:
+            stream.write(index, stamp, *detections)
+        if progress is not None and (index + 1) % PROGRESS_EVERY == 0:
+            progress(index + 1, max(total, index + 1))
+    if progress is not None:
+        done = len(tracked.stamps)
+        progress(done, done)
+    return tracked
+
+
+def _bounds(first: Roi, second: Roi) -> tuple[slice, slice]:
+    """The rows and columns of the smallest rectangle holding both ROIs: all the tracker looks at,
+    so all that is decoded of each frame after calibration."""
+    rows = slice(min(first.y, second.y), max(first.y + first.height, second.y + second.height))
+    cols = slice(min(first.x, second.x), max(first.x + first.width, second.x + second.width))
+    return rows, cols
+
+
+def _read(
+    video: FrameSource,
+    given: tuple[Roi, Roi] | None,
+    led_side: str | None,
+    progress: Callable[[int, int], object] | None,
+    tracks_csv: str | Path | None,
+    warnings: list[str],
+) -> tuple[Calibration, _Tracked]:
+    """Calibrate on the first frames, then track every frame, each row going to ``tracks_csv`` as
+    it is measured (see the module docstring)."""
+    crop = Crop()
+    wanted, every = calibration_plan(video.fps, video.decodes_in_part)
+    with contextlib.ExitStack() as stack:
+        stream = stack.enter_context(contextlib.closing(video.frames(crop, every)))
+        rows = stack.enter_context(TrackStream(tracks_csv)) if tracks_csv is not None else None
+        first = next(stream)
+        window = calibration_window(first, stream, wanted, CALIBRATION_MAX_BYTES // first[1].nbytes, given)
+        calibration = calibrate([image for _, image in window[-wanted:]], given, led_side, warnings)
+        band_rows, band_cols = _bounds(calibration.led.roi, calibration.sphere.roi)
+        if every > 1:
+            stream.close()
+            window = []
+            stream = stack.enter_context(contextlib.closing(video.frames(crop)))
+        crop.to(band_rows, band_cols)
+        origin = (band_cols.start, band_rows.start)
+        tracked = _track_frames(
+            itertools.chain(((stamp, crop.cut(image)) for stamp, image in window), stream),
+            (BlobTracker(calibration.led, origin), BlobTracker(calibration.sphere, origin)),
+            video.frame_count,
+            progress,
+            rows,
+        )
+    return calibration, tracked
+
+
+def check_track(track: Track, name: str, warnings: list[str]) -> None:
+    """AnalysisError if the blob left its ROI or was found too rarely; else a warning for any frames
+    it is missing in, saying how many were dark and how many cut off."""
+    found = float(np.mean(track.valid))
+    clipped = float(np.mean(track.clipped))
+    if clipped > MAX_CLIPPED:
+        raise AnalysisError(
+            f"the {name} leaves its ROI (cut off by its edge) in {clipped:.0%} of frames; "
+            f"give a larger {name} ROI that holds its whole swing"
+        )
+    if found < MIN_VALID:
+        raise AnalysisError(
+            f"the {name} was found in only {found:.0%} of frames; check that its ROI holds it over "
+            "the whole swing and that nothing hides it"
+        )
+    missing = int(np.count_nonzero(~track.valid))
+    if missing:
+        # Dark: nothing near the blob's brightness anywhere in the ROI (an LED switched off for a
+        # blink code, a hand in front of it), as opposed to a blob seen but not measurable.
+        dark = int(np.count_nonzero(~track.valid & ~track.clipped & (track.peak < 0.5 * np.median(track.peak[track.valid]))))
+        cut = int(np.count_nonzero(track.clipped))
+        reasons = []
+        if dark:
+            reasons.append(f"{dark} dark (off or hidden)")
+        if cut:
+            reasons.append(f"{cut} cut off by the ROI's edge")
+        detail = f", of them {' and '.join(reasons)}" if reasons else ""
+        warnings.append(
+            f"the {name} was missing in {missing} frames ({1 - found:.1%}){detail}; those frames were left out"
+        )
+
+
+def _rois(
+    video: FrameSource, led_roi: Sequence[float] | None, sphere_roi: Sequence[float] | None
+) -> tuple[Roi, Roi] | None:
+    if (led_roi is None) != (sphere_roi is None):
+        raise AnalysisError("give both led_roi and sphere_roi, or neither to find them automatically")
+    if led_roi is None or sphere_roi is None:
+        return None
+    return Roi.parse(led_roi, video.frame_size, "LED"), Roi.parse(sphere_roi, video.frame_size, "sphere")
+
+
+def track(
+    source: str | Path | np.ndarray,
+    *,
+    fps: float | None = None,
+    led_roi: Sequence[float] | None = None,
+    sphere_roi: Sequence[float] | None = None,
+    led_side: str | None = None,
+    progress: Callable[[int, int], object] | None = None,
+    tracks_csv: str | Path | None = None,
+) -> Tracks:
+    """Track the LED and the rendered sphere in every frame of a video.
+
+    ``source`` is a video file, a folder of numbered images, or an array of frames, (N, H, W) grey
+    or (N, H, W, 3) BGR; ``fps`` overrides the file's frame rate and is required for arrays and
+    image folders. ROIs are [x, y, width, height] in pixels: give both or neither; without them the
+    two largest moving bright regions are used, the LED being the one on ``led_side`` ("left" or
+    "right") if given, else the brighter. ``progress(done, total)`` is called as frames are tracked
+    (for clips of PROGRESS_MIN_SECONDS or more). ``tracks_csv`` receives every frame's row as it is
+    measured, then the final table once the frame times are decided (``analysis.report``); it is
+    written before the tracks are checked, so tracks that fail a check stay on disk to look at.
+    """
+    if led_side is not None and led_side not in SIDES:
+        raise AnalysisError(f"led_side must be left or right, not {led_side!r}")
+    video = open_frames(source, fps)
+    given = _rois(video, led_roi, sphere_roi)
+    if video.fps is not None and video.frame_count < PROGRESS_MIN_SECONDS * video.fps:
+        progress = None
+    warnings: list[str] = []
+    started = time.perf_counter()
+    calibration, tracked = _read(video, given, led_side, progress, tracks_csv, warnings)
+    seconds = time.perf_counter() - started
+    stamps = np.array(tracked.stamps, dtype=np.float64)
+    times = frame_times(stamps, video.fps if fps is not None else None, video.container_fps, video.stamp_origin)
+    warnings.extend(times.warnings)
+    if isinstance(video, VideoFile):
+        count_warning = check_count(stamps.size, video.frame_count, video.name)
+        if count_warning:
+            warnings.append(count_warning)
+    repeats = repeated_frames(tracked.positions(0), tracked.positions(1))
+    if np.any(repeats):
+        warnings.append(
+            f"{int(np.count_nonzero(repeats))} frame(s) repeat the one before exactly (inserted by the recorder); "
+            "they were left out"
+        )
+    led = tracked.track_of(0, times.t, repeats)
+    sphere = tracked.track_of(1, times.t, repeats)
+    diagnostics: dict[str, Any] = {
+        "time_source": times.source,
+        "dropped_frames": times.dropped,
+        "repeated_frames": int(np.count_nonzero(repeats)),
+        "variable_frame_rate": times.variable,
+        "detection_rate": {"led": float(np.mean(led.valid)), "sphere": float(np.mean(sphere.valid))},
+        "clipped_frames": {"led": int(np.count_nonzero(led.clipped)), "sphere": int(np.count_nonzero(sphere.clipped))},
+    }
+    tracks = Tracks(
+        led, sphere, stamps, times, calibration.led.roi, calibration.sphere.roi, calibration.roi_source,
+        calibration.led_rule, tuple(warnings), diagnostics, seconds,
+    )  # fmt: skip
+    if tracks_csv is not None:
+        write_tracks_csv(tracks_csv, tracks)
+    check_track(led, "LED", warnings)
+    check_track(sphere, "sphere", warnings)
+    return dataclasses.replace(tracks, warnings=tuple(warnings))
