@@ -1,9 +1,11 @@
 """The Kalman and DESP predictors as pure JAX functions over `lax.scan`, for batched tuning.
 
-Importing this module switches JAX to float64 (`jax_enable_x64`): the twins must agree with the
-real-time predictors to 1e-9 and the filters' variances span many decades. Nothing else in
-`predictors` imports JAX, so the real-time path never pays for it; a program that needs float32
-JAX elsewhere should not import this module.
+The twins need float64: they must agree with the real-time predictors to 1e-9 and the filters'
+variances span many decades. Importing this module changes no JAX setting; make the arrays and run
+the twins inside `with jax.enable_x64(True):` (JAX's switch for the current thread, restored on
+leaving; `predictors.tuning.tune` does this itself). A twin given float32 times, as arrays made
+outside would be, raises PredictorError. Nothing else in `predictors` imports JAX, so the real-time
+path never pays for it.
 
 Each function takes parameters (a NamedTuple of scalars, in natural units) and one trace as arrays
 in arrival order, and returns the pose predicted at `query_times[k]` after taking sample k, exactly
@@ -41,8 +43,6 @@ from predictors.kalman import (
 )
 from predictors.kinematic_covariance import SERIES_BELOW
 from predictors.params import MAX_GAP, MAX_HORIZON
-
-jax.config.update("jax_enable_x64", True)
 
 Array = jax.Array
 
@@ -286,6 +286,14 @@ def _kalman_step(order: int, params: KalmanParams, s: _KalmanState, t: Array, z:
     )
 
 
+def _require_float64(trace: TraceArrays) -> None:
+    if trace.times.dtype != jnp.float64:
+        raise PredictorError(
+            f"the JAX twins need float64 times, got {trace.times.dtype}: make the arrays and run the twins "
+            "inside `with jax.enable_x64(True):`"
+        )
+
+
 def _select(condition: Array, a: NamedTuple, b: NamedTuple) -> NamedTuple:
     return jax.tree_util.tree_map(lambda x, y: jnp.where(condition, x, y), a, b)
 
@@ -295,6 +303,7 @@ def kalman_predictions(order: int, params: KalmanParams, trace: TraceArrays) -> 
     (order 3) at trace.query_times, sample by sample. `order` is static."""
     if order not in (2, 3):
         raise ValueError(f"order must be 2 or 3, got {order!r}")
+    _require_float64(trace)
     n = trace.times.shape[0]
     empty = _KalmanState(
         jnp.asarray(False), jnp.asarray(0.0), jnp.zeros((order, 3)), jnp.eye(order), jnp.array([1.0, 0.0, 0.0, 0.0]),
@@ -352,6 +361,7 @@ def _desp_smoothed(params: DespParams, s1: Array, s2: Array, q1: Array, q2: Arra
 
 def desp_predictions(params: DespParams, trace: TraceArrays) -> tuple[Array, Array]:
     """Predicted positions (N, 3) and orientations (N, 4) of `desp` at trace.query_times."""
+    _require_float64(trace)
     n = trace.times.shape[0]
     zero3, identity = jnp.zeros(3), jnp.array([1.0, 0.0, 0.0, 0.0])
     false = jnp.asarray(False)

@@ -26,7 +26,8 @@ class Minimum:
 
 
 def minimise(fun: Callable[[jax.Array], jax.Array], x0: np.ndarray, max_iterations: int = 50, tolerance: float = 1e-6) -> Minimum:
-    """Minimise fun (a scalar, differentiable JAX function of a 1-D array) from x0 by L-BFGS-B."""
+    """Minimise fun (a scalar, differentiable JAX function of a 1-D array) from x0 by L-BFGS-B, in
+    float64: call it inside `jax.enable_x64(True)`, as `predictors.tuning.tune` does."""
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="JAXopt is no longer maintained", category=DeprecationWarning)
         import jaxopt

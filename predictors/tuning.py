@@ -23,7 +23,8 @@ fitted only where the part of the pose it `acts_on` moved in the traces.
   (`AUTO_MEMORY_GRID_S` x `AUTO_MARGIN_GRID` and the starting values), each point scored by
   replaying the real-time `auto`.
 
-Importing this module imports JAX and switches it to float64 (see `predictors.jax_filters`).
+Importing this module imports JAX and changes none of its settings: `tune` computes in float64
+inside `jax.enable_x64(True)` (see `predictors.jax_filters`), restoring the caller's setting.
 """
 
 from __future__ import annotations
@@ -227,13 +228,14 @@ def tune(
     max_iterations: int = 40,
 ) -> TuneResult:
     """Fit `predictor`'s parameters (starting from `params`, else its defaults) to predict the
-    training `traces` `horizon_s` seconds ahead."""
+    training `traces` `horizon_s` seconds ahead, in float64 whatever the caller's JAX setting."""
     if predictor not in TUNABLE:
         raise PredictorError(f"cannot tune {predictor!r}; tunable predictors: {', '.join(TUNABLE)}")
     if not traces:
         raise PredictorError("tuning needs at least one training trace")
     if not (math.isfinite(horizon_s) and horizon_s >= 0.0):
         raise PredictorError(f"the horizon must be zero or a positive number of seconds, got {horizon_s!r}")
-    if predictor == "auto":
-        return _tune_auto(traces, horizon_s, params or {}, max_iterations)
-    return _fit(predictor, traces, horizon_s, params or {}, max_iterations).result
+    with jax.enable_x64(True):
+        if predictor == "auto":
+            return _tune_auto(traces, horizon_s, params or {}, max_iterations)
+        return _fit(predictor, traces, horizon_s, params or {}, max_iterations).result

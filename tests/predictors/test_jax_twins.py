@@ -1,5 +1,6 @@
 """The JAX twins agree with the real-time predictors to 1e-9, also vmapped, on a trace with every
-awkward feature: sign flips, duplicate and out-of-order times, a drop-out."""
+awkward feature: sign flips, duplicate and out-of-order times, a drop-out. They need float64, which
+each test turns on for itself (`jax.enable_x64`), as a user of the twins does."""
 
 import jax
 import jax.numpy as jnp
@@ -22,6 +23,12 @@ from predictors.registry import params_of
 from predictors.synthetic import head_motion
 
 HORIZON = 0.05
+
+
+@pytest.fixture(autouse=True)
+def float64():
+    with jax.enable_x64(True):
+        yield
 
 
 @pytest.fixture(scope="module")
@@ -121,6 +128,14 @@ def test_a_twin_built_from_the_declared_parameters_agrees_with_the_real_time_pre
     values = params_of(name).resolve(params)
     positions, orientations = jax.jit(lambda trace: predictions(name, values, trace))(arrays(awkward))
     assert_agree(awkward, make(name, **params), positions, orientations)
+
+
+def test_a_twin_refuses_float32_arrays_naming_the_switch(awkward):
+    with jax.enable_x64(False):
+        trace = arrays(awkward)
+        params = DespParams(*map(jnp.asarray, (0.6, 0.7, 0.0, 1.0, 0.5)))
+        with pytest.raises(PredictorError, match=r"need float64 times, got float32.*jax.enable_x64\(True\)"):
+            desp_predictions(params, trace)
 
 
 def test_only_twinned_predictors_have_twins(awkward):

@@ -2,7 +2,12 @@
 fitted damping is the motion's own, and auto's choice is fitted on a grid."""
 
 import math
+import os
+import subprocess
+import sys
+from pathlib import Path
 
+import jax
 import numpy as np
 import pytest
 from scipy.signal import lfilter
@@ -30,6 +35,24 @@ def test_tuning_kalman_cv_lowers_held_out_error_from_a_poor_start(traces):
     after = evaluate("kalman-cv", held_out, [0.05], result.params, timing_repeats=1).at(50.0)
     assert after.angular_rms_deg < before.angular_rms_deg
     assert after.position_rms_mm < before.position_rms_mm
+
+
+def test_importing_the_twins_and_tuning_leaves_jax_in_float32():
+    code = "import predictors, predictors.jax_filters, predictors.tuning, jax; print(jax.config.jax_enable_x64)"
+    environment = {k: v for k, v in os.environ.items() if k != "JAX_ENABLE_X64"}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=environment,
+                          cwd=Path(__file__).resolve().parents[2])
+    assert done.stdout.strip() == "False"
+
+
+def test_tuning_computes_in_float64_whatever_the_callers_setting_and_restores_it(traces):
+    train = traces[0]
+    results = {}
+    for caller in (False, True):
+        with jax.enable_x64(caller):
+            results[caller] = tune("desp", [train], 0.02, max_iterations=2)
+            assert jax.config.jax_enable_x64 is caller
+    assert results[False] == results[True]
 
 
 def test_tuning_an_untunable_predictor_is_a_clear_error(traces):
