@@ -6,6 +6,7 @@ import json
 import cv2
 import pytest
 
+from analysis import MethodResult, register_estimator, unregister_estimator
 from rig.cli import main
 
 
@@ -63,3 +64,27 @@ def test_latency_range_option_is_checked(clip_file, capsys):
         main(["analyse", str(clip_file), "--latency-range", "300,-100"])
     assert exit_.value.code == 2
     assert "LOW must be below HIGH" in capsys.readouterr().err
+
+
+class ChosenPeriods:
+    """A lab's own estimator: the latency as the whole-period choice left it (no fit, so quick)."""
+
+    name = "chosen-periods"
+    gives_interval = False
+
+    def estimate(self, context):
+        return MethodResult(self.name, context.cycles.reference_s * 1e3, None, "sine", 0.0, {})
+
+
+def test_method_choices_follow_the_estimator_registry(clip_file, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["analyse", str(clip_file), "--method", "chosen-periods"])
+    assert exit_.value.code == 2 and "invalid choice" in capsys.readouterr().err
+    register_estimator(ChosenPeriods())
+    try:
+        assert main(["analyse", str(clip_file), "--method", "chosen-periods", "--json"]) == 0
+    finally:
+        unregister_estimator("chosen-periods")
+    report = json.loads(capsys.readouterr().out)
+    assert report["method"] == "chosen-periods" and list(report["methods"]) == ["chosen-periods"]
+    assert report["latency_ms"] == pytest.approx(45.0, abs=0.5)
