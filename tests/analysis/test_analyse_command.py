@@ -88,3 +88,6 @@ def test_method_choices_follow_the_estimator_registry(clip_file, capsys):
     report = json.loads(capsys.readouterr().out)
     assert report["method"] == "chosen-periods" and list(report["methods"]) == ["chosen-periods"]
     assert report["latency_ms"] == pytest.approx(45.0, abs=0.5)
+    with pytest.raises(SystemExit) as exit_:
+        main(["analyse", str(clip_file), "--method", "chosen-periods"])
+    assert exit_.value.code == 2
