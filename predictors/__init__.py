@@ -7,7 +7,8 @@
     pose = predictor.predict(0.016)
 
 Predictors (`names()`): hold, slerp, kalman-cv, kalman-ca, desp, auto; each class documents its
-parameters and their units. `evaluate` scores one on a `Trace` (`read_trace` reads CSV files).
+parameters and their units. `evaluate` scores one on a `Trace` (`read_trace` reads CSV files);
+`SAMPLE_COLUMNS`, `sample_row` and `read_samples` are the one file format of tracker samples.
 `predictors.quaternion` holds the vectorised quaternion maths, (w, x, y, z) Hamilton;
 `predictors.synthetic` generates head motion. Tuning (`predictors.tuning`) and the JAX twins of the
 filters (`predictors.jax_filters`) import JAX, so they are imported only by name, never from here:
@@ -20,9 +21,10 @@ from predictors.evaluation import Evaluation, HorizonScore, evaluate
 from predictors.params_file import read_params, write_params
 from predictors.pose import Pose, PoseSample
 from predictors.registry import Predictor, make, names
-from predictors.trace import Trace, read_trace, write_trace
+from predictors.trace import SAMPLE_COLUMNS, Trace, read_samples, read_trace, sample_row, write_trace
 
 __all__ = [
+    "SAMPLE_COLUMNS",
     "Evaluation",
     "HorizonScore",
     "Pose",
@@ -35,7 +37,9 @@ __all__ = [
     "names",
     "quaternion",
     "read_params",
+    "read_samples",
     "read_trace",
+    "sample_row",
     "write_params",
     "write_trace",
 ]

@@ -1,8 +1,12 @@
-"""Traces: recorded or simulated tracker samples, with the motion to score predictions against.
+"""Tracker samples on disk, and traces: samples with the motion to score predictions against.
 
-A trace file is CSV with the header `t,px,py,pz,qw,qx,qy,qz` (seconds, metres, unit quaternion
-w-first) and optionally a `t_arrival` column (s, when the host received the sample; the sensor time
-`t` when absent). The rig's tracker recordings (`t_sensor,t_arrival,...`) read as traces too.
+One file format holds tracker samples everywhere (what the rig records, simulated or live; what
+benches, tuning and notebooks read): CSV with the header `t_sensor,t_arrival,px,py,pz,qw,qx,qy,qz`
+(`SAMPLE_COLUMNS`: seconds on the rig clock, metres, unit quaternion w-first), one row per sample
+in the order the host received them. The rig writes it row by row as samples arrive and ends every
+row with a newline in the same write, so in such a file a last line without one is a row cut short
+by a crash: readers skip it. Recordings from elsewhere read as traces too with a `t` column (the
+sensor time) instead of `t_sensor`, and `t_arrival` optional (the sensor time when absent).
 
 A `Trace` holds the samples a predictor is fed and the truth it is scored against. For a recording
 the truth is the recording itself; `with_noise` and `with_delay` change the samples and leave the
@@ -24,6 +28,7 @@ from predictors.errors import PredictorError
 from predictors.pose import PoseSample
 
 POSE_COLUMNS = ("px", "py", "pz", "qw", "qx", "qy", "qz")
+SAMPLE_COLUMNS = ("t_sensor", "t_arrival", *POSE_COLUMNS)
 _NORM_TOLERANCE = 1e-3
 
 
@@ -196,27 +201,61 @@ def _checked(name: str, t: np.ndarray, position: np.ndarray, orientation: np.nda
     return t, position, orientation / norm[:, None]
 
 
+def sample_row(sample: PoseSample) -> tuple[float, ...]:
+    """The values of one sample in `SAMPLE_COLUMNS` order."""
+    return (sample.t_sensor, sample.t_arrival, *sample.position.tolist(), *sample.orientation.tolist())
+
+
+def _table(path: Path, what: str) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """The header and the numbered, non-empty rows of a CSV file; in a file of the rig's own format, a
+    last row without its newline (cut short by a crash) is left out."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise PredictorError(f"cannot read {what} {path}: {error}") from None
+    lines = text.split("\n")
+    header = [name.strip() for name in next(csv.reader([lines[0]]))] if lines[0] else []
+    if header[:1] == ["t_sensor"]:
+        lines = lines[:-1]
+    rows = [(number, row) for number, row in enumerate(csv.reader(lines[1:]), start=2) if row]
+    return header, rows
+
+
+def read_samples(path: str | os.PathLike[str]) -> list[PoseSample]:
+    """The samples of a file in the rig's format (`SAMPLE_COLUMNS`), in file order, exactly as
+    written; PredictorError naming the line of a malformed row."""
+    path = Path(path)
+    header, rows = _table(path, "tracker samples from")
+    if tuple(header) != SAMPLE_COLUMNS:
+        raise PredictorError(f"{path} is not a tracker sample file: its first line must be {','.join(SAMPLE_COLUMNS)}")
+    samples = []
+    for number, row in rows:
+        try:
+            if len(row) != len(SAMPLE_COLUMNS):
+                raise ValueError(f"expected {len(SAMPLE_COLUMNS)} comma-separated numbers, got {len(row)}")
+            values = [float(cell) for cell in row]
+            samples.append(PoseSample(values[0], values[1], np.array(values[2:5]), np.array(values[5:9])))
+        except (ValueError, PredictorError) as error:
+            raise PredictorError(f"{path}, line {number}: {error}") from None
+    return samples
+
+
 def read_trace(path: str | os.PathLike[str]) -> Trace:
     """A trace from a CSV file (see the module docstring); PredictorError naming what is wrong."""
     path = Path(path)
-    try:
-        with open(path, newline="", encoding="utf-8") as file:
-            rows = list(csv.reader(file))
-    except (OSError, UnicodeDecodeError) as error:
-        raise PredictorError(f"cannot read trace {path}: {error}") from None
-    if not rows:
-        raise PredictorError(f"trace {path} is empty; it needs the header t,{','.join(POSE_COLUMNS)}")
-    header = [name.strip() for name in rows[0]]
+    header, rows = _table(path, "trace")
+    if not header:
+        raise PredictorError(f"trace {path} is empty; it needs the header {','.join(SAMPLE_COLUMNS)}")
     time_column = "t" if "t" in header else "t_sensor"
     missing = [c for c in (time_column, *POSE_COLUMNS) if c not in header]
     if missing:
         raise PredictorError(
-            f"trace {path} lacks column(s) {', '.join(missing)}; the header must hold t,{','.join(POSE_COLUMNS)} "
-            "(and optionally t_arrival)"
+            f"trace {path} lacks column(s) {', '.join(missing)}; the header must hold "
+            f"{','.join(SAMPLE_COLUMNS)} (or t instead of t_sensor, and t_arrival optional)"
         )
     columns = [header.index(c) for c in (time_column, *POSE_COLUMNS)]
     arrival = header.index("t_arrival") if "t_arrival" in header else None
-    body = [row for row in rows[1:] if row]
+    body = [row for _, row in rows]
     try:
         values = np.array([[float(row[c]) for c in columns] for row in body], dtype=np.float64)
         t_arrival = None if arrival is None else np.array([float(row[arrival]) for row in body])
@@ -228,8 +267,9 @@ def read_trace(path: str | os.PathLike[str]) -> Trace:
 
 
 def write_trace(path: str | os.PathLike[str], trace: Trace) -> None:
-    """Write the trace's samples as CSV with a t_arrival column; floats round-trip exactly."""
+    """Write the trace's samples in the rig's format (`SAMPLE_COLUMNS`), in the trace's order;
+    floats round-trip exactly."""
     with open(path, "w", newline="", encoding="utf-8") as file:
-        file.write("t,t_arrival," + ",".join(POSE_COLUMNS) + "\n")
+        file.write(",".join(SAMPLE_COLUMNS) + "\n")
         for row in np.column_stack([trace.t, trace.t_arrival, trace.position, trace.orientation]):
             file.write(",".join(repr(float(v)) for v in row) + "\n")
