@@ -1,4 +1,4 @@
-"""`rig bench analyser`: each estimator's error, interval coverage and speed on videos of known latency.
+"""The analyser bench (`rig bench analyser`): each estimator's error, interval coverage and speed on videos of known latency.
 
 The simulated rig films a grid of cases whose latency it knows: pendulum periods 0.6 to 1.9 s,
 cameras 60 to 480 fps, displays 60 to 144 Hz, swings of 5 to 45 degrees, quality factors 20 to 500,
@@ -28,11 +28,7 @@ small latency, asks the pendulum for times past the end of its simulated window.
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
-import sys
-import tempfile
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -42,11 +38,10 @@ import cv2
 import numpy as np
 
 import analysis
-from analysis.video import open_frames
-from rig.commands import options
-from rig.errors import RigError
-from rig.session import SimulationConfig, simulate
-from rig.sim.camera import CameraConfig, VideoFileWriter
+from analysis.video.sources import open_frames
+from rig.records import VideoRecord
+from rig.service import SimulationConfig, Truth, simulate
+from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
 from rig.sim.tracker import TrackerConfig
@@ -167,20 +162,20 @@ def quick_grid() -> list[Case]:
 def _rewrite(video: Path, out: Path, change: Callable[[int, np.ndarray], np.ndarray], fps: float) -> Path:
     """Write ``video``'s frames, changed, to ``out`` as the simulated camera writes them."""
     source = open_frames(video)
-    writer = VideoFileWriter(out, fps, *source.frame_size)
+    writer = VideoRecord(out, fps, *source.frame_size)
     with writer:
         for index, (_, frame) in enumerate(source.frames()):
             writer.write(change(index, frame))
     return out
 
 
-def impaired(video: Path, case: Case, truth: dict[str, Any], seed: int) -> Path:
+def impaired(video: Path, case: Case, truth: Truth, seed: int) -> Path:
     """The case's video after its impairment (the original for those the simulation makes itself)."""
     fps = case.config.camera.fps
     if case.impairment == "blur":
         return _rewrite(video, video.with_name("blurred.avi"), lambda _, f: cv2.GaussianBlur(f, (0, 0), BLUR_SIGMA_PX), fps)
     if case.impairment == "missing":
-        x, y, w, h = truth["sphere_roi"]
+        x, y, w, h = truth.sphere_roi
         frames = [frame for _, frame in open_frames(video).frames()]
         background = np.median(np.stack([f[y : y + h, x : x + w] for f in frames[:: max(1, len(frames) // 31)]]), axis=0)
         hidden = set(np.random.default_rng(seed).choice(len(frames), round(MISSING_FRACTION * len(frames)), replace=False).tolist())
@@ -207,7 +202,7 @@ def run_case(case: Case, folder: Path, log: Log) -> dict[str, Any]:
     """Simulate, impair, decode and analyse one case; one JSON-ready row."""
     started = time.perf_counter()
     run = simulate(case.config, folder, overwrite=True)
-    truth_ms = float(run.truth["latency_ms"])
+    truth_ms = float(run.truth.latency_ms)
     video = impaired(run.video_path, case, run.truth, case.config.seed)
     simulated = time.perf_counter() - started
     first_decode, frames = decode_seconds(video)
@@ -275,7 +270,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
     """Per method: error statistics over unambiguous cases, interval coverage, speed."""
     summary = {}
     decode_total = sum(row["decode_s"] for row in rows)
-    for name in analysis.METHODS:
+    for name in analysis.methods():
         clear = [row["methods"][name] for row in rows if not row["ambiguous"]]
         errors_ms = np.abs([m["error_ms"] for m in clear])
         errors_frames = np.abs([m["error_frames"] for m in clear])
@@ -376,45 +371,3 @@ def run_bench(cases: list[Case], folder: Path, log: Log) -> dict[str, Any]:
         rows.append(run_case(case, folder / f"case{index:03d}", log))
     summary = summarise(rows)
     return {"summary": summary, "targets_met": targets_met(summary), "cases": rows}
-
-
-def _log(message: str) -> None:
-    print(message, file=sys.stderr, flush=True)
-
-
-def _run(args: argparse.Namespace) -> int:
-    cases = quick_grid() if args.quick else grid(args.cases)
-    with tempfile.TemporaryDirectory(prefix="rig-bench-analyser-") as scratch:
-        folder = args.runs if args.runs is not None else Path(scratch)
-        report = run_bench(cases, folder, _log)
-    if args.json is not None:
-        try:
-            args.json.write_text(json.dumps(report, indent=1))
-        except OSError as error:
-            raise RigError(f"cannot write {args.json}: {error}") from error
-    if args.plot is not None:
-        try:
-            plot(report["summary"], report["cases"], args.plot)
-        except OSError as error:
-            raise RigError(f"cannot write {args.plot}: {error}") from error
-    print(table(report["summary"]))
-    for target, met in report["targets_met"].items():
-        print(f"{target}: {'met' if met else 'not met' if met is not None else 'n/a'}")
-    return 0
-
-
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
-        "analyser",
-        help="error, interval coverage and speed of each latency estimator on simulated videos",
-        description="Simulate videos of known latency over a grid of periods, frame rates, refresh rates, "
-        "swings, damping and impairments, analyse each with every method, and report per method the median "
-        "and worst error, the coverage of the 95%% intervals and the speed against decoding alone. "
-        "The default grid takes about ten minutes on two cores; --quick runs two tiny cases.",
-    )
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the summary and every case as JSON")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot speed against error per method")
-    parser.add_argument("--quick", action="store_true", help="two short cases (a smoke test)")
-    parser.add_argument("--cases", type=options.positive_int, default=DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
-    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the simulated videos here (default: a temporary folder)")
-    parser.set_defaults(func=_run)

@@ -1,4 +1,4 @@
-"""`rig bench predictors`: every predictor on every trace, speed against error.
+"""The predictor bench (`rig bench predictors`): every predictor on every trace, speed against error.
 
 Default traces:
 
@@ -16,20 +16,14 @@ error if asked.
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
-import predictors
 from predictors import Evaluation, Trace, evaluate, read_trace
 from predictors.synthetic import head_motion
-from rig.commands import options
-from rig.errors import ConfigError
-from rig.progress import ProgressBar
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import TrackerConfig, simulate_tracker
 
@@ -56,17 +50,6 @@ def default_traces(duration_s: float, seed: int) -> list[Trace]:
     """The pendulum, the synthetic head and the real head-motion trace."""
     head = head_motion(duration_s, 120.0, seed).with_noise(0.0005, math.radians(0.1), seed)
     return [pendulum_trace(duration_s, seed), head, read_trace(REAL_TRACE)]
-
-
-def horizons_ms(text: str) -> tuple[float, ...]:
-    """A comma-separated list of horizons in ms, each >= 0."""
-    try:
-        values = tuple(float(part) for part in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected horizons in ms separated by commas, got {text!r}") from None
-    if not all(math.isfinite(v) and v >= 0.0 for v in values):
-        raise argparse.ArgumentTypeError(f"horizons must be zero or positive milliseconds, got {text!r}")
-    return values
 
 
 def table(results: Sequence[Evaluation], horizons: Sequence[float]) -> str:
@@ -125,7 +108,7 @@ def run_bench(
     specs: Sequence[tuple[str, dict[str, Any]]],
     horizons: Sequence[float],
     timing_repeats: int,
-    progress: ProgressBar | None = None,
+    progress: Callable[[float, float], object] | None = None,
 ) -> list[Evaluation]:
     """Every predictor spec on every trace."""
     results = []
@@ -136,48 +119,3 @@ def run_bench(
             if progress is not None:
                 progress(i * len(specs) + j + 1, total)
     return results
-
-
-def _run(args: argparse.Namespace) -> int:
-    horizons = args.horizons_ms
-    traces = [read_trace(path) for path in args.trace] if args.trace else default_traces(args.duration, args.seed)
-    specs = args.predictor or [(name, {}) for name in predictors.names()]
-    if args.plot_horizon_ms not in horizons:
-        raise ConfigError(f"--plot-horizon-ms {args.plot_horizon_ms:g} must be one of --horizons-ms {','.join(f'{h:g}' for h in horizons)}")
-    results = run_bench(traces, specs, horizons, args.timing_repeats, ProgressBar("benchmarking predictors"))
-    print(table(results, horizons))
-    ratios = cost_ratios(results)
-    for trace, ratio in ratios.items():
-        print(f"kalman-cv / desp cost on {trace}: {ratio:.2f}")
-    if args.json:
-        record = {"horizons_ms": list(horizons), "kalman_cv_over_desp_cost": ratios, "results": [r.to_dict() for r in results]}
-        args.json.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
-    if args.plot:
-        plot(results, args.plot_horizon_ms, args.plot)
-    return 0
-
-
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
-    """Register `predictors` (under `rig bench`)."""
-    parser = subparsers.add_parser(
-        "predictors",
-        help="score every predictor on traces: error at several horizons against cost per update",
-        description=__doc__.split("\n\n")[0] + " With no --trace, runs the simulated pendulum, the synthetic head "
-        "and the real head-motion trace.",
-    )
-    parser.add_argument("--trace", type=Path, action="append", metavar="FILE",
-                        help="trace CSV (t,px,py,pz,qw,qx,qy,qz[,t_arrival]); repeat for several (default: the built-in three)")
-    parser.add_argument("--predictor", type=options.predictor_spec, action="append", metavar="NAME[:key=value,...]",
-                        help="predictor and parameters, or NAME:FILE.json; repeat for several (default: every predictor)")
-    parser.add_argument("--horizons-ms", type=horizons_ms, default=DEFAULT_HORIZONS_MS, metavar="H,H,...",
-                        help="prediction horizons after each sample's arrival (default: 0,10,20,50,100)")
-    parser.add_argument("--plot-horizon-ms", type=options.non_negative_float, default=50.0,
-                        help="the horizon the plot shows (default: %(default)s)")
-    parser.add_argument("--duration", type=options.positive_float, default=30.0,
-                        help="seconds of simulated pendulum and synthetic head (default: %(default)s)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the simulated traces (default: %(default)s)")
-    parser.add_argument("--timing-repeats", type=options.non_negative_int, default=3,
-                        help="timed replays per predictor and trace; the best counts (default: %(default)s)")
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write every score as JSON")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="draw speed against error")
-    parser.set_defaults(func=_run)

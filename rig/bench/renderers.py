@@ -1,4 +1,4 @@
-"""`rig bench renderers`: cost, latency and image error of the direct and the warp renderer against scene size.
+"""The renderer bench (`rig bench renderers`): cost, latency and image error of the direct and the warp renderer against scene size.
 
 For each display resolution and load of N triangles:
 
@@ -25,13 +25,8 @@ period); a latency that would need a period over the grid's limit is reported as
 
 from __future__ import annotations
 
-import argparse
-import csv
-import json
 import os
 import platform
-import sys
-import tempfile
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -42,14 +37,13 @@ import numpy as np
 import analysis
 from analysis import AnalysisError
 from predictors import Pose
-from rig.commands import options
-from rig.errors import ConfigError, RigError
 from rig.render import gl
 from rig.render.direct import DirectRenderer
 from rig.render.image_error import lab_error_percent, psnr_db
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, RenderSetup
 from rig.render.warp import WarpRenderer
-from rig.session import DEFAULT_WARP_MS, SimulationConfig, simulate
+from rig.service import SimulationConfig, simulate
+from rig.session import DEFAULT_SERVER_MS
 from rig.sim.bench import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -225,7 +219,7 @@ def measure_latency(
     Returns the measured and true latency (ms), the spread of the per-display-frame delay, the
     period used, and a note; latencies are None when the expected one needs too long a period.
     """
-    server_s = DEFAULT_WARP_MS / 1e3 if renderer == "warp" else 0.0
+    server_s = DEFAULT_SERVER_MS / 1e3 if renderer == "warp" else 0.0
     expected_s = (2.0 * cost_s if renderer == "direct" else server_s) + 0.1
     period = max(PendulumConfig().period_s, expected_s / LATENCY_PERIOD_FRACTION)
     if period > grid.max_period_s:
@@ -249,20 +243,20 @@ def measure_latency(
         warmup_s=max(cost_s + 0.5, period),
     )
     run = simulate(config, out_dir, overwrite=True)
-    server = f", server {DEFAULT_WARP_MS:g} ms modelled" if renderer == "warp" else ""
+    server = f", server {DEFAULT_SERVER_MS:g} ms modelled" if renderer == "warp" else ""
     note = (
         f"cost measured, then modelled: {cost_s * 1e3:.1f} ms per application frame{server}; "
         f"simulated at {width}x{height}, predictor {predictor}"
     )
     figures = {
         "latency_measured_ms": None,
-        "latency_true_ms": run.truth["latency_ms"],
-        "latency_sd_ms": run.truth["display_frame_delay_ms"]["sd"],
+        "latency_true_ms": run.truth.latency_ms,
+        "latency_sd_ms": run.truth.display_frame_delay_ms.sd,
         "latency_period_s": period,
     }
     try:
         # the ROIs of the simulated bench, as a lab marks them once for its camera
-        result = analysis.analyse(run.video_path, led_roi=run.truth["led_roi"], sphere_roi=run.truth["sphere_roi"])
+        result = analysis.analyse(run.video_path, led_roi=run.truth.led_roi, sphere_roi=run.truth.sphere_roi)
     except AnalysisError as error:
         return {**figures, "latency_note": f"{note}; the analyser failed: {error}"}
     if result.ambiguous:
@@ -336,169 +330,3 @@ def run_bench(grid: BenchGrid, predictors: dict[str, str], runs_dir: Path, log: 
             if (row["renderer"], row["triangles"], (row["width"], row["height"])) == (renderer, triangles, first):
                 row.update(figures)
     return rows
-
-
-def write_csv(rows: list[dict[str, Any]], path: Path) -> None:
-    with path.open("w", newline="") as stream:
-        writer = csv.DictWriter(stream, fieldnames=ROW_FIELDS)
-        writer.writeheader()
-        writer.writerows(rows)
-
-
-def plot_rows(rows: list[dict[str, Any]], path: Path) -> None:
-    """Latency against N for both renderers, and image error against warp time."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    figure, (left, right) = plt.subplots(1, 2, figsize=(12, 4.8))
-    for renderer, colour in (("direct", "tab:red"), ("warp", "tab:blue")):
-        points = {
-            r["triangles"]: r for r in rows if r["renderer"] == renderer and r["latency_measured_ms"] is not None
-        }
-        n = sorted(points)
-        if n:
-            left.errorbar(n, [points[k]["latency_measured_ms"] for k in n], yerr=[points[k]["latency_sd_ms"] for k in n],
-                          marker="o", color=colour, capsize=3, label=f"{renderer}, measured from video")  # fmt: skip
-            left.plot(n, [points[k]["latency_true_ms"] for k in n], "x--", color=colour, alpha=0.6, label=f"{renderer}, true")
-        beyond = sorted({r["triangles"] for r in rows if r["renderer"] == renderer and str(r["latency_note"]).startswith("beyond")})
-        for k in beyond:
-            left.annotate("beyond range", (k, 1.0), xycoords=("data", "axes fraction"), ha="center", va="top",
-                          color=colour, fontsize=8, rotation=90)  # fmt: skip
-    left.set_xscale("log")
-    left.set_yscale("log")
-    left.set_xlabel("load triangles")
-    left.set_ylabel("latency (ms); bars: sd of the per-frame delay")
-    left.set_title("latency against scene size")
-    left.legend(fontsize=8)
-    warp = [r for r in rows if r["renderer"] == "warp"]
-    for (width, height), marker in zip(sorted({(r["width"], r["height"]) for r in warp}), "os^Dv"):
-        for ratio, colour in zip(sorted({r["rate_ratio"] for r in warp}), ("tab:green", "tab:orange", "tab:purple", "tab:brown")):
-            chosen = [r for r in warp if (r["width"], r["height"], r["rate_ratio"]) == (width, height, ratio)]
-            right.scatter([r["frame_ms_median"] for r in chosen], [r["lab_error_pct"] for r in chosen], marker=marker,
-                          color=colour, label=f"{width}x{height}, client:display 1:{ratio}")  # fmt: skip
-    right.set_xlabel("warp time per display frame (ms, median)")
-    right.set_ylabel("pixels with Lab error > 10 (%)")
-    right.set_title("image error against warp time (one point per N)")
-    right.legend(fontsize=8)
-    figure.tight_layout()
-    try:
-        figure.savefig(path, dpi=110)
-    except OSError as error:
-        raise RigError(f"cannot write the plot {path}: {error}") from error
-    finally:
-        plt.close(figure)
-
-
-def _format(value: Any, digits: int = 1) -> str:
-    if value is None:
-        return "-"
-    return f"{value:.{digits}f}" if isinstance(value, float) else str(value)
-
-
-def print_table(rows: list[dict[str, Any]]) -> None:
-    print(f"{'renderer':8} {'N':>9} {'size':>9} {'ratio':>5} {'frame ms':>9} {'p95':>8} {'gpu ms':>7} {'cpu ms':>8} {'client ms':>9} "
-          f"{'lat meas':>8} {'lat true':>8} {'sd':>5} {'Lab>10 %':>8} {'PSNR':>5} {'holes %':>7}")  # fmt: skip
-    for r in rows:
-        ratio = f"1:{r['rate_ratio']}" if r["rate_ratio"] else "-"
-        print(
-            f"{r['renderer']:8} {r['triangles']:>9} {r['width']}x{r['height']:<4} {ratio:>5} {_format(r['frame_ms_median']):>9} "
-            f"{_format(r['frame_ms_p95']):>8} {_format(r['frame_gpu_ms_median']):>7} {_format(r['frame_cpu_ms_median']):>8} "
-            f"{_format(r['client_ms_median']):>9} "
-            f"{_format(r['latency_measured_ms']):>8} {_format(r['latency_true_ms']):>8} {_format(r['latency_sd_ms']):>5} "
-            f"{_format(r['lab_error_pct'], 2):>8} {_format(r['psnr_db']):>5} {_format(r['hole_pct'], 2):>7}"
-        )
-    notes = sorted({r["latency_note"] for r in rows if r["latency_note"]})
-    for note in notes:
-        print(f"latency: {note}")
-    print(f"machine: {rows[0]['machine']}" if rows else "no rows")
-
-
-def _int_list(text: str) -> tuple[int, ...]:
-    values = tuple(options.non_negative_int(part) for part in text.split(","))
-    if not values:
-        raise argparse.ArgumentTypeError(f"expected a comma-separated list of whole numbers, got {text!r}")
-    return values
-
-
-def _ratio_list(text: str) -> tuple[int, ...]:
-    values = _int_list(text)
-    if min(values) < 1:
-        raise argparse.ArgumentTypeError(f"rate ratios are display frames per client frame, at least 1, got {text!r}")
-    return values
-
-
-def _resolution_list(text: str) -> tuple[tuple[int, int], ...]:
-    sizes = []
-    for part in text.split(","):
-        w, sep, h = part.lower().partition("x")
-        try:
-            size = (int(w), int(h))
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT[,WIDTHxHEIGHT...], got {text!r}") from None
-        if not sep or min(size) < 16:
-            raise argparse.ArgumentTypeError(f"a resolution is WIDTHxHEIGHT, each at least 16, got {part!r}")
-        sizes.append(size)
-    return tuple(sizes)
-
-
-def grid_from_args(args: argparse.Namespace) -> BenchGrid:
-    grid = QUICK_GRID if args.quick else BenchGrid()
-    changes = {name: getattr(args, name) for name in ("triangles", "resolutions", "ratios") if getattr(args, name) is not None}
-    return replace(grid, **changes)
-
-
-def _run(args: argparse.Namespace) -> int:
-    grid = grid_from_args(args)
-    outputs = [path for path in (args.json, args.csv, args.plot) if path is not None]
-    for path in outputs:
-        if not path.parent.exists():
-            raise ConfigError(f"cannot write {path}: folder {path.parent} does not exist")
-
-    def log(line: str) -> None:
-        print(line, file=sys.stderr, flush=True)
-
-    predictors = {"direct": args.direct_predictor, "warp": args.predictor}
-    if args.runs is not None:
-        args.runs.mkdir(parents=True, exist_ok=True)
-        rows = run_bench(grid, predictors, args.runs, log)
-    else:
-        with tempfile.TemporaryDirectory(prefix="rig-bench-") as runs:
-            rows = run_bench(grid, predictors, Path(runs), log)
-    if args.json is not None:
-        args.json.write_text(json.dumps(rows, indent=1) + "\n")
-    if args.csv is not None:
-        write_csv(rows, args.csv)
-    if args.plot is not None:
-        plot_rows(rows, args.plot)
-    print_table(rows)
-    return 0
-
-
-def add_parser(subparsers: argparse._SubParsersAction) -> None:
-    parser = subparsers.add_parser(
-        "renderers",
-        help="frame cost, latency and image error of the direct and warp renderers against scene size",
-        description="Time the direct renderer and the warp renderer's client and server for load sizes and "
-        "display resolutions, measure the image error of warped frames against direct renders, and the latency "
-        "`rig analyse` finds in simulated videos (frame costs measured, then modelled). The default grid takes "
-        "several minutes; --quick runs a tiny one.",
-    )
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the rows as a JSON list")
-    parser.add_argument("--csv", type=Path, metavar="OUT", help="write the rows as CSV")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot latency against N and error against warp time")
-    parser.add_argument("--quick", action="store_true", help="a tiny grid (a smoke test, seconds not minutes)")
-    parser.add_argument("--triangles", type=_int_list, metavar="N,N,...", help="load sizes (default 10000,100000,1000000,5000000)")
-    parser.add_argument("--resolutions", type=_resolution_list, metavar="WxH,...", help="display sizes (default 640x480,1280x720)")
-    parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
-    parser.add_argument("--predictor", default="slerp", help="the warp renderer's predictor in the latency runs (default: %(default)s)")
-    parser.add_argument(
-        "--direct-predictor",
-        default="hold",
-        help="the direct renderer's predictor in the latency runs (default: %(default)s, as the seeds' reference "
-        "renderer, which sampled the tracker just before drawing: linear prediction across a frame of seconds "
-        "overshoots the swing)",
-    )
-    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the latency runs' videos here (default: a temporary folder)")
-    parser.set_defaults(func=_run)

@@ -1,11 +1,226 @@
-"""`rig bench SUBJECT`: benchmarks that print a table and write JSON and a plot of speed against error."""
+"""`rig bench SUBJECT`: benchmarks that print a table and write JSON and a plot of speed against error.
+
+The subjects are the modules of `rig.bench`, each registered here with its options (SUBJECTS).
+"""
 
 from __future__ import annotations
 
 import argparse
-import importlib
+import json
+import math
+import sys
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, Callable
 
-SUBJECTS = ("analyser", "predictors", "renderers")
+import predictors
+from predictors import read_trace
+from rig.bench import analyser, predictors as predictor_bench, renderer_report, renderers
+from rig.commands import options
+from rig.errors import ConfigError, RigError
+from rig.progress import ProgressBar
+
+
+def _log(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def _write_json(path: Path, record: Any) -> None:
+    try:
+        path.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
+    except OSError as error:
+        raise RigError(f"cannot write {path}: {error}") from error
+
+
+def _plot(draw: Callable[[], None], path: Path) -> None:
+    try:
+        draw()
+    except OSError as error:
+        raise RigError(f"cannot write the plot {path}: {error}") from error
+
+
+# -- analyser ------------------------------------------------------------------------------------
+
+
+def _run_analyser(args: argparse.Namespace) -> int:
+    cases = analyser.quick_grid() if args.quick else analyser.grid(args.cases)
+    with tempfile.TemporaryDirectory(prefix="rig-bench-analyser-") as scratch:
+        folder = args.runs if args.runs is not None else Path(scratch)
+        report = analyser.run_bench(cases, folder, _log)
+    if args.json is not None:
+        _write_json(args.json, report)
+    if args.plot is not None:
+        _plot(lambda: analyser.plot(report["summary"], report["cases"], args.plot), args.plot)
+    print(analyser.table(report["summary"]))
+    for target, met in report["targets_met"].items():
+        print(f"{target}: {'met' if met else 'not met' if met is not None else 'n/a'}")
+    return 0
+
+
+def _add_analyser(benchmarks: argparse._SubParsersAction) -> None:
+    parser = benchmarks.add_parser(
+        "analyser",
+        help="error, interval coverage and speed of each latency estimator on simulated videos",
+        description="Simulate videos of known latency over a grid of periods, frame rates, refresh rates, "
+        "swings, damping and impairments, analyse each with every method, and report per method the median "
+        "and worst error, the coverage of the 95%% intervals and the speed against decoding alone. "
+        "The default grid takes about fifteen minutes on two cores; --quick runs two tiny cases.",
+    )
+    parser.add_argument("--json", type=Path, metavar="OUT", help="write the summary and every case as JSON")
+    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot speed against error per method")
+    parser.add_argument("--quick", action="store_true", help="two short cases (a smoke test)")
+    parser.add_argument("--cases", type=options.positive_int, default=analyser.DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
+    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the simulated videos here (default: a temporary folder)")
+    parser.set_defaults(func=_run_analyser)
+
+
+# -- predictors ----------------------------------------------------------------------------------
+
+
+def _horizons_ms(text: str) -> tuple[float, ...]:
+    """A comma-separated list of horizons in ms, each >= 0."""
+    try:
+        values = tuple(float(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected horizons in ms separated by commas, got {text!r}") from None
+    if not all(math.isfinite(v) and v >= 0.0 for v in values):
+        raise argparse.ArgumentTypeError(f"horizons must be zero or positive milliseconds, got {text!r}")
+    return values
+
+
+def _run_predictors(args: argparse.Namespace) -> int:
+    horizons = args.horizons_ms
+    if args.plot_horizon_ms not in horizons:
+        raise ConfigError(f"--plot-horizon-ms {args.plot_horizon_ms:g} must be one of --horizons-ms {','.join(f'{h:g}' for h in horizons)}")
+    traces = [read_trace(path) for path in args.trace] if args.trace else predictor_bench.default_traces(args.duration, args.seed)
+    specs = args.predictor or [(name, {}) for name in predictors.names()]
+    results = predictor_bench.run_bench(traces, specs, horizons, args.timing_repeats, ProgressBar("benchmarking predictors"))
+    print(predictor_bench.table(results, horizons))
+    ratios = predictor_bench.cost_ratios(results)
+    for trace, ratio in ratios.items():
+        print(f"kalman-cv / desp cost on {trace}: {ratio:.2f}")
+    if args.json:
+        _write_json(args.json, {"horizons_ms": list(horizons), "kalman_cv_over_desp_cost": ratios, "results": [r.to_dict() for r in results]})
+    if args.plot:
+        _plot(lambda: predictor_bench.plot(results, args.plot_horizon_ms, args.plot), args.plot)
+    return 0
+
+
+def _add_predictors(benchmarks: argparse._SubParsersAction) -> None:
+    parser = benchmarks.add_parser(
+        "predictors",
+        help="score every predictor on traces: error at several horizons against cost per update",
+        description=predictor_bench.__doc__.split("\n\n")[0] + " With no --trace, runs the simulated pendulum, the "
+        "synthetic head and the real head-motion trace.",
+    )
+    parser.add_argument("--trace", type=Path, action="append", metavar="FILE",
+                        help="trace CSV (t_sensor,t_arrival,px,py,pz,qw,qx,qy,qz, or t instead of t_sensor); repeat "
+                        "for several (default: the built-in three)")  # fmt: skip
+    parser.add_argument("--predictor", type=options.predictor_spec, action="append", metavar="NAME[:key=value,...]",
+                        help="predictor and parameters, or NAME:FILE.json; repeat for several (default: every predictor: "
+                        f"{', '.join(predictors.names())})")  # fmt: skip
+    parser.add_argument("--horizons-ms", type=_horizons_ms, default=predictor_bench.DEFAULT_HORIZONS_MS, metavar="H,H,...",
+                        help="prediction horizons after each sample's arrival (default: 0,10,20,50,100)")  # fmt: skip
+    parser.add_argument("--plot-horizon-ms", type=options.non_negative_float, default=50.0,
+                        help="the horizon the plot shows (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--duration", type=options.positive_float, default=30.0,
+                        help="seconds of simulated pendulum and synthetic head (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--seed", type=int, default=0, help="seed of the simulated traces (default: %(default)s)")
+    parser.add_argument("--timing-repeats", type=options.non_negative_int, default=3,
+                        help="timed replays per predictor and trace; the best counts (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--json", type=Path, metavar="OUT", help="write every score as JSON")
+    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="draw speed against error")
+    parser.set_defaults(func=_run_predictors)
+
+
+# -- renderers -----------------------------------------------------------------------------------
+
+
+def _int_list(text: str) -> tuple[int, ...]:
+    values = tuple(options.non_negative_int(part) for part in text.split(","))
+    if not values:
+        raise argparse.ArgumentTypeError(f"expected a comma-separated list of whole numbers, got {text!r}")
+    return values
+
+
+def _ratio_list(text: str) -> tuple[int, ...]:
+    values = _int_list(text)
+    if min(values) < 1:
+        raise argparse.ArgumentTypeError(f"rate ratios are display frames per client frame, at least 1, got {text!r}")
+    return values
+
+
+def _resolution_list(text: str) -> tuple[tuple[int, int], ...]:
+    sizes = []
+    for part in text.split(","):
+        w, sep, h = part.lower().partition("x")
+        try:
+            size = (int(w), int(h))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT[,WIDTHxHEIGHT...], got {text!r}") from None
+        if not sep or min(size) < 16:
+            raise argparse.ArgumentTypeError(f"a resolution is WIDTHxHEIGHT, each at least 16, got {part!r}")
+        sizes.append(size)
+    return tuple(sizes)
+
+
+def _run_renderers(args: argparse.Namespace) -> int:
+    grid = renderers.QUICK_GRID if args.quick else renderers.BenchGrid()
+    grid = replace(grid, **{name: getattr(args, name) for name in ("triangles", "resolutions", "ratios") if getattr(args, name) is not None})
+    for path in (args.json, args.csv, args.plot):
+        if path is not None and not path.parent.exists():
+            raise ConfigError(f"cannot write {path}: folder {path.parent} does not exist")
+    bench_predictors = {"direct": args.direct_predictor, "warp": args.predictor}
+    if args.runs is not None:
+        args.runs.mkdir(parents=True, exist_ok=True)
+        rows = renderers.run_bench(grid, bench_predictors, args.runs, _log)
+    else:
+        with tempfile.TemporaryDirectory(prefix="rig-bench-") as runs:
+            rows = renderers.run_bench(grid, bench_predictors, Path(runs), _log)
+    if args.json is not None:
+        _write_json(args.json, rows)
+    if args.csv is not None:
+        renderer_report.write_csv(rows, args.csv)
+    if args.plot is not None:
+        renderer_report.plot_rows(rows, args.plot)
+    print(renderer_report.table(rows))
+    return 0
+
+
+def _add_renderers(benchmarks: argparse._SubParsersAction) -> None:
+    parser = benchmarks.add_parser(
+        "renderers",
+        help="frame cost, latency and image error of the direct and warp renderers against scene size",
+        description="Time the direct renderer and the warp renderer's client and server for load sizes and "
+        "display resolutions, measure the image error of warped frames against direct renders, and the latency "
+        "`rig analyse` finds in simulated videos (frame costs measured, then modelled). The default grid takes "
+        "several minutes; --quick runs a tiny one.",
+    )
+    parser.add_argument("--json", type=Path, metavar="OUT", help="write the rows as a JSON list")
+    parser.add_argument("--csv", type=Path, metavar="OUT", help="write the rows as CSV")
+    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot latency against N and error against warp time")
+    parser.add_argument("--quick", action="store_true", help="a tiny grid (a smoke test, seconds not minutes)")
+    parser.add_argument("--triangles", type=_int_list, metavar="N,N,...", help="load sizes (default 10000,100000,1000000,5000000)")
+    parser.add_argument("--resolutions", type=_resolution_list, metavar="WxH,...", help="display sizes (default 640x480,1280x720)")
+    parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
+    parser.add_argument("--predictor", default="slerp", help="the warp renderer's predictor in the latency runs (default: %(default)s)")
+    parser.add_argument(
+        "--direct-predictor",
+        default="hold",
+        help="the direct renderer's predictor in the latency runs (default: %(default)s, as the seeds' reference "
+        "renderer, which sampled the tracker just before drawing: linear prediction across a frame of seconds "
+        "overshoots the swing)",
+    )
+    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the latency runs' videos here (default: a temporary folder)")
+    parser.set_defaults(func=_run_renderers)
+
+
+SUBJECTS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
+    "analyser": _add_analyser,
+    "predictors": _add_predictors,
+    "renderers": _add_renderers,
+}
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -15,5 +230,5 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description="Benchmarks are commands, not tests: each prints a table and writes JSON and a PNG.",
     )
     benchmarks = parser.add_subparsers(dest="bench", required=True, metavar="SUBJECT")
-    for subject in SUBJECTS:
-        importlib.import_module(f"rig.bench.{subject}").add_parser(benchmarks)
+    for add in SUBJECTS.values():
+        add(benchmarks)

@@ -8,66 +8,23 @@ from __future__ import annotations
 
 import argparse
 import json
-from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
-from analysis import LatencyResult
-from analysis.plots import plot_tracks
-from rig.commands import simulate
-from rig.commands.analyse import run_analysis, summary_line
-from rig.errors import RigError
-from rig.session import DEFAULT_WARP_MS, SimulationConfig
+from rig.commands.formatting import summary_line
+from rig.commands.simulation_options import add_simulation_options, config_from_args
+from rig.progress import ProgressBar
+from rig.service import compare_renderers, comparison_config, demo
+from rig.service.demo import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
+from rig.session import DEFAULT_SERVER_MS
+from rig.sim.config import SimulationConfig
 
-AGREEMENT_MS = 1.0
 EXIT_MISMATCH = 1
-COMPARE_RENDERERS = ("direct", "warp")
-COMPARE_TRIANGLES = 100_000
-COMPARE_APP_FRAME_MS = 100.0
-
-
-def _measure(config: SimulationConfig, out: Path) -> tuple[dict[str, Any], LatencyResult]:
-    """Simulate `config` into `out`, analyse the video, plot both trajectories: the report and the
-    analysis."""
-    # A demo folder holds synthetic data only: rerunning the demo replaces a previous simulation
-    # (recognised by its truth.json) but never anything else.
-    sim = simulate.run_simulation(config, out, overwrite=(out / "truth.json").exists())
-    result = run_analysis(sim.video_path)
-    true_ms = sim.truth["latency_ms"]
-    difference = result.latency_ms - true_ms
-    plot_path = out / "demo.png"
-    try:
-        plot_tracks(result, plot_path, title=f"rig demo: measured {result.latency_ms:.2f} ms, true {true_ms:.2f} ms")
-    except OSError as error:
-        raise RigError(f"cannot write the plot {plot_path}: {error}") from error
-    report = {
-        "latency_true_ms": true_ms,
-        "latency_measured_ms": result.latency_ms,
-        "difference_ms": difference,
-        "agrees": abs(difference) <= AGREEMENT_MS and not result.ambiguous,
-        "analysis": result.to_dict(),
-        "simulation": simulate.summary(sim),
-        "plot": str(plot_path),
-    }
-    return report, result
-
-
-def _config(args: argparse.Namespace) -> SimulationConfig:
-    """The simulated rig the options describe; for --compare, a scene left at the defaults (no load,
-    cheap frames) becomes the heavy one."""
-    config = simulate.config_from_args(args)
-    defaults = SimulationConfig()
-    if args.compare and config.scene_triangles == defaults.scene_triangles:
-        config = replace(config, scene_triangles=COMPARE_TRIANGLES)
-    if args.compare and config.app_frame_ms == defaults.app_frame_ms:
-        config = replace(config, app_frame_ms=COMPARE_APP_FRAME_MS)
-    return config
 
 
 def _run(args: argparse.Namespace) -> int:
-    config = _config(args)
+    config = config_from_args(args)
     if args.compare:
-        return _run_comparison(args, config)
+        return _run_comparison(args, comparison_config(config))
     out: Path = args.out
     if not args.json:
         print(
@@ -75,18 +32,19 @@ def _run(args: argparse.Namespace) -> int:
             f"{config.tracker.rate_hz:g} Hz tracker, predictor {config.predictor}, renderer {config.renderer}, "
             f"{config.camera.fps:g} fps camera -> {out}"
         )
-    report, result = _measure(config, out)
+    report = demo(config, out, ProgressBar)
     if args.json:
-        print(json.dumps(report))
+        print(json.dumps(report.to_dict()))
     else:
-        verdict = "OK" if report["agrees"] else "MISMATCH"
-        print(f"true latency      {report['latency_true_ms']:8.2f} ms  (truth.json: what an ideal analyser measures)")
-        print(f"measured latency  {result.latency_ms:8.2f} ms  ({summary_line(result)})")
-        print(f"difference        {report['difference_ms']:+8.2f} ms  {verdict}: the analyser should agree within {AGREEMENT_MS:g} ms")
-        print(f"plot of both trajectories: {report['plot']}")
+        result = report.measurement.result
+        verdict = "OK" if report.agrees else "MISMATCH"
+        print(f"true latency      {report.true_ms:8.2f} ms  (truth.json: what an ideal analyser measures)")
+        print(f"measured latency  {report.measured_ms:8.2f} ms  ({summary_line(result)})")
+        print(f"difference        {report.difference_ms:+8.2f} ms  {verdict}: the analyser should agree within {AGREEMENT_MS:g} ms")
+        print(f"plot of both trajectories: {report.plot}")
         for warning in result.warnings:
             print(f"warning: {warning}")
-    return 0 if report["agrees"] else EXIT_MISMATCH
+    return 0 if report.agrees else EXIT_MISMATCH
 
 
 def _cost_text(ms: float | None, what: str) -> str:
@@ -98,25 +56,24 @@ def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
         print(
             f"comparing {' and '.join(COMPARE_RENDERERS)} on one scene: {config.scene_triangles} load triangles, "
             f"{_cost_text(config.app_frame_ms, 'application frame')}, "
-            f"{_cost_text(config.warp_ms if config.warp_ms is not None else DEFAULT_WARP_MS, 'warp per refresh')}; "
+            f"{_cost_text(config.warp_ms if config.warp_ms is not None else DEFAULT_SERVER_MS, 'warp per refresh')}; "
             f"{config.duration_s:g} s at {config.display.refresh_hz:g} Hz, predictor {config.predictor} -> {args.out}/<renderer>"
         )
-    measured = {name: _measure(replace(config, renderer=name), args.out / name) for name in COMPARE_RENDERERS}
-    reports = {name: report for name, (report, _) in measured.items()}
-    agrees = all(report["agrees"] for report in reports.values())
+    reports = compare_renderers(config, args.out, ProgressBar)
+    agrees = all(report.agrees for report in reports.values())
     if args.json:
-        print(json.dumps(reports))
+        print(json.dumps({name: report.to_dict() for name, report in reports.items()}))
     else:
         print(f"{'renderer':10} {'true latency':>14} {'measured latency':>18} {'difference':>12}")
         for name, report in reports.items():
-            verdict = "OK" if report["agrees"] else "MISMATCH"
+            verdict = "OK" if report.agrees else "MISMATCH"
             print(
-                f"{name:10} {report['latency_true_ms']:11.2f} ms {report['latency_measured_ms']:15.2f} ms "
-                f"{report['difference_ms']:+9.2f} ms  {verdict}"
+                f"{name:10} {report.true_ms:11.2f} ms {report.measured_ms:15.2f} ms "
+                f"{report.difference_ms:+9.2f} ms  {verdict}"
             )
-            for warning in measured[name][1].warnings:
+            for warning in report.measurement.result.warnings:
                 print(f"warning ({name}): {warning}")
-        print(f"plots: {', '.join(report['plot'] for report in reports.values())}")
+        print(f"plots: {', '.join(str(report.plot) for report in reports.values())}")
     return 0 if agrees else EXIT_MISMATCH
 
 
@@ -137,5 +94,5 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         f"and print both latencies side by side; a scene left at the defaults becomes {COMPARE_TRIANGLES} load "
         f"triangles at {COMPARE_APP_FRAME_MS:g} ms (modelled) per application frame",
     )
-    simulate.add_simulation_options(parser)
+    add_simulation_options(parser)
     parser.set_defaults(func=_run)

@@ -4,137 +4,25 @@ from __future__ import annotations
 
 import argparse
 import json
-from dataclasses import replace
 from pathlib import Path
 
-from rig.commands import options
+from rig.commands.simulation_options import add_lab_options, add_simulation_options, config_from_args, with_lab_options
 from rig.progress import ProgressBar
-from rig.session import DEFAULT_WARP_MS, SimulationConfig, SimulationResult, simulate
-from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
-from rig.sim.camera import CameraConfig
-from rig.sim.display import DisplayConfig
-from rig.sim.pendulum import PendulumConfig
-from rig.sim.tracker import TrackerConfig
-
-
-def add_simulation_options(parser: argparse.ArgumentParser) -> None:
-    """The options that describe a simulated rig (shared by `simulate` and `demo`)."""
-    defaults = SimulationConfig()
-    group = parser.add_argument_group("simulated rig")
-    group.add_argument("--renderer", default=defaults.renderer, help="renderer under test (default: %(default)s)")
-    group.add_argument(
-        "--predictor",
-        type=options.predictor_spec,
-        default=(defaults.predictor, {}),
-        metavar="NAME[:key=value,...]",
-        help="pose predictor and its parameters, or NAME:FILE.json (default: hold)",
-    )
-    group.add_argument("--display-hz", type=options.positive_float, default=DisplayConfig().refresh_hz, help="display refresh rate (default: %(default)s)")
-    group.add_argument("--tracker-hz", type=options.positive_float, default=TrackerConfig().rate_hz, help="tracker sample rate (default: %(default)s)")
-    group.add_argument("--camera-fps", type=options.positive_float, default=CameraConfig().fps, help="camera frame rate (default: %(default)s)")
-    group.add_argument("--duration", type=options.positive_float, default=defaults.duration_s, help="filmed seconds (default: %(default)s)")
-    group.add_argument("--seed", type=int, default=defaults.seed, help="random seed; the same seed gives the same video (default: %(default)s)")
-    group.add_argument("--scene-triangles", type=options.non_negative_int, default=0, help="load geometry drawn behind the sphere (default: 0)")
-    group.add_argument(
-        "--app-frame-ms",
-        type=options.app_frame_cost,
-        default=defaults.app_frame_ms,
-        help="modelled application frame cost in ms, or 'measured' for the real GL time (default: %(default)s)",
-    )
-    group.add_argument(
-        "--warp-ms",
-        type=options.positive_float,
-        default=None,
-        help=f"modelled warp cost per display frame in ms (default for the warp renderer: {DEFAULT_WARP_MS:g})",
-    )
-    group.add_argument(
-        "--transport-delay-ms",
-        type=options.non_negative_float,
-        default=TrackerConfig().transport_delay_s * 1e3,
-        help="fixed tracker-to-host delay (default: %(default)s)",
-    )
-    group.add_argument("--period-s", type=options.positive_float, default=PendulumConfig().period_s, help="pendulum period (default: %(default)s)")
-    group.add_argument("--amplitude-deg", type=options.positive_float, default=PendulumConfig().amplitude_deg, help="swing amplitude, up to 45 (default: %(default)s)")
-    group.add_argument("--quality", type=options.positive_float, default=PendulumConfig().quality, help="pendulum quality factor Q (default: %(default)s)")
-
-
-def config_from_args(args: argparse.Namespace) -> SimulationConfig:
-    predictor, params = args.predictor
-    return SimulationConfig(
-        duration_s=args.duration,
-        seed=args.seed,
-        pendulum=PendulumConfig(period_s=args.period_s, amplitude_deg=args.amplitude_deg, quality=args.quality),
-        tracker=TrackerConfig(rate_hz=args.tracker_hz, transport_delay_s=args.transport_delay_ms / 1e3),
-        display=DisplayConfig(refresh_hz=args.display_hz),
-        camera=CameraConfig(fps=args.camera_fps),
-        renderer=args.renderer,
-        predictor=predictor,
-        predictor_params=params,
-        scene_triangles=args.scene_triangles,
-        app_frame_ms=args.app_frame_ms,
-        warp_ms=args.warp_ms,
-    )
-
-
-def add_lab_options(parser: argparse.ArgumentParser) -> None:
-    """What a lab does during a filmed run: release a held pendulum, blink the board's LED."""
-    board = SimulatedBoardConfig()
-    group = parser.add_argument_group("lab procedure")
-    group.add_argument(
-        "--release-s",
-        type=options.non_negative_float,
-        default=None,
-        metavar="S",
-        help="hold the pendulum at rest at its amplitude and release it S seconds into the film "
-        "(at least one swing before the end; default: swinging from the start)",
-    )
-    group.add_argument(
-        "--board",
-        action="store_true",
-        help=f"simulate the rig board: it plays the LED blink code ({board.blink_bits} bits of "
-        f"{board.blink_bit_s * 1e3:g} ms from {board.blink_start_s:g} s of film; the film must last until "
-        f"{board.blink_end_s:g} s) and records its LED changes and the pendulum encoder on its own clock "
-        f"({board.board_offset_s:g} s ahead) in DIR/{BOARD_FOLDER}/, as `rig board record` does",
-    )
-
-
-def with_lab_options(config: SimulationConfig, args: argparse.Namespace) -> SimulationConfig:
-    """The config with the release and board that the lab options ask for."""
-    return replace(
-        config,
-        pendulum=replace(config.pendulum, release_s=args.release_s),
-        board=SimulatedBoardConfig() if args.board else None,
-    )
-
-
-def run_simulation(config: SimulationConfig, out: Path, overwrite: bool) -> SimulationResult:
-    return simulate(config, out, progress=ProgressBar("simulating"), overwrite=overwrite)
-
-
-def summary(result: SimulationResult) -> dict[str, object]:
-    truth = result.truth
-    return {
-        "out_dir": str(result.out_dir),
-        "video": str(result.video_path),
-        "latency_ms": truth["latency_ms"],
-        "display_frame_delay_ms": {k: truth["display_frame_delay_ms"][k] for k in ("mean", "sd")},
-        "frames": truth["frames"],
-        "camera_fps": truth["camera_fps"],
-        "led_roi": truth["led_roi"],
-        "sphere_roi": truth["sphere_roi"],
-    }
+from rig.service import simulate
+from rig.sim.board import BOARD_FOLDER
 
 
 def _run(args: argparse.Namespace) -> int:
-    result = run_simulation(with_lab_options(config_from_args(args), args), args.out, args.overwrite)
+    result = simulate(with_lab_options(config_from_args(args), args), args.out, ProgressBar("simulating"), args.overwrite)
     if args.json:
-        print(json.dumps(summary(result)))
+        print(json.dumps(result.summary()))
     else:
-        d = result.truth["display_frame_delay_ms"]
+        truth = result.truth
+        d = truth.display_frame_delay_ms
         print(
-            f"wrote {result.truth['frames']} frames to {result.video_path}; true latency "
-            f"{result.truth['latency_ms']:.2f} ms (sensor-to-photon delay per display frame "
-            f"{d['mean']:.2f} +/- {d['sd']:.2f} ms)"
+            f"wrote {truth.frames} frames to {result.video_path}; true latency "
+            f"{truth.latency_ms:.2f} ms (sensor-to-photon delay per display frame "
+            f"{d.mean:.2f} +/- {d.sd:.2f} ms)"
         )
     return 0
 

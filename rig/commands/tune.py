@@ -2,9 +2,7 @@
 
 Training traces are the --trace files; held-out traces are the --held-out files, or, without any,
 the last part of each training trace (--split says how much is kept for training). The fitted
-parameters go to --out as a file that `rig simulate --predictor NAME:FILE.json`, `rig bench
-predictors --predictor NAME:FILE.json` and `predictors.make(name, **predictors.read_params(FILE)[1])`
-accept.
+parameters go to --out (see `rig.service.tune`).
 """
 
 from __future__ import annotations
@@ -12,52 +10,25 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from predictors import evaluate, read_trace, write_params
+from predictors import read_trace
 from rig.commands import options
-
-
-def _held_out_rms(name: str, params: dict, traces: list, horizon_s: float) -> dict[str, float]:
-    """Angular (deg) and position (mm) RMS error over the held-out traces, weighted by count."""
-    scores = [evaluate(name, trace, [horizon_s], params, timing_repeats=1).scores[0] for trace in traces]
-    count = sum(s.count for s in scores)
-    angular = (sum(s.count * s.angular_rms_deg**2 for s in scores) / count) ** 0.5
-    position = (sum(s.count * s.position_rms_mm**2 for s in scores) / count) ** 0.5
-    return {"angular_rms_deg": angular, "position_rms_mm": position}
+from rig.service import split_traces, tune
 
 
 def _run(args: argparse.Namespace) -> int:
-    from predictors.tuning import tune  # imports JAX: only when tuning
-
     traces = [read_trace(path) for path in args.trace]
-    if args.held_out:
-        train, held_out = traces, [read_trace(path) for path in args.held_out]
-    else:
-        halves = [trace.split(args.split) for trace in traces]
-        train, held_out = [h[0] for h in halves], [h[1] for h in halves]
-    horizon_s = args.horizon_ms / 1e3
+    held_out = [read_trace(path) for path in args.held_out or []]
+    train, held_out = split_traces(traces, held_out, args.split)
     name, start = args.predictor
     print(f"tuning {name} at {args.horizon_ms:g} ms on {sum(len(t) for t in train)} samples ...", flush=True)
-    result = tune(name, train, horizon_s, start, max_iterations=args.max_iterations)
-    fitted = ", ".join(f"{k}={result.params[k]:.6g}" for k in result.fitted) or "nothing (no motion to fit)"
-    print(f"fitted {fitted}; training loss {result.loss_before:.4g} -> {result.loss_after:.4g} "
-          f"in {result.iterations} iterations")
-    comparison = {
-        f"{name} tuned": _held_out_rms(name, result.params, held_out, horizon_s),
-        f"{name} start": _held_out_rms(name, start, held_out, horizon_s),
-        "slerp": _held_out_rms("slerp", {}, held_out, horizon_s),
-    }
-    print(f"held-out RMS error at {args.horizon_ms:g} ms ({sum(len(t) for t in held_out)} samples):")
-    for label, rms in comparison.items():
+    report = tune(name, start, train, held_out, args.horizon_ms / 1e3, args.max_iterations)
+    fit = report.fit
+    fitted = ", ".join(f"{k}={fit.params[k]:.6g}" for k in fit.fitted) or "nothing (no motion to fit)"
+    print(f"fitted {fitted}; training loss {fit.loss_before:.4g} -> {fit.loss_after:.4g} in {fit.iterations} iterations")
+    print(f"held-out RMS error at {args.horizon_ms:g} ms ({report.held_out_samples} samples):")
+    for label, rms in report.comparison.items():
         print(f"  {label:24s} {rms['angular_rms_deg']:.4f} deg  {rms['position_rms_mm']:.4f} mm")
-    write_params(
-        args.out,
-        name,
-        result.params,
-        horizon_ms=args.horizon_ms,
-        fitted=list(result.fitted),
-        train=[t.name for t in train],
-        held_out={"traces": [t.name for t in held_out], **comparison},
-    )
+    report.write(args.out, args.horizon_ms)
     print(f"wrote {args.out}")
     return 0
 

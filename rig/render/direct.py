@@ -55,9 +55,8 @@ class _Scene:
 class DirectRenderer:
     """Draws a bright sphere at the predicted position in front of dim load geometry.
 
-    The sphere is rotation-symmetric, so only the pose's position moves it. Frame cost is
-    `app_frame_ms` when the setup gives one (modelled), else the wall time of the GL work on
-    this machine, from the first draw call until the image is read back (measured).
+    The sphere is rotation-symmetric, so only the pose's position moves it. A frame's cost is the
+    wall time of its GL work on this machine, from the first draw call until the image is read back.
     """
 
     name = "direct"
@@ -93,10 +92,7 @@ class DirectRenderer:
         start = time.perf_counter()
         with self._scene.ctx:
             image = _draw(self._scene, pose.position)
-        elapsed = time.perf_counter() - start
-        if self._setup.app_frame_ms is not None:
-            return AppFrameResult(self._setup.app_frame_ms / 1000.0, "modelled", pose, image)
-        return AppFrameResult(elapsed, "measured", pose, image)
+        return AppFrameResult(time.perf_counter() - start, pose, image)
 
     def render_display_frame(self, request: DisplayFrameRequest) -> DisplayFrameResult:
         raise RigError(

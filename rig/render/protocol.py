@@ -16,9 +16,9 @@ Two kinds of frames exist, as in the seed papers' display-layer architecture:
   frame, and the display repeats that image until the next application frame is ready.
 
 Images are RGB, uint8, shape (height, width, 3), row 0 at the top of the display (the row that is
-scanned out first). Costs are seconds on the rig clock: either modelled (a configured number,
-deterministic) or measured (the real render time on this machine); `cost_source` says which, so a
-run never pretends a cost it neither modelled nor measured.
+scanned out first). A renderer reports what its work took on this machine (`cost_s`, wall
+seconds); whether the run's clock charges that measured cost or a modelled one is the session's
+cost model (`rig.session.timing`), not the renderer's business.
 
 Third-party renderers are classes registered under the entry-point group `rig.renderers`; the
 class is constructed without arguments and then `open`ed with a `RenderSetup`.
@@ -27,13 +27,12 @@ class is constructed without arguments and then `open`ed with a `RenderSetup`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Literal, Protocol, runtime_checkable
+from typing import Callable, Protocol, runtime_checkable
 
 import numpy as np
 
 from predictors import Pose
 
-CostSource = Literal["modelled", "measured"]
 PredictFn = Callable[[float], Pose]
 
 
@@ -42,7 +41,9 @@ class RenderSetup:
     """What a renderer needs to know once, before the first frame.
 
     world_to_clip maps homogeneous world coordinates (metres) to OpenGL clip space; the display
-    shows clip x, y in [-1, 1] with +y at the top row.
+    shows clip x, y in [-1, 1] with +y at the top row. wait_for_gpu asks the renderer to wait for
+    the GPU to finish each frame, so that its reported cost is the whole work; a run that models
+    its costs does not read them and lets the GPU run on.
     """
 
     width: int
@@ -50,9 +51,13 @@ class RenderSetup:
     world_to_clip: np.ndarray
     sphere_radius_m: float
     scene_triangles: int = 0
-    app_frame_ms: float | None = None
-    warp_ms: float | None = None
+    wait_for_gpu: bool = True
     seed: int = 0
+
+    def row_fraction(self, position: np.ndarray) -> float:
+        """The display row (0 top, 1 bottom) a world position is drawn at."""
+        clip = self.world_to_clip @ np.append(position, 1.0)
+        return float(np.clip((1.0 - clip[1] / clip[3]) / 2.0, 0.0, 1.0))
 
 
 @dataclass(frozen=True)
@@ -65,8 +70,10 @@ class AppFrameRequest:
 
 @dataclass(frozen=True)
 class AppFrameResult:
+    """What an application frame drew (the pose it used, its image where it has one: None for a
+    renderer that composes at every refresh) and what the work took (s)."""
+
     cost_s: float
-    cost_source: CostSource
     pose: Pose
     image: np.ndarray | None
 
@@ -87,7 +94,6 @@ class DisplayFrameRequest:
 class DisplayFrameResult:
     image: np.ndarray
     cost_s: float
-    cost_source: CostSource
     pose: Pose
 
 

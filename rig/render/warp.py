@@ -17,10 +17,10 @@ Objects and what moves them on the server:
   and linear); it does not move, so it keeps the matrix computed once at open;
 * the background (ID 0) is static, warped just inside the far plane.
 
-Costs: `RenderSetup.app_frame_ms` / `warp_ms` model the client's and the server's cost on the rig
-clock; left None, the renderer reports what the GL work took on this machine: wall time until the
-GPU finished, without the readback a real display would not need. `last_warp_seconds` also gives
-the server's GL timer query.
+Costs: the renderer reports what the GL work took on this machine: wall time until the GPU
+finished, without the readback a real display would not need (the client waits for the GPU only
+when `RenderSetup.wait_for_gpu` asks it to). `last_warp_seconds` also gives the server's GL timer
+query.
 """
 
 from __future__ import annotations
@@ -181,21 +181,19 @@ class WarpRenderer:
             for target, view in zip(targets, self._client_views):
                 self._scene.draw(target, view, self._load_model(load_pose), pose.position)
                 self._scene.prepare_surface(target)
-            if setup.app_frame_ms is None:
-                self._ctx.finish()  # only a measured cost needs to wait for the GPU
+            if setup.wait_for_gpu:
+                self._ctx.finish()
         elapsed = time.perf_counter() - start
         self._frames[request.index] = _ClientFrame(float(request.t_start), np.array(pose.position), load_pose, targets)
-        if setup.app_frame_ms is not None:
-            return AppFrameResult(setup.app_frame_ms / 1e3, "modelled", pose, None)
-        return AppFrameResult(elapsed, "measured", pose, None)
+        return AppFrameResult(elapsed, pose, None)
 
     def render_display_frame(self, request: DisplayFrameRequest) -> DisplayFrameResult:
         """Server: warp the newest finished client frame (`request.app_frame`) to the newest pose."""
-        setup = self._check_open()
+        self._check_open()
         pose = request.predict(request.t_photon)
         if request.app_frame < 0:
             image = np.zeros((self.server_size[1], self.server_size[0], 3), dtype=np.uint8)
-            return self._display_result(image, 0.0, pose)
+            return DisplayFrameResult(image, 0.0, pose)
         frame = self._switch_to(request.app_frame)
         matrices = self._matrices(frame, pose, request.t_photon)
         with self._ctx:
@@ -203,7 +201,7 @@ class WarpRenderer:
                 self._server.warp(frame.targets, matrices)
                 self._server.fill()
             image = self._server.read_rgb()
-        return self._display_result(image, self._timer.wall_s, pose)
+        return DisplayFrameResult(image, self._timer.wall_s, pose)
 
     def close(self) -> None:
         if self._ctx is None:
@@ -263,11 +261,6 @@ class WarpRenderer:
     def _new_target(self) -> ClientTarget:
         with self._ctx:
             return ClientTarget(self._ctx, self.client_size)
-
-    def _display_result(self, image: np.ndarray, elapsed: float, pose: Pose) -> DisplayFrameResult:
-        if self._setup.warp_ms is not None:
-            return DisplayFrameResult(image, self._setup.warp_ms / 1e3, "modelled", pose)
-        return DisplayFrameResult(image, elapsed, "measured", pose)
 
     def _switch_to(self, index: int) -> _ClientFrame:
         """The client frame `index`, releasing older ones the first time it is shown."""

@@ -2,10 +2,10 @@
 pendulum's encoder on its own clock, and the run records what it reports as a real board recording.
 
 The board's clock runs `board_offset_s` ahead of the simulation's: board time = simulation time +
-offset, counted in ticks of RIG_TICK_HZ (firmware/include/protocol.h) like the real board's.
+offset, counted in ticks of RIG_TICK_HZ (rig/board/protocol.h) like the real board's.
 
 The LED is on at `blink_level` throughout the run, except during the blink: from `blink_start_s`
-(simulation time) bit k of the code (rig.devices.blink_code.lfsr_bits) holds it at blink_level or
+(simulation time) bit k of the code (analysis.board.blink_code.lfsr_bits) holds it at blink_level or
 off for [start + k bit_s, start + (k + 1) bit_s); after the last bit it is on again.
 
 The encoder reads count = floor(theta * counts_per_rev / (2 pi) + 0.5), as the emulated board's
@@ -15,7 +15,8 @@ split further at the swing's turning points (found by bisection), so the angle i
 each: every crossing in one is found, none is missed, and each is solved for by Newton's method
 kept inside its interval, to far better than a microsecond.
 
-Written into the board folder as the run goes (rig.devices.recording's formats):
+Written into the board folder as the run goes, through rig.board.recording's writer in the format
+of analysis.board.recording:
 led.csv (the switch-on at the start of the run, every change during the blink with its bit, the
 switch back on after it), encoder.csv (every edge, `edges` = 1 as a board reporting every edge
 sends), the other files of a recording with their headers only, and recording.json at the end.
@@ -33,10 +34,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rig.devices.blink_code import BlinkSchedule, lfsr_bits
-from rig.devices.board_events import BoardIdentity, EncoderEdge, LedChange
-from rig.devices.protocol import protocol
-from rig.devices.recording import BoardRecorder
+from analysis.board.blink_code import BlinkSchedule, lfsr_bits
+from analysis.board.recording import METADATA, TABLES
+from rig.board.events import BoardIdentity, EncoderEdge, LedChange
+from rig.board.protocol import protocol
+from rig.board.recording import BoardRecorder
+from rig.clock import Clock
 from rig.errors import ConfigError
 from rig.sim.pendulum import Pendulum
 
@@ -218,26 +221,56 @@ class _EncoderEdges:
 
 
 class SimulatedBoard:
-    """Records what the simulated board reports into `out_dir` as the simulation clock advances over
-    [t_begin, t_end]; `advance(t)` writes and flushes every event up to t."""
+    """The simulated board as an instrument beside a run (`rig.devices.protocols.Instrument`): once
+    connected, it records into `out_dir` what the board reports up to the rig clock's present, at
+    every poll, over [t_begin, t_end]. `finish` completes the recording with recording.json, as
+    `rig board record` does at the end of a recording; `close` records up to the present and
+    closes the files, so an interrupted run keeps a readable recording (without recording.json)."""
 
     def __init__(self, config: SimulatedBoardConfig, pendulum: Pendulum, t_begin: float, t_end: float, out_dir: Path) -> None:
         self.config = config
         self.t_begin = t_begin
         self.t_end = t_end
+        self.out_dir = Path(out_dir)
         self.release_s = pendulum.config.release_s
         self._tick_hz = protocol()["RIG_TICK_HZ"]
         self._led = config.led_changes(t_begin)
         self._encoder = _EncoderEdges(pendulum, config.counts_per_rev, t_begin)
         self._pending: tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]] | None = None
-        self.recorder = BoardRecorder(out_dir)
+        self._clock: Clock | None = None
+        self.recorder: BoardRecorder | None = None
+
+    def connect(self, clock: Clock) -> None:
+        self.recorder = BoardRecorder(self.out_dir)
+        self._clock = clock
+
+    def poll(self) -> None:
+        """Record every event up to the present."""
+        if self._clock is None:
+            raise RuntimeError("the simulated board is not connected")
+        self._record_until(self._clock.now())
+
+    def finish(self) -> None:
+        """Record up to the present and write recording.json."""
+        self.poll()
+        self._write_metadata()
+
+    def close(self) -> None:
+        """Record up to the present and close the files."""
+        if self._clock is None:
+            return
+        try:
+            self.poll()
+        finally:
+            self.recorder.close()
+            self._clock = None
 
     def _ticked(self, t: float) -> tuple[int, float]:
         """The board tick and board time of simulation time t."""
         tick = round((t + self.config.board_offset_s) * self._tick_hz)
         return tick, tick / self._tick_hz
 
-    def advance(self, t: float) -> None:
+    def _record_until(self, t: float) -> None:
         """Write every LED change and encoder edge at simulation times up to t (at most t_end)."""
         t = min(t, self.t_end)
         while self._led and self._led[0][0] <= t:
@@ -258,9 +291,7 @@ class SimulatedBoard:
             self._pending = None
         self.recorder.on_batch_end()
 
-    def finish(self) -> None:
-        """Write the rest of the run's events and recording.json."""
-        self.advance(self.t_end)
+    def _write_metadata(self) -> None:
         spec = protocol()
         identity = BoardIdentity(
             name="simulated",
@@ -287,5 +318,10 @@ class SimulatedBoard:
         swung throughout) and the blink on the board's clock."""
         return {"offset_s": self.config.board_offset_s, "release_s": self.release_s, "blink": asdict(self.config.schedule())}
 
-    def close(self) -> None:
-        self.recorder.close()
+
+def remove_recording(folder: Path) -> None:
+    """Remove a board recording's files from `folder` (nothing else), and the folder if that empties it."""
+    for name in [table.name for table in TABLES] + [METADATA]:
+        (folder / name).unlink(missing_ok=True)
+    if folder.is_dir() and not any(folder.iterdir()):
+        folder.rmdir()

@@ -1,4 +1,4 @@
-"""A simulated high-speed camera filming the LED and the display.
+"""A simulated high-speed camera filming the LED and the display (`SimCamera`).
 
 Each frame integrates the scene over its exposure by averaging `subsamples` instants (motion blur),
 adds a dark level and read noise, and saturates at 255 like an 8-bit sensor. The LED is a bright
@@ -13,12 +13,16 @@ Gaussian draws would dominate the simulation's cost, and the analyser cannot tel
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
+from typing import TYPE_CHECKING
 
-import cv2
 import numpy as np
 
-from rig.errors import ConfigError, RigError
+from rig.clock import Clock
+from rig.devices.protocols import CameraFrame
+from rig.errors import ConfigError
+
+if TYPE_CHECKING:
+    from rig.sim.scene import FilmedScene
 
 LED_SIGMA_PX = 2.2
 LED_FULL_LEVEL = 255
@@ -126,29 +130,41 @@ class CameraSensor:
         image[y0:y1, x0:x1] += spot.astype(np.float32)
 
 
-class VideoFileWriter:
-    """Writes 8-bit grey frames to an MJPEG AVI: a codec every OpenCV build reads back."""
+class SimCamera:
+    """The simulated twin of a camera (`rig.devices.protocols.Camera`): frames start at 0 s on the
+    rig clock, one every 1 / fps, for `duration_s`; each is exposed as soon as everything it sees
+    is known (the display's content up to the end of its exposure)."""
 
-    FOURCC = "MJPG"
-    QUALITY = 95
+    def __init__(self, config: CameraConfig, scene: FilmedScene, duration_s: float, seed: int) -> None:
+        self.config = config
+        self.fps = config.fps
+        self.width = config.width
+        self.height = config.height
+        self.scene = scene
+        self.frame_times = np.arange(0.0, duration_s - config.exposure, 1.0 / config.fps)
+        self._seed = seed
+        self._sensor: CameraSensor | None = None
+        self._next = 0
 
-    def __init__(self, path: Path, fps: float, width: int, height: int) -> None:
-        self.path = Path(path)
-        self._writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*self.FOURCC), fps, (width, height), True)
-        if not self._writer.isOpened():
-            raise RigError(f"cannot write video {self.path}: OpenCV has no {self.FOURCC} writer here")
-        self._writer.set(cv2.VIDEOWRITER_PROP_QUALITY, self.QUALITY)
-        self.frames = 0
+    def connect(self, clock: Clock) -> None:
+        self._sensor = CameraSensor(self.config, seed=self._seed)
 
-    def write(self, grey: np.ndarray) -> None:
-        self._writer.write(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR))
-        self.frames += 1
+    def poll(self) -> list[CameraFrame]:
+        """Every frame whose exposure ends before the display's settled time, not returned before."""
+        if self._sensor is None:
+            raise RuntimeError("the simulated camera is not connected")
+        exposure = self.config.exposure
+        offsets = self.config.subsample_offsets()
+        frames = []
+        while self._next < len(self.frame_times) and self.frame_times[self._next] + exposure < self.scene.settled_until:
+            t_start = float(self.frame_times[self._next])
+            instants = self.frame_times[self._next] + offsets
+            image = self._sensor.expose(
+                self.scene.led_pixels(instants), self.scene.panel_light(instants), self.scene.panel, self.scene.led_levels(instants)
+            )
+            frames.append(CameraFrame(self._next, t_start, exposure, image))
+            self._next += 1
+        return frames
 
     def close(self) -> None:
-        self._writer.release()
-
-    def __enter__(self) -> "VideoFileWriter":
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+        self._sensor = None

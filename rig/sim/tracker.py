@@ -1,4 +1,4 @@
-"""The simulated tracker, and the CSV file format that tracker samples are recorded in.
+"""The simulated tracker (`SimTracker`), a twin of `rig.devices.protocols.TrackerSource`.
 
 The simulated sensor rides on the pendulum bob. It measures at a fixed rate on its own clock and
 sends each measurement over a serial/USB-like transport:
@@ -15,26 +15,22 @@ sends each measurement over a serial/USB-like transport:
 
 All randomness comes from numpy's default_rng(seed), drawn for every sample in a fixed order, so a
 seed fixes the whole run and changing the dropout rate does not change the noise of the samples
-that are kept.
+that are kept. The samples are worked out once, when the tracker connects, and handed out as the
+rig clock passes their arrival times.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass
-from pathlib import Path
-from types import TracebackType
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from predictors import PoseSample
+from rig.clock import Clock
 from rig.errors import ConfigError, RigError
 from rig.sim.pendulum import Pendulum
-
-CSV_HEADER = "t_sensor,t_arrival,px,py,pz,qw,qx,qy,qz"
-_CSV_FIELDS = len(CSV_HEADER.split(","))
 
 
 @dataclass(frozen=True)
@@ -106,89 +102,48 @@ def simulate_tracker(
     ]
 
 
-def _csv_row(sample: PoseSample) -> str:
-    values = (sample.t_sensor, sample.t_arrival, *sample.position.tolist(), *sample.orientation.tolist())
-    return ",".join(repr(float(v)) for v in values) + "\n"
+class SimTracker:
+    """The simulated tracker of a run: samples for sensor times in [t_start, t_end), handed out
+    as the clock passes their arrival."""
 
+    def __init__(self, pendulum: Pendulum, config: TrackerConfig, t_start: float, t_end: float, seed: int) -> None:
+        self.pendulum = pendulum
+        self.config = config
+        self.t_start = t_start
+        self.t_end = t_end
+        self.seed = seed
+        self._clock: Clock | None = None
+        self._samples: list[PoseSample] = []
+        self._next = 0
 
-class TrackerCsvWriter:
-    """Writes tracker samples to CSV as they arrive, one flushed row per sample.
+    def connect(self, clock: Clock) -> None:
+        self._samples = simulate_tracker(self.pendulum, self.config, self.t_start, self.t_end, self.seed)
+        if not self._samples:
+            raise RigError("the tracker produced no samples; check its rate and dropout settings")
+        self._clock = clock
+        self._next = 0
 
-    Each row is flushed to the operating system at once, so a crash of the recording process
-    leaves a readable file holding every sample written so far (a power cut may still lose the
-    last rows: rows are flushed, not fsynced). Floats are written with repr, so reading the file
-    gives back the exact values. An existing file is only replaced with overwrite=True.
-    """
+    def poll(self) -> list[PoseSample]:
+        """The samples that have arrived by now and were not handed out before."""
+        now = self._connected().now()
+        first = self._next
+        while self._next < len(self._samples) and self._samples[self._next].t_arrival <= now:
+            self._next += 1
+        return self._samples[first : self._next]
 
-    def __init__(self, path: str | os.PathLike[str], overwrite: bool = False) -> None:
-        self.path = Path(path)
-        try:
-            self._file = open(self.path, "w" if overwrite else "x", encoding="ascii", newline="")
-        except FileExistsError:
-            raise RigError(
-                f"{self.path} already exists; choose another file or pass overwrite=True to replace it"
-            ) from None
-        except OSError as error:
-            raise RigError(f"cannot write tracker samples to {self.path}: {error.strerror}") from None
-        self._file.write(CSV_HEADER + "\n")
-        self._file.flush()
-
-    def write(self, sample: PoseSample) -> None:
-        """Append one sample and flush it."""
-        self._file.write(_csv_row(sample))
-        self._file.flush()
+    def wait(self, timeout_s: float) -> list[PoseSample]:
+        """Move the clock on to the next arrival, if it comes within `timeout_s`; then poll."""
+        clock = self._connected()
+        if self._next < len(self._samples):
+            arrival = self._samples[self._next].t_arrival
+            if arrival <= clock.now() + timeout_s:
+                clock.wait_until(arrival)
+        return self.poll()
 
     def close(self) -> None:
-        self._file.close()
+        self._clock = None
 
-    def __enter__(self) -> TrackerCsvWriter:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
-
-
-def write_tracker_csv(
-    path: str | os.PathLike[str], samples: list[PoseSample], overwrite: bool = False
-) -> None:
-    """Write all `samples` to a new tracker CSV file (see TrackerCsvWriter)."""
-    with TrackerCsvWriter(path, overwrite=overwrite) as writer:
-        for sample in samples:
-            writer.write(sample)
-
-
-def read_tracker_csv(path: str | os.PathLike[str]) -> list[PoseSample]:
-    """Read a tracker CSV file written by TrackerCsvWriter, in file order.
-
-    The writer ends every row with a newline in the same write, so a last line without one is a
-    row cut short by a crash mid-write: it is skipped. Any other malformed row raises RigError
-    naming the line.
-    """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="ascii")
-    except (OSError, UnicodeDecodeError) as error:
-        raise RigError(f"cannot read tracker samples from {path}: {error}") from None
-    lines = text.split("\n")
-    if lines[0] != CSV_HEADER:
-        raise RigError(f"{path} is not a tracker CSV file: its first line must be {CSV_HEADER!r}")
-    samples = []
-    for number, row in enumerate(lines[1:-1], start=2):
-        try:
-            samples.append(_parse_row(row))
-        except ValueError as error:
-            raise RigError(f"{path}, line {number}: {error}") from None
-    return samples
-
-
-def _parse_row(row: str) -> PoseSample:
-    fields = row.split(",")
-    if len(fields) != _CSV_FIELDS:
-        raise ValueError(f"expected {_CSV_FIELDS} comma-separated numbers, got {len(fields)}")
-    values = [float(field) for field in fields]
-    return PoseSample(values[0], values[1], np.array(values[2:5]), np.array(values[5:9]))
+    def _connected(self) -> Clock:
+        if self._clock is None:
+            raise RigError("the simulated tracker is not connected; call connect(clock) first")
+        return self._clock

@@ -7,7 +7,7 @@ import pytest
 
 import analysis
 from rig.cli import main
-from rig.session import SimulationConfig, simulate
+from rig.service import SimulationConfig, simulate
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -30,16 +30,16 @@ def test_analyser_recovers_the_true_latency(name: str, tmp_path: Path) -> None:
     result = analysis.analyse(run.video_path)
     assert not result.ambiguous
     assert result.frames_used == result.frames
-    assert result.latency_ms == pytest.approx(run.truth["latency_ms"], abs=TOLERANCE_MS)
+    assert result.latency_ms == pytest.approx(run.truth.latency_ms, abs=TOLERANCE_MS)
 
 
 def test_prediction_and_scene_cost_move_the_latency_the_right_way(tmp_path: Path) -> None:
     """Slerp prediction hides latency, an expensive scene adds it: the truth must say so."""
     latency = {
-        name: simulate(CONFIGURATIONS[name], tmp_path / name).truth["latency_ms"]
+        name: simulate(CONFIGURATIONS[name], tmp_path / name).truth.latency_ms
         for name in ("60Hz-hold", "heavy-scene-long-frame")
     }
-    slerp = simulate(SimulationConfig(duration_s=6.0, predictor="slerp"), tmp_path / "slerp").truth["latency_ms"]
+    slerp = simulate(SimulationConfig(duration_s=6.0, predictor="slerp"), tmp_path / "slerp").truth.latency_ms
     assert slerp < latency["60Hz-hold"] - 15.0
     assert latency["heavy-scene-long-frame"] > latency["60Hz-hold"] + 30.0
 
@@ -69,10 +69,10 @@ def test_a_board_recording_fixes_a_latency_beyond_half_a_period(tmp_path: Path, 
     assert main(argv) == 0
     report = json.loads(capsys.readouterr().out)
     assert not report["ambiguous"] and "board encoder start" in report["cycles"]["how"]
-    assert report["latency_ms"] == pytest.approx(run.truth["latency_ms"], abs=TOLERANCE_MS)
+    assert report["latency_ms"] == pytest.approx(run.truth.latency_ms, abs=TOLERANCE_MS)
     low, high = report["board"]["offset_interval_s"]
     assert low <= 37.5 <= high
-    assert report["cycles"]["events_ms"]["board encoder start"] == pytest.approx(run.truth["latency_ms"], abs=20.0)
+    assert report["cycles"]["events_ms"]["board encoder start"] == pytest.approx(run.truth.latency_ms, abs=20.0)
     assert main(argv[:-1]) == 0
     lines = capsys.readouterr().out.splitlines()
     board = next(line for line in lines if line.startswith("board: "))

@@ -1,6 +1,8 @@
 """The command line: help everywhere, one-line errors with exit status 2 for bad input."""
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -81,3 +83,13 @@ def test_predictor_parameters_are_parsed() -> None:
 
     assert predictor_spec("slerp") == ("slerp", {})
     assert predictor_spec("kalman-cv:q=0.5,order=2,name=x") == ("kalman-cv", {"q": 0.5, "order": 2, "name": "x"})
+
+
+def test_importing_the_command_line_and_both_libraries_leaves_jax_settings_alone() -> None:
+    code = (
+        "import rig.cli, rig.service, analysis, predictors, predictors.tuning\n"
+        "import jax\n"
+        "print(jax.config.jax_enable_x64)\n"
+    )
+    printed = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert printed.strip() == "False"

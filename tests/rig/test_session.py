@@ -3,6 +3,7 @@
 import csv
 import json
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
@@ -12,12 +13,14 @@ import pytest
 from analysis.board.blink_code import align_blink_code
 from analysis.board.recording import load_table
 from rig.errors import ConfigError, RigError
-from rig.session import Simulation, SimulationConfig, simulate
+from predictors import read_samples
+from rig.service import SimulationConfig, simulate
 from rig.sim.board import SimulatedBoardConfig, encoder_count
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
-from rig.sim.tracker import TrackerConfig, read_tracker_csv
+from rig.sim.tracker import TrackerConfig
+from rig.sim.world import SimulatedWorld
 
 SMALL_CAMERA = CameraConfig(fps=120.0, width=320, height=240, subsamples=4)
 
@@ -73,8 +76,7 @@ def test_long_frames_are_repeated_until_the_next_is_ready(tmp_path: Path) -> Non
     images = [int(r["image"]) for r in read_rows(tmp_path / "display_frames.csv")]
     repeats = np.diff(np.flatnonzero(np.diff(images)))
     assert set(repeats.tolist()) == {3}
-    delay = run.truth["display_frame_delay_ms"]
-    assert delay["mean"] > 50.0
+    assert run.truth.display_frame_delay_ms.mean > 50.0
 
 
 def test_each_display_frame_delay_is_photon_time_minus_newest_sample(default_run) -> None:
@@ -89,7 +91,7 @@ def test_each_display_frame_delay_is_photon_time_minus_newest_sample(default_run
 def test_true_latency_lies_half_a_refresh_beyond_the_mean_frame_delay(default_run) -> None:
     truth = default_run.truth
     half_refresh_ms = 1e3 / 60 / 2
-    assert truth["latency_ms"] == pytest.approx(truth["display_frame_delay_ms"]["mean"] + half_refresh_ms, abs=1.5)
+    assert truth.latency_ms == pytest.approx(truth.display_frame_delay_ms.mean + half_refresh_ms, abs=1.5)
 
 
 def test_an_existing_run_is_not_overwritten(default_run) -> None:
@@ -107,7 +109,7 @@ def test_an_interrupted_run_leaves_a_readable_partial_record(tmp_path: Path) -> 
     with pytest.raises(KeyboardInterrupt):
         simulate(small_config(), tmp_path, progress=interrupt_halfway)
     assert not (tmp_path / "truth.json").exists()
-    samples = read_tracker_csv(tmp_path / "tracker.csv")
+    samples = read_samples(tmp_path / "tracker.csv")
     assert len(samples) > 60
     assert len(read_rows(tmp_path / "display_frames.csv")) > 30
     capture = cv2.VideoCapture(str(tmp_path / "video.avi"))
@@ -135,11 +137,22 @@ def lab_config(**overrides) -> SimulationConfig:
     return small_config(duration_s=3.0, pendulum=PendulumConfig(release_s=RELEASE_S), board=BOARD, **overrides)
 
 
+@dataclass(frozen=True)
+class LabRun:
+    """A lab run's folder, and what its simulated world knows."""
+
+    out_dir: Path
+    config: SimulationConfig
+    world: SimulatedWorld
+    frame_times: np.ndarray
+
+
 @pytest.fixture(scope="module")
-def lab_run(tmp_path_factory: pytest.TempPathFactory) -> Simulation:
-    simulation = Simulation(lab_config(), tmp_path_factory.mktemp("lab"))
-    simulation.run()
-    return simulation
+def lab_run(tmp_path_factory: pytest.TempPathFactory) -> LabRun:
+    config = lab_config()
+    run = simulate(config, tmp_path_factory.mktemp("lab"))
+    world = SimulatedWorld(config)
+    return LabRun(run.out_dir, config, world, world.camera().frame_times)
 
 
 def video_frames(video: Path) -> np.ndarray:
@@ -153,7 +166,7 @@ def video_frames(video: Path) -> np.ndarray:
         frames.append(frame[:, :, 1])
 
 
-def exposure_levels(run: Simulation) -> np.ndarray:
+def exposure_levels(run: LabRun) -> np.ndarray:
     """The LED's level at 9 instants spread over each frame's exposure, shape (9, frames)."""
     exposure = run.config.camera.exposure
     return np.stack([BOARD.led_level(run.frame_times + f * exposure) for f in np.linspace(0.0, 1.0, 9)])
@@ -161,8 +174,8 @@ def exposure_levels(run: Simulation) -> np.ndarray:
 
 def test_a_run_without_a_board_records_none(default_run) -> None:
     assert not (default_run.out_dir / "board").exists()
-    assert default_run.truth["board"] is None
-    assert default_run.truth["config"]["pendulum"]["release_s"] is None
+    assert default_run.truth.board is None
+    assert default_run.truth.config.pendulum.release_s is None
 
 
 def test_truth_describes_the_board_and_the_release(lab_run) -> None:
@@ -191,7 +204,7 @@ def test_the_video_shows_the_blink(lab_run) -> None:
     """The LED's brightest pixel is saturated in frames exposed wholly inside an on bit and dark in
     frames exposed wholly inside an off bit; the video's own on/off times the board's clock."""
     camera = lab_run.config.camera
-    x, y, w, h = lab_run.layout.led_roi
+    x, y, w, h = lab_run.world.layout.led_roi
     peaks = video_frames(lab_run.out_dir / "video.avi")[:, y : y + h, x : x + w].max(axis=(1, 2))
     assert peaks.size == lab_run.frame_times.size
     levels = exposure_levels(lab_run)
@@ -209,10 +222,10 @@ def test_encoder_csv_follows_the_pendulum_from_its_release(lab_run) -> None:
     encoder = load_table(lab_run.out_dir / "board", "encoder.csv")
     t, count, step = encoder["rig_time_s"], encoder["count"], encoder["step"]
     assert t.min() > RELEASE_S and t.max() <= lab_run.config.duration_s
-    dense = encoder_count(lab_run.pendulum.angle(np.arange(lab_run.t_begin, lab_run.t_end, 20e-6)), BOARD.counts_per_rev)
+    dense = encoder_count(lab_run.world.pendulum.angle(np.arange(lab_run.world.t_begin, lab_run.world.t_end, 20e-6)), BOARD.counts_per_rev)
     assert t.size == np.abs(np.diff(dense)).sum() > 500
-    np.testing.assert_array_equal(encoder_count(lab_run.pendulum.angle(t - 1e-6), BOARD.counts_per_rev), count - step)
-    np.testing.assert_array_equal(encoder_count(lab_run.pendulum.angle(t + 1e-6), BOARD.counts_per_rev), count)
+    np.testing.assert_array_equal(encoder_count(lab_run.world.pendulum.angle(t - 1e-6), BOARD.counts_per_rev), count - step)
+    np.testing.assert_array_equal(encoder_count(lab_run.world.pendulum.angle(t + 1e-6), BOARD.counts_per_rev), count)
     np.testing.assert_allclose(encoder["board_time_s"] - t, BOARD.board_offset_s, rtol=0, atol=1e-6)
 
 
@@ -224,7 +237,7 @@ def test_the_held_led_stays_put_in_the_video_until_the_release(lab_run) -> None:
     lit = np.all(exposure_levels(lab_run) > 0, axis=0)
     held = lit & (lab_run.frame_times + camera.exposure < RELEASE_S)
     swinging = lab_run.frame_times > RELEASE_S + 0.1
-    expected = lab_run.layout.led_pixels(lab_run.pendulum.led_position(np.array([0.0])))[0, 0]
+    expected = lab_run.world.layout.led_pixels(lab_run.world.pendulum.led_position(np.array([0.0])))[0, 0]
     assert held.sum() > 60
     assert np.all(np.abs(columns[held] - expected) <= 1.0)
     assert np.ptp(columns[swinging]) > camera.width / 4

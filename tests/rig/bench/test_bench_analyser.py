@@ -7,12 +7,13 @@ from pathlib import Path
 import pytest
 
 from rig.bench import analyser
+from rig.commands import bench
 
 
 @pytest.fixture
 def parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rig bench")
-    analyser.add_parser(parser.add_subparsers())
+    parser = argparse.ArgumentParser(prog="rig")
+    bench.add_parser(parser.add_subparsers())
     return parser
 
 
@@ -20,7 +21,7 @@ def test_quick_bench_reports_every_method_with_errors_coverage_and_speed(
     parser: argparse.ArgumentParser, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out, plot = tmp_path / "bench.json", tmp_path / "bench.png"
-    args = parser.parse_args(["analyser", "--quick", "--json", str(out), "--plot", str(plot)])
+    args = parser.parse_args(["bench", "analyser", "--quick", "--json", str(out), "--plot", str(plot)])
     assert args.func(args) == 0
     report = json.loads(out.read_text())
     assert set(report["summary"]) == {"fft", "xcorr", "sinefit", "bayes"}

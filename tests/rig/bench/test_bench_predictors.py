@@ -8,11 +8,12 @@ import numpy as np
 from predictors import Trace, write_trace
 from predictors import quaternion as quat
 from rig.bench import predictors as bench
+from rig.commands import bench as bench_command
 
 
 def parser() -> argparse.ArgumentParser:
-    root = argparse.ArgumentParser(prog="rig bench")
-    bench.add_parser(root.add_subparsers(dest="command", required=True))
+    root = argparse.ArgumentParser(prog="rig")
+    bench_command.add_parser(root.add_subparsers(dest="command", required=True))
     return root
 
 
@@ -21,7 +22,7 @@ def test_bench_on_a_tiny_trace_prints_the_table_and_writes_json_and_plot(tmp_pat
     trace = Trace.from_samples("tiny", t, np.outer(t, [0.2, 0.0, 0.0]), quat.from_rotation_vector(np.outer(t, [0, 1.0, 0])))
     write_trace(tmp_path / "tiny.csv", trace)
     args = parser().parse_args([
-        "predictors", "--trace", str(tmp_path / "tiny.csv"), "--predictor", "slerp", "--predictor", "kalman-cv",
+        "bench", "predictors", "--trace", str(tmp_path / "tiny.csv"), "--predictor", "slerp", "--predictor", "kalman-cv",
         "--predictor", "desp:position_alpha=0.4", "--horizons-ms", "0,50", "--timing-repeats", "1",
         "--json", str(tmp_path / "out.json"), "--plot", str(tmp_path / "out.png"),
     ])

@@ -8,13 +8,13 @@ import json
 
 import pytest
 
-from rig.bench import renderers
+from rig.commands import bench
 from rig.bench.renderers import QUICK_GRID, ROW_FIELDS
 
 
 def bench_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rig bench")
-    renderers.add_parser(parser.add_subparsers(dest="command", required=True))
+    parser = argparse.ArgumentParser(prog="rig")
+    bench.add_parser(parser.add_subparsers(dest="command", required=True))
     return parser
 
 
@@ -22,7 +22,7 @@ def bench_parser() -> argparse.ArgumentParser:
 def quick_run(tmp_path_factory: pytest.TempPathFactory):
     out = tmp_path_factory.mktemp("bench")
     args = bench_parser().parse_args(
-        ["renderers", "--quick", "--json", str(out / "rows.json"), "--csv", str(out / "rows.csv"), "--plot", str(out / "bench.png")]
+        ["bench", "renderers", "--quick", "--json", str(out / "rows.json"), "--csv", str(out / "rows.csv"), "--plot", str(out / "bench.png")]
     )
     assert args.func(args) == 0
     return out, json.loads((out / "rows.json").read_text())
@@ -72,5 +72,5 @@ def test_csv_and_plot_are_written(quick_run):
 def test_bad_grid_options_are_rejected(capsys: pytest.CaptureFixture[str]):
     for bad in (["--resolutions", "640by480"], ["--ratios", "0"], ["--triangles", "ten"]):
         with pytest.raises(SystemExit):
-            bench_parser().parse_args(["renderers", *bad])
+            bench_parser().parse_args(["bench", "renderers", *bad])
     assert "error" in capsys.readouterr().err

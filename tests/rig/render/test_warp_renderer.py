@@ -183,24 +183,17 @@ def test_before_any_client_frame_the_display_is_dark_and_unknown_frames_are_refu
         client_frame(front, 20, [0.0, 0.0, 0.0])
 
 
-def test_costs_are_modelled_when_given_and_measured_otherwise():
+@pytest.mark.parametrize("wait_for_gpu", [True, False])
+def test_client_and_server_report_what_their_work_took(wait_for_gpu):
     renderer = WarpRenderer()
-    renderer.open(RenderSetup(WIDTH, HEIGHT, ORTHOGRAPHIC, RADIUS, app_frame_ms=40.0, warp_ms=3.0))
+    renderer.open(RenderSetup(WIDTH, HEIGHT, ORTHOGRAPHIC, RADIUS, wait_for_gpu=wait_for_gpu))
     try:
         app = renderer.render_app_frame(AppFrameRequest(0, 0.0, 0.0, at([0.0, 0.0, 0.0])))
         shown = renderer.render_display_frame(DisplayFrameRequest(0, 0.0, 0.0, at([0.0, 0.0, 0.0]), 0))
+        wall, gpu = renderer.last_warp_seconds
     finally:
         renderer.close()
-    assert (app.cost_s, app.cost_source, app.image) == (0.04, "modelled", None)
-    assert (shown.cost_s, shown.cost_source) == (0.003, "modelled")
-    measured = opened()
-    try:
-        app = measured.render_app_frame(AppFrameRequest(0, 0.0, 0.0, at([0.0, 0.0, 0.0])))
-        shown = measured.render_display_frame(DisplayFrameRequest(0, 0.0, 0.0, at([0.0, 0.0, 0.0]), 0))
-        wall, gpu = measured.last_warp_seconds
-    finally:
-        measured.close()
-    assert app.cost_source == shown.cost_source == "measured"
+    assert app.image is None
     assert app.cost_s > 0.0 and shown.cost_s == wall > 0.0
     assert gpu is None or gpu > 0.0
 

@@ -13,6 +13,7 @@ from analysis.board.blink_code import lfsr_bits
 from analysis.board.recording import load_table
 from rig.board.protocol import protocol
 from rig.board.recording import FILES
+from rig.clock import VirtualClock
 from rig.errors import ConfigError, RigError
 from rig.sim.board import SimulatedBoard, SimulatedBoardConfig, encoder_count
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -100,9 +101,13 @@ def recorded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Pendulum, Simula
     config = SimulatedBoardConfig(board_offset_s=1234.56789, blink_start_s=0.1, blink_bits=16)
     out = tmp_path_factory.mktemp("board")
     board = SimulatedBoard(config, pendulum, T_BEGIN, T_END, out)
+    clock = VirtualClock(T_BEGIN)
+    board.connect(clock)
     try:
         for t in np.arange(T_BEGIN, T_END, 0.0137):
-            board.advance(float(t))
+            clock.wait_until(float(t))
+            board.poll()
+        clock.wait_until(T_END)
         board.finish()
     finally:
         board.close()
@@ -176,11 +181,15 @@ def test_the_recording_has_every_file_of_a_real_one_and_describes_the_board(reco
 def test_events_are_on_disk_as_soon_as_the_clock_passes_them(tmp_path: Path) -> None:
     pendulum = Pendulum(PendulumConfig(), t_end=3.0, t_start=-1.0)
     board = SimulatedBoard(SimulatedBoardConfig(blink_start_s=0.1, blink_bits=8), pendulum, 0.0, 2.0, tmp_path)
+    clock = VirtualClock(0.0)
+    board.connect(clock)
     try:
-        board.advance(0.63)
+        clock.wait_until(0.63)
+        board.poll()
         first = load_table(tmp_path, "encoder.csv")["rig_time_s"]
         assert first.size > 100 and first.max() <= 0.63
-        board.advance(1.4)
+        clock.wait_until(1.4)
+        board.poll()
         second = load_table(tmp_path, "encoder.csv")["rig_time_s"]
         np.testing.assert_array_equal(second[: first.size], first)
         assert 0.63 < second[first.size] and second.max() <= 1.4
@@ -192,7 +201,7 @@ def test_events_are_on_disk_as_soon_as_the_clock_passes_them(tmp_path: Path) -> 
 def test_a_folder_holding_a_recording_is_refused(recorded) -> None:
     pendulum, config, out = recorded
     with pytest.raises(RigError, match="already holds a board recording"):
-        SimulatedBoard(config, pendulum, T_BEGIN, T_END, out)
+        SimulatedBoard(config, pendulum, T_BEGIN, T_END, out).connect(VirtualClock(T_BEGIN))
 
 
 def test_an_edge_pair_at_a_turning_point_is_not_lost(tmp_path: Path) -> None:
@@ -202,6 +211,7 @@ def test_an_edge_pair_at_a_turning_point_is_not_lost(tmp_path: Path) -> None:
     amplitude = (k + 0.5) * 2.0 * np.pi / 2400 + 1e-7
     pendulum = Pendulum(PendulumConfig(amplitude_deg=math.degrees(amplitude), quality=math.inf), t_end=2.0)
     board = SimulatedBoard(SimulatedBoardConfig(blink_start_s=0.1, blink_bits=4), pendulum, 0.0, 1.5 * pendulum.period_s, tmp_path)
+    board.connect(VirtualClock(1.5 * pendulum.period_s))
     try:
         board.finish()
     finally:

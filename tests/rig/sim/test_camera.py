@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from rig.errors import ConfigError
-from rig.sim.camera import CameraConfig, CameraSensor, VideoFileWriter
+from rig.records import VideoRecord
+from rig.sim.camera import CameraConfig, CameraSensor
 
 NO_PANEL = (0, 0, 1, 1)
 
@@ -93,7 +94,7 @@ def test_panel_light_lands_in_its_rectangle() -> None:
 
 def test_video_is_read_back_by_opencv(tmp_path) -> None:
     path = tmp_path / "v.avi"
-    with VideoFileWriter(path, fps=240.0, width=160, height=120) as video:
+    with VideoRecord(path, fps=240.0, width=160, height=120) as video:
         for i in range(12):
             video.write(np.full((120, 160), 10 * i, dtype=np.uint8))
     capture = cv2.VideoCapture(str(path))

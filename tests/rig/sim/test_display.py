@@ -4,37 +4,37 @@ import numpy as np
 import pytest
 
 from rig.errors import ConfigError
-from rig.sim.display import COMMON_REFRESH_HZ, Display, DisplayConfig
+from rig.sim.display import COMMON_REFRESH_HZ, DisplayConfig, SimDisplay
 
 
 @pytest.fixture(params=COMMON_REFRESH_HZ, ids=lambda hz: f"{hz:g}Hz")
-def display(request: pytest.FixtureRequest) -> Display:
-    return Display(DisplayConfig(refresh_hz=request.param, t0=0.25))
+def display(request: pytest.FixtureRequest) -> SimDisplay:
+    return SimDisplay(DisplayConfig(refresh_hz=request.param, t0=0.25))
 
 
-def test_vblanks_are_one_period_apart(display: Display) -> None:
+def test_vblanks_are_one_period_apart(display: SimDisplay) -> None:
     times = display.vblank_time(np.arange(10))
     assert times[0] == 0.25
     np.testing.assert_allclose(np.diff(times), 1.0 / display.config.refresh_hz, rtol=1e-12)
 
 
-def test_frame_finished_between_blanks_appears_at_the_next_blank(display: Display) -> None:
+def test_frame_finished_between_blanks_appears_at_the_next_blank(display: SimDisplay) -> None:
     t = display.vblank_time(3) + 0.3 * display.period_s
     assert display.refresh_after(t) == 4
 
 
-def test_frame_finished_exactly_at_a_blank_misses_it(display: Display) -> None:
+def test_frame_finished_exactly_at_a_blank_misses_it(display: SimDisplay) -> None:
     assert display.refresh_after(display.vblank_time(5)) == 6
 
 
-def test_scanout_runs_top_to_bottom_over_one_period(display: Display) -> None:
+def test_scanout_runs_top_to_bottom_over_one_period(display: SimDisplay) -> None:
     assert display.scanout_delay(0.0) == 0.0
     assert display.scanout_delay(1.0) == pytest.approx(display.period_s)
     assert display.scanout_delay(0.25) == pytest.approx(0.25 * display.period_s)
     assert display.photon_time(2, 0.5) == pytest.approx(display.vblank_time(2) + 0.5 * display.period_s)
 
 
-def test_each_row_holds_its_refresh_until_scanned_again(display: Display) -> None:
+def test_each_row_holds_its_refresh_until_scanned_again(display: SimDisplay) -> None:
     period = display.period_s
     v = display.vblank_time(7)
     # Just after the blank only the top row shows refresh 7; the middle still shows refresh 6.
@@ -46,12 +46,12 @@ def test_each_row_holds_its_refresh_until_scanned_again(display: Display) -> Non
     assert display.refresh_shown(np.array(v + 1.5 * period + 1e-9), np.array(0.5)) == 8
 
 
-def test_rows_before_the_first_refresh_show_nothing(display: Display) -> None:
+def test_rows_before_the_first_refresh_show_nothing(display: SimDisplay) -> None:
     assert display.refresh_shown(np.array(0.0), np.array(0.0)) == -1
 
 
 def test_partial_scanout_fraction_leaves_a_blanking_interval() -> None:
-    display = Display(DisplayConfig(refresh_hz=60.0, scanout_fraction=0.9))
+    display = SimDisplay(DisplayConfig(refresh_hz=60.0, scanout_fraction=0.9))
     assert display.scanout_delay(1.0) == pytest.approx(0.9 / 60.0)
 
 

@@ -4,20 +4,12 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from predictors import PoseSample
+from rig.clock import VirtualClock
 from rig.errors import ConfigError, RigError
 from rig.sim.pendulum import Pendulum, PendulumConfig
-from rig.sim.tracker import (
-    CSV_HEADER,
-    TrackerConfig,
-    TrackerCsvWriter,
-    read_tracker_csv,
-    simulate_tracker,
-    write_tracker_csv,
-)
+from rig.sim.tracker import SimTracker, TrackerConfig, simulate_tracker
 
 QUIET = dict(position_noise_m=0.0, orientation_noise_deg=0.0, jitter_s=0.0)
 
@@ -166,83 +158,31 @@ def test_config_rejects_bad_values(kwargs, message):
         TrackerConfig(**kwargs)
 
 
-def _assert_same_samples(read: list[PoseSample], written: list[PoseSample]) -> None:
-    assert len(read) == len(written)
-    for a, b in zip(read, written):
-        assert a.t_sensor == b.t_sensor
-        assert a.t_arrival == b.t_arrival
-        np.testing.assert_array_equal(a.position, b.position)
-        np.testing.assert_array_equal(a.orientation, b.orientation)
+def test_the_simulated_tracker_hands_out_each_sample_once_its_arrival_has_passed(pendulum):
+    tracker = SimTracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=4)
+    expected = simulate_tracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=4)
+    clock = VirtualClock(-0.5)
+    tracker.connect(clock)
+    first = tracker.wait(timeout_s=1.0)
+    assert clock.now() == expected[0].t_arrival
+    got = list(first)
+    for t in np.arange(0.0, 1.1, 0.013):
+        clock.wait_until(float(t))
+        arrived = tracker.poll()
+        assert all(s.t_arrival <= clock.now() for s in arrived)
+        got += arrived
+    tracker.close()
+    assert [s.t_sensor for s in got] == [s.t_sensor for s in expected]
 
 
-def test_csv_round_trip_is_exact(pendulum, tmp_path):
-    samples = simulate_tracker(pendulum, TrackerConfig(dropout=0.1), 0.0, 2.0, seed=2)
-    path = tmp_path / "tracker.csv"
-    write_tracker_csv(path, samples)
-    assert path.read_text().splitlines()[0] == CSV_HEADER
-    _assert_same_samples(read_tracker_csv(path), samples)
+def test_waiting_gives_nothing_when_no_sample_comes_in_time(pendulum):
+    tracker = SimTracker(pendulum, TrackerConfig(transport_delay_s=0.5), 0.0, 1.0, seed=4)
+    clock = VirtualClock(0.0)
+    tracker.connect(clock)
+    assert tracker.wait(timeout_s=0.1) == []
+    assert clock.now() == 0.0
 
 
-@settings(max_examples=50, deadline=None)
-@given(
-    times=st.lists(st.floats(allow_nan=False, allow_infinity=False), min_size=2, max_size=2),
-    position=st.lists(st.floats(allow_nan=False, allow_infinity=False), min_size=3, max_size=3),
-)
-def test_csv_round_trip_is_exact_for_any_finite_values(tmp_path_factory, times, position):
-    sample = PoseSample(times[0], times[1], np.array(position), np.array([0.5, -0.5, 0.5, 0.5]))
-    path = tmp_path_factory.mktemp("csv") / "tracker.csv"
-    write_tracker_csv(path, [sample])
-    _assert_same_samples(read_tracker_csv(path), [sample])
-
-
-def test_abandoned_writer_leaves_a_readable_file(pendulum, tmp_path):
-    samples = simulate_tracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=3)
-    path = tmp_path / "tracker.csv"
-    writer = TrackerCsvWriter(path)
-    try:
-        for sample in samples[:5]:
-            writer.write(sample)
-        _assert_same_samples(read_tracker_csv(path), samples[:5])
-    finally:
-        writer.close()
-
-
-def test_a_row_cut_short_at_the_end_is_skipped(pendulum, tmp_path):
-    samples = simulate_tracker(pendulum, TrackerConfig(), 0.0, 0.1, seed=3)
-    path = tmp_path / "tracker.csv"
-    write_tracker_csv(path, samples)
-    text = path.read_text()
-    path.write_text(text[: text.rindex("\n", 0, -1) + 12])
-    _assert_same_samples(read_tracker_csv(path), samples[:-1])
-
-
-def test_writer_refuses_to_replace_a_file_unless_told(pendulum, tmp_path):
-    samples = simulate_tracker(pendulum, TrackerConfig(), 0.0, 0.1, seed=3)
-    path = tmp_path / "tracker.csv"
-    write_tracker_csv(path, samples)
-    with pytest.raises(RigError, match="already exists"):
-        write_tracker_csv(path, samples[:2])
-    write_tracker_csv(path, samples[:2], overwrite=True)
-    _assert_same_samples(read_tracker_csv(path), samples[:2])
-
-
-@pytest.mark.parametrize(
-    "text, message",
-    [
-        ("t,x,y\n", "not a tracker CSV file"),
-        ("", "not a tracker CSV file"),
-        (CSV_HEADER + "\n0,0,0,0,0,1,0,0\n", "line 2: expected 9 comma-separated numbers, got 8"),
-        (CSV_HEADER + "\n0,0,0,0,0,1,0,0,0\n0,0,0,0,zero,1,0,0,0\n", "line 3: could not convert"),
-        (CSV_HEADER + "\n0,0,0,0,0,2,0,0,0\n", "line 2: .*unit quaternion"),
-    ],
-)
-def test_reading_a_malformed_file_names_the_problem(tmp_path, text, message):
-    path = tmp_path / "tracker.csv"
-    path.write_text(text)
-    with pytest.raises(RigError, match=message):
-        read_tracker_csv(path)
-
-
-def test_reading_a_missing_file_raises(tmp_path):
-    with pytest.raises(RigError, match="cannot read tracker samples"):
-        read_tracker_csv(tmp_path / "absent.csv")
+def test_an_unconnected_tracker_says_so(pendulum):
+    with pytest.raises(RigError, match="not connected"):
+        SimTracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=4).poll()

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from rig.truth import effective_latency, shown_signal
+from rig.sim.truth import effective_latency, shown_signal
 
 PERIOD = 1.0
 

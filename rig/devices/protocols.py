@@ -1,0 +1,124 @@
+"""The seams between a run and the world: a tracker, a display, a camera, and instruments beside them.
+
+A session (`rig.session`) sees devices only through these protocols, so a simulated twin
+(`rig.sim`), a real device and a third party's plug-in are interchangeable. Every device follows
+the same life cycle: its constructor stores settings and opens nothing; `connect(clock)` opens it
+and puts its timestamps on the run's clock (`rig.clock`); `close()` releases it and may be called
+more than once. No method blocks on I/O except the ones that say they wait.
+
+Times are seconds on the rig clock. Images are numpy arrays: a display takes RGB uint8
+(height, width, 3), row 0 at the top (the row scanned out first); a camera gives grey uint8
+(height, width).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from predictors import PoseSample
+from rig.clock import Clock
+
+NO_IMAGE = -1
+"""The image id of a refresh that shows nothing yet (a dark display)."""
+
+
+@runtime_checkable
+class TrackerSource(Protocol):
+    """Pose samples, each stamped with the sensor's time and the host's arrival time."""
+
+    def connect(self, clock: Clock) -> None: ...
+
+    def poll(self) -> list[PoseSample]:
+        """Every sample that has arrived by now and was not returned before, in arrival order."""
+        ...
+
+    def wait(self, timeout_s: float) -> list[PoseSample]:
+        """As `poll`, but first wait (on the clock) until a sample has arrived, at most `timeout_s`;
+        empty if none came."""
+        ...
+
+    def close(self) -> None: ...
+
+
+@runtime_checkable
+class Display(Protocol):
+    """Shows images at its refreshes and says when each refresh's light leaves which row.
+
+    Refresh k starts at `vblank_time(k)`; rows are lit top to bottom from there. An image handed
+    over with `present` appears at a refresh after it was ready (at most one new image a refresh)
+    and stays until the next one (sample-and-hold).
+    """
+
+    width: int
+    height: int
+    refresh_hz: float
+
+    def connect(self, clock: Clock) -> None: ...
+
+    def vblank_time(self, k: int) -> float:
+        """When refresh k starts."""
+        ...
+
+    def refresh_after(self, t: float) -> int:
+        """The first refresh that starts strictly after `t`."""
+        ...
+
+    def photon_time(self, k: int, row_fraction: float) -> float:
+        """When refresh k's light leaves the row at `row_fraction` (0 top, 1 bottom)."""
+        ...
+
+    def present(self, image: np.ndarray, t_ready: float, image_id: int) -> int:
+        """Hand over `image`, finished at `t_ready`, under `image_id`; the refresh it appears at."""
+        ...
+
+    def shown(self, k: int) -> int:
+        """The id of the image refresh k shows (NO_IMAGE: none yet); asked for k = 0, 1, 2, ... in
+        turn, as the run reaches each refresh."""
+        ...
+
+    def close(self) -> None: ...
+
+
+@dataclass(frozen=True, eq=False)
+class CameraFrame:
+    """One camera frame: its index, when its exposure started and how long it lasted, its image."""
+
+    index: int
+    t_start: float
+    exposure_s: float
+    image: np.ndarray
+
+
+@runtime_checkable
+class Camera(Protocol):
+    """Frames of the bench, each with its exposure on the rig clock."""
+
+    fps: float
+    width: int
+    height: int
+
+    def connect(self, clock: Clock) -> None: ...
+
+    def poll(self) -> list[CameraFrame]:
+        """Every frame complete by now and not returned before, in order."""
+        ...
+
+    def close(self) -> None: ...
+
+
+@runtime_checkable
+class Instrument(Protocol):
+    """Something that records beside a run on its own (the rig board): the session polls it as the
+    run goes, so it records up to the present; `finish` completes its record when the run ends
+    normally, `close` follows on any exit."""
+
+    def connect(self, clock: Clock) -> None: ...
+
+    def poll(self) -> None: ...
+
+    def finish(self) -> None: ...
+
+    def close(self) -> None: ...

@@ -1,0 +1,119 @@
+"""How the rig writes what a run records, as the run goes: tables as CSV, camera frames as video.
+
+Every table a run records (tracker samples, application and display frames, a board's events) is a
+`CsvRecord`. Rows reach the operating system as they are written (each row, or each batch where
+the caller says when a batch ends), so a crash or a Ctrl-C leaves a readable file holding every
+row written so far: a partial file and a finished one have the same header and the same rows. A
+power cut may still lose the last rows: rows are flushed, not fsynced.
+
+Floats are written with `repr`, so reading a file back gives the exact values; None is an empty
+cell. Lines end in a bare newline.
+
+A `VideoRecord` is released on any exit (use it as a context manager), so an interrupted run
+keeps a playable video of every frame written.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+from pathlib import Path
+from types import TracebackType
+from typing import Any, Sequence
+
+import cv2
+import numpy as np
+
+from rig.errors import RigError
+
+
+def _cell(value: Any) -> Any:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return repr(float(value))
+    return value
+
+
+class CsvRecord:
+    """A CSV table written as it grows.
+
+    flush_each_row False leaves flushing to the caller (`flush()` after each batch of rows), for
+    sources that deliver many rows at once. An existing file is replaced only with overwrite=True.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        header: Sequence[str],
+        *,
+        overwrite: bool = False,
+        flush_each_row: bool = True,
+    ) -> None:
+        self.path = Path(path)
+        self.header = tuple(header)
+        self._flush_each_row = flush_each_row
+        try:
+            self._file = open(self.path, "w" if overwrite else "x", encoding="utf-8", newline="")
+        except FileExistsError:
+            raise RigError(f"{self.path} already exists; choose another folder or pass --overwrite") from None
+        except OSError as error:
+            raise RigError(f"cannot write {self.path}: {error.strerror}") from None
+        self._writer = csv.writer(self._file, lineterminator="\n")
+        self._writer.writerow(self.header)
+        self._file.flush()
+        self.rows = 0
+
+    def write(self, row: Sequence[Any]) -> None:
+        """Append one row (as many cells as the header has)."""
+        if len(row) != len(self.header):
+            raise ValueError(f"{self.path.name}: a row of {len(row)} cells for a header of {len(self.header)}")
+        self._writer.writerow([_cell(value) for value in row])
+        self.rows += 1
+        if self._flush_each_row:
+            self._file.flush()
+
+    def flush(self) -> None:
+        self._file.flush()
+
+    def close(self) -> None:
+        self._file.close()
+
+    def __enter__(self) -> CsvRecord:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
+
+
+class VideoRecord:
+    """Writes 8-bit grey frames to an MJPEG AVI: a codec every OpenCV build reads back."""
+
+    FOURCC = "MJPG"
+    QUALITY = 95
+
+    def __init__(self, path: str | os.PathLike[str], fps: float, width: int, height: int) -> None:
+        self.path = Path(path)
+        self._writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*self.FOURCC), fps, (width, height), True)
+        if not self._writer.isOpened():
+            raise RigError(f"cannot write video {self.path}: OpenCV has no {self.FOURCC} writer here")
+        self._writer.set(cv2.VIDEOWRITER_PROP_QUALITY, self.QUALITY)
+        self.frames = 0
+
+    def write(self, grey: np.ndarray) -> None:
+        self._writer.write(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR))
+        self.frames += 1
+
+    def close(self) -> None:
+        self._writer.release()
+
+    def __enter__(self) -> VideoRecord:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,121 @@
+"""Simulate the rig: a session on a virtual clock with the simulated devices, and the run's truth.
+
+A run writes into its output folder as it goes (`rig.session.record`): `tracker.csv`,
+`app_frames.csv`, `display_frames.csv` and `video.avi`, with a simulated board its recording in
+`board/` (`rig.sim.board`), and at the end `truth.json` (`rig.sim.truth`). A folder that already
+holds a run is refused unless `overwrite` is given.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import predictors
+from rig.clock import VirtualClock
+from rig.devices.registry import DeviceContext, make_device
+from rig.errors import RigError
+from rig.render import RenderSetup, make_renderer
+from rig.session import RUN_FILES, RunRecord, Session, SessionParts, cost_model, timing_for
+from rig.session.session import Progress
+from rig.sim.board import BOARD_FOLDER, remove_recording
+from rig.sim.config import SimulationConfig
+from rig.sim.truth import Truth, run_truth
+from rig.sim.world import SimulatedWorld
+
+TRUTH_FILE = "truth.json"
+SIMULATION_FILES = (*RUN_FILES, TRUTH_FILE, BOARD_FOLDER)
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Where a simulated run wrote its files, and its truth."""
+
+    out_dir: Path
+    video_path: Path
+    truth: Truth
+
+    def summary(self) -> dict[str, Any]:
+        """The run in brief, JSON-ready."""
+        truth = self.truth
+        return {
+            "out_dir": str(self.out_dir),
+            "video": str(self.video_path),
+            "latency_ms": truth.latency_ms,
+            "display_frame_delay_ms": {"mean": truth.display_frame_delay_ms.mean, "sd": truth.display_frame_delay_ms.sd},
+            "frames": truth.frames,
+            "camera_fps": truth.camera_fps,
+            "led_roi": truth.led_roi,
+            "sphere_roi": truth.sphere_roi,
+        }
+
+
+def _prepare(out_dir: Path, overwrite: bool) -> None:
+    """Make the output folder; refuse one holding a run unless `overwrite`, and then clear the old
+    run's board recording (its files only)."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise RigError(f"{out_dir} is a file, not a folder; choose an output folder")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise RigError(f"cannot make the output folder {out_dir}: {error.strerror}") from None
+    existing = [name for name in SIMULATION_FILES if (out_dir / name).exists()]
+    if existing and not overwrite:
+        raise RigError(f"{out_dir} already holds a run ({', '.join(existing)}); choose another output folder or pass --overwrite")
+    if overwrite:
+        remove_recording(out_dir / BOARD_FOLDER)
+
+
+def simulate(
+    config: SimulationConfig,
+    out_dir: Path,
+    progress: Progress | None = None,
+    overwrite: bool = False,
+) -> SimulationResult:
+    """Run the simulated rig of `config` and write its video, samples, frame logs and truth into out_dir."""
+    out_dir = Path(out_dir)
+    world = SimulatedWorld(config)
+    context = DeviceContext(simulation=world)
+    display = make_device("display", "sim", context)
+    camera = make_device("camera", "sim", context)
+    renderer = make_renderer(config.renderer)
+    board = world.board(out_dir / BOARD_FOLDER)
+    timing = timing_for(renderer, config.warp_ms)
+    setup = RenderSetup(
+        width=config.display.width,
+        height=config.display.height,
+        world_to_clip=world.layout.world_to_clip,
+        sphere_radius_m=world.layout.sphere_radius_m,
+        scene_triangles=config.scene_triangles,
+        wait_for_gpu=config.app_frame_ms is None,
+        seed=config.seed,
+    )
+    parts = SessionParts(
+        clock=VirtualClock(world.t_begin),
+        tracker=make_device("tracker", "sim", context),
+        predictor=predictors.make(config.predictor, **config.predictor_params),
+        renderer=renderer,
+        render_setup=setup,
+        timing=timing,
+        app_cost=cost_model(config.app_frame_ms),
+        display=display,
+        camera=camera,
+        instruments=[board] if board is not None else [],
+    )
+    _prepare(out_dir, overwrite)
+    with RunRecord(out_dir, (camera.fps, camera.width, camera.height), overwrite=overwrite) as record:
+        log = Session(parts, world.t_begin, world.t_end, record, progress).run()
+    truth = run_truth(
+        config,
+        world.pendulum,
+        display,
+        log,
+        camera_span=(0.0, float(camera.frame_times[-1] + config.camera.exposure)),
+        frames=len(camera.frame_times),
+        rois=(list(world.layout.led_roi), list(world.layout.sphere_roi)),
+        display_frame_cost=timing.display_frame_cost(),
+        board=board.truth() if board is not None else None,
+    )
+    truth.write(out_dir / TRUTH_FILE)
+    return SimulationResult(out_dir, record.video_path, truth)

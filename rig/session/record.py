@@ -1,0 +1,60 @@
+"""The files a run writes as it goes, the same live or simulated (see `rig.session`):
+
+* `tracker.csv` every tracker sample as it reaches the host (`predictors.SAMPLE_COLUMNS`);
+* `app_frames.csv` every application frame: when it started, what it cost and where that figure
+  came from, when it finished, the photon time it predicted for, the newest sample behind it, and
+  the position drawn;
+* `display_frames.csv` every refresh that shows an image: which image, the row it lights, its
+  photon time, the newest sample behind it, the sensor-to-photon delay, and the x drawn;
+* `video.avi` the camera's frames, where the run has a camera it records itself.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from pathlib import Path
+
+from predictors import SAMPLE_COLUMNS
+from rig.records import CsvRecord, VideoRecord
+
+TRACKER_FILE = "tracker.csv"
+APP_FRAMES_FILE = "app_frames.csv"
+DISPLAY_FRAMES_FILE = "display_frames.csv"
+VIDEO_FILE = "video.avi"
+RUN_FILES = (VIDEO_FILE, TRACKER_FILE, APP_FRAMES_FILE, DISPLAY_FRAMES_FILE)
+APP_FRAME_COLUMNS = (
+    "index", "t_start", "cost_s", "cost_source", "t_finish", "t_photon_target", "t_sensor_newest", "x", "y", "z",
+)  # fmt: skip
+DISPLAY_FRAME_COLUMNS = ("refresh", "t_vblank", "image", "row_fraction", "t_photon", "t_sensor_newest", "delay_ms", "x")
+
+
+class RunRecord:
+    """The open files of one run in `out_dir`; `video_size` (fps, width, height) for a camera the run
+    records, None for none. Use as a context manager: every file is closed on any exit."""
+
+    def __init__(self, out_dir: Path, video_size: tuple[float, int, int] | None, overwrite: bool = False) -> None:
+        self.out_dir = Path(out_dir)
+        self._stack = contextlib.ExitStack()
+        with self._stack:
+            self.tracker = self._stack.enter_context(CsvRecord(self.out_dir / TRACKER_FILE, SAMPLE_COLUMNS, overwrite=overwrite))
+            self.app_frames = self._stack.enter_context(
+                CsvRecord(self.out_dir / APP_FRAMES_FILE, APP_FRAME_COLUMNS, overwrite=overwrite)
+            )
+            self.display_frames = self._stack.enter_context(
+                CsvRecord(self.out_dir / DISPLAY_FRAMES_FILE, DISPLAY_FRAME_COLUMNS, overwrite=overwrite)
+            )
+            self.video = self._stack.enter_context(VideoRecord(self.out_dir / VIDEO_FILE, *video_size)) if video_size else None
+            self._stack = self._stack.pop_all()
+
+    @property
+    def video_path(self) -> Path:
+        return self.out_dir / VIDEO_FILE
+
+    def close(self) -> None:
+        self._stack.close()
+
+    def __enter__(self) -> RunRecord:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

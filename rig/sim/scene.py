@@ -1,0 +1,80 @@
+"""What the simulated camera films: the real LED on the pendulum and the light of the display panel.
+
+The camera sees the LED where the bench layout (`rig.sim.bench`) puts the pendulum, as bright as
+the board drives it, and the display panel as each of its rows emits at each instant (the
+display's scan-out and sample-and-hold, `rig.sim.display`), in camera digital numbers.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from rig.devices.protocols import NO_IMAGE
+from rig.sim.bench import BenchLayout
+from rig.sim.board import SimulatedBoardConfig
+from rig.sim.display import SimDisplay
+from rig.sim.pendulum import Pendulum
+
+
+class FilmedScene:
+    """The light reaching the camera at given instants."""
+
+    def __init__(
+        self,
+        pendulum: Pendulum,
+        display: SimDisplay,
+        layout: BenchLayout,
+        display_black_dn: float,
+        display_white_dn: float,
+        board: SimulatedBoardConfig | None,
+    ) -> None:
+        self.pendulum = pendulum
+        self.display = display
+        self.layout = layout
+        self.panel = layout.panel
+        self._black = display_black_dn
+        self._white = display_white_dn
+        self._board = board
+        self._rows = (np.arange(layout.panel[3]) + 0.5) / layout.panel[3]
+        self._panels: dict[int, np.ndarray] = {}
+
+    @property
+    def settled_until(self) -> float:
+        """Until when the scene's light is known: the display's content is decided up to there."""
+        return self.display.settled_until
+
+    def led_pixels(self, instants: np.ndarray) -> np.ndarray:
+        """Where the camera sees the LED at each instant, (S, 2) pixels."""
+        return self.layout.led_pixels(self.pendulum.led_position(instants))
+
+    def led_levels(self, instants: np.ndarray) -> np.ndarray | None:
+        """The LED's drive level 0..255 at each instant; None for an LED always fully on."""
+        return self._board.led_level(instants) if self._board is not None else None
+
+    def panel_light(self, instants: np.ndarray) -> np.ndarray:
+        """The display panel's light averaged over the given instants, row by row (scan-out)."""
+        content = self.display.content
+        refresh = self.display.refresh_shown(instants[:, None], self._rows[None, :])
+        # Only the last few refreshes can be on screen: look them up without copying all of content.
+        first = max(int(refresh.min()), 0)
+        recent = np.asarray(content[first:])
+        image_ids = np.where(refresh >= 0, recent[np.maximum(refresh, 0) - first], NO_IMAGE)
+        _, _, pw, ph = self.panel
+        light = np.zeros((ph, pw), dtype=np.float32)
+        for image_id in np.unique(image_ids):
+            weight = (image_ids == image_id).mean(axis=0).astype(np.float32)
+            shown = self._panel_image(int(image_id)) if image_id != NO_IMAGE else self._black
+            light += weight[:, None] * shown
+        return light
+
+    def _panel_image(self, image_id: int) -> np.ndarray:
+        """The display image `image_id` as the camera sees it on the panel, in digital numbers."""
+        if image_id not in self._panels:
+            for old in [i for i in self._panels if i not in self.display.images]:
+                del self._panels[old]
+            _, _, pw, ph = self.panel
+            grey = cv2.cvtColor(np.ascontiguousarray(self.display.images[image_id]), cv2.COLOR_RGB2GRAY)
+            panel = cv2.resize(grey, (pw, ph), interpolation=cv2.INTER_AREA).astype(np.float32)
+            self._panels[image_id] = self._black + panel * np.float32((self._white - self._black) / 255.0)
+        return self._panels[image_id]
