@@ -1,28 +1,36 @@
 # Two entry points for a newcomer: `make demo` and `make test`. Both first install what is missing:
 # Debian packages (as root; otherwise the command to run is printed) and a virtual environment
-# with the pinned Python packages of constraints.txt.
+# with the pinned Python packages of constraints.txt. Only the tests need the firmware's toolchain
+# and its emulator (firmware/system-packages.txt): `make demo` leaves them out.
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
-SYSTEM_PACKAGE_LISTS := system-packages.txt $(wildcard firmware/system-packages.txt)
+TEST_STAMP := $(VENV)/.installed-test
 
-.PHONY: demo test system venv clean
+.PHONY: demo test system test-system venv clean
 
 system:
-	@scripts/install-system-packages.sh $(SYSTEM_PACKAGE_LISTS)
+	@scripts/install-system-packages.sh system-packages.txt
+
+test-system:
+	@scripts/install-system-packages.sh system-packages.txt firmware/system-packages.txt
 
 venv: $(STAMP)
 
 $(STAMP): pyproject.toml setup.py analysis/_jpeg_region.c constraints.txt
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet -c constraints.txt -e '.[test]'
+	$(BIN)/pip install --quiet -c constraints.txt -e .
 	touch $(STAMP)
+
+$(TEST_STAMP): $(STAMP)
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[test]'
+	touch $(TEST_STAMP)
 
 demo: system $(STAMP)
 	$(BIN)/rig demo --out out/demo
 
-test: system $(STAMP)
+test: test-system $(TEST_STAMP)
 	$(MAKE) -C firmware all test
 	$(BIN)/python -m pytest -q
 
