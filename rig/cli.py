@@ -8,7 +8,8 @@ from typing import Sequence
 
 from analysis.errors import AnalysisError
 from predictors import PredictorError
-from rig.commands import analyse, bench, board, demo, simulate, tune
+from rig.commands import analyse, bench, board, demo, report, simulate, sweep, tune
+from rig.compile_cache import keep_compiled_fits
 from rig.errors import RigError
 
 USER_ERRORS = (RigError, PredictorError, AnalysisError)
@@ -22,7 +23,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Measure motion-to-photon latency with a pendulum, an LED and a camera; simulate the rig.",
     )
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for command in (demo, simulate, analyse, bench, tune, board):
+    for command in (demo, simulate, analyse, sweep, report, bench, tune, board):
         command.add_parser(subparsers)
     return parser
 
@@ -41,6 +42,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def run() -> None:
     """Console-script entry point."""
+    keep_compiled_fits()
     sys.exit(main())
 
 

@@ -1,0 +1,42 @@
+"""`rig sweep SPEC.toml --out DIR`: simulate and analyse every point of a grid, into one summary."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from rig.commands import options
+from rig.progress import ProgressBar
+from rig.service.sweep import read_sweep, run_sweep
+
+
+def _run(args: argparse.Namespace) -> int:
+    sweep = read_sweep(args.spec)
+    rows, summary = run_sweep(sweep, args.out, args.workers, args.scheduler, ProgressBar("sweeping", unit="points"))
+    if args.json:
+        print(json.dumps(rows))
+    else:
+        for row in rows:
+            settings = ", ".join(f"{name}={row[name]}" for name in sweep.grid)
+            measured = f"{row['latency_ms']:.2f} ms (true {row['truth_ms']:.2f}, error {row['error_ms']:+.3f})" if row["latency_ms"] is not None else f"failed: {row['error']}"
+            print(f"{settings}: {measured}")
+        print(f"summary: {summary} and {summary.with_suffix('.json')}")
+    return 0
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "sweep",
+        help="simulate and analyse a grid of simulated rigs into one summary",
+        description="SPEC.toml names [base] simulation settings, a [grid] of settings and the values to sweep each "
+        "over (every combination runs), and optional [analysis] options (method, latency_range_ms, seed, led_side). "
+        "Each point is simulated into DIR/pointNNN and analysed; DIR/summary.csv (and .json) gets one row per point "
+        "as it finishes, with the truth and the error beside the measured latency.",
+    )
+    parser.add_argument("spec", type=Path, metavar="SPEC.toml", help="the sweep")
+    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="folder for the runs and the summary")
+    parser.add_argument("--workers", type=options.positive_int, help="run on a local Dask cluster of this many processes")
+    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on an existing Dask scheduler")
+    parser.add_argument("--json", action="store_true", help="print the rows as JSON")
+    parser.set_defaults(func=_run)

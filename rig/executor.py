@@ -1,0 +1,70 @@
+"""One way to run many independent jobs (a batch of videos, a sweep, a bench grid): in this process,
+on a local Dask cluster, or on an existing Dask scheduler, with the same answers whichever runs them.
+
+A job is a pure function of picklable arguments (paths and parameters), so any worker can run it;
+results come back as they complete, tagged with their place in the input, so a caller can record
+each as soon as it exists and still put them in input order at the end.
+
+    with executor(workers=2) as run:
+        for index, result in run(analyse_one, requests):
+            ...
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+from typing import Any, Callable, Iterator, Sequence
+
+from rig.errors import ConfigError, RigError
+
+Jobs = Callable[[Callable[[Any], Any], Sequence[Any]], Iterator[tuple[int, Any]]]
+"""Runs `function` on each item; yields (index of the item, its result) as each completes."""
+
+
+def _serial(function: Callable[[Any], Any], items: Sequence[Any]) -> Iterator[tuple[int, Any]]:
+    for index, item in enumerate(items):
+        yield index, function(item)
+
+
+def _on_dask(client: Any) -> Jobs:
+    from distributed import as_completed
+
+    def run(function: Callable[[Any], Any], items: Sequence[Any]) -> Iterator[tuple[int, Any]]:
+        futures = {client.submit(function, item, pure=False): index for index, item in enumerate(items)}
+        try:
+            for future in as_completed(futures):
+                yield futures[future], future.result()
+        finally:
+            client.cancel(list(futures))
+
+    return run
+
+
+@contextlib.contextmanager
+def executor(workers: int | None = None, scheduler: str | None = None) -> Iterator[Jobs]:
+    """Jobs run serially here (neither given), on a local Dask cluster of `workers` processes with
+    one thread each and no dashboard, or on the Dask scheduler at `scheduler` (tcp://HOST:PORT),
+    whose workers must reach the jobs' paths."""
+    if workers is not None and scheduler is not None:
+        raise ConfigError("give --workers or --scheduler, not both")
+    if workers is None and scheduler is None:
+        yield _serial
+        return
+    if workers is not None and workers < 1:
+        raise ConfigError(f"--workers must be at least 1, got {workers}")
+    from distributed import Client, LocalCluster
+
+    logging.getLogger("distributed").setLevel(logging.ERROR)
+    with contextlib.ExitStack() as stack:
+        if scheduler is not None:
+            try:
+                client = stack.enter_context(Client(scheduler, timeout="10s"))
+            except OSError as error:
+                raise RigError(f"cannot reach the Dask scheduler at {scheduler}: {error}") from None
+        else:
+            cluster = stack.enter_context(
+                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+            )
+            client = stack.enter_context(Client(cluster))
+        yield _on_dask(client)

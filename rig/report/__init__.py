@@ -1,0 +1,1 @@
+"""Reports a lab can keep: their content (`document`) and their pictures (`figures`)."""

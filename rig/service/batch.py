@@ -1,0 +1,202 @@
+"""Many measurements at once: analyse a batch of videos into one summary, on any executor.
+
+Every video becomes one row (`SUMMARY_COLUMNS`, plus the labels the user gave): `status` is `ok`,
+`warning` (measured, but read the warnings, or ambiguous) or `failed` (with the reason in
+`error`); one bad video never stops the batch. Rows reach the summary CSV as each video finishes,
+so an interrupted batch keeps what it finished; the JSON beside it (`partial: true` until the end)
+holds the same rows. At the end both are rewritten in the order the videos were given, so a batch
+gives the same summary, row for row, serially or on Dask.
+"""
+
+from __future__ import annotations
+
+import glob
+import json
+import os
+import time
+import traceback
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+from analysis.errors import AnalysisError
+from predictors import PredictorError
+from rig.errors import ConfigError, RigError
+from rig.executor import executor
+from rig.records import CsvRecord
+from rig.service.analyse import AnalysisRequest, analyse
+
+VIDEO_SUFFIXES = (".avi", ".mp4", ".mov", ".mkv", ".m4v", ".webm")
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
+SUMMARY_COLUMNS = (
+    "index", "video", "status", "latency_ms", "ci95_low_ms", "ci95_high_ms", "method", "model", "period_s",
+    "frequency_hz", "frames", "frames_used", "ambiguous", "warnings", "error", "seconds",
+)  # fmt: skip
+USER_ERRORS = (RigError, AnalysisError, PredictorError)
+RESULT_COLUMNS = frozenset((*SUMMARY_COLUMNS, "truth_ms", "error_ms"))
+"""Every column a summary row may hold that is not a label (a sweep adds the truth and the error)."""
+
+
+@dataclass(frozen=True)
+class BatchItem:
+    """One video to analyse and the labels its row carries (for grouping and comparing)."""
+
+    request: AnalysisRequest
+    labels: dict[str, str] = field(default_factory=dict)
+
+
+def find_videos(paths: Sequence[str | Path]) -> list[Path]:
+    """The videos that paths, folders and glob patterns name, in the order given (a folder's in name
+    order). A folder holding video files gives each of them; a folder of images is one video."""
+    found: list[Path] = []
+    for entry in paths:
+        matches = sorted(glob.glob(str(entry))) if glob.has_magic(str(entry)) else [str(entry)]
+        if not matches:
+            raise ConfigError(f"nothing matches {entry}")
+        for match in map(Path, matches):
+            videos = sorted(p for p in match.iterdir() if p.suffix.lower() in VIDEO_SUFFIXES) if match.is_dir() else []
+            found.extend(videos or [match])
+    return list(dict.fromkeys(found))
+
+
+def labels_from(path: Path | None, videos: Sequence[Path]) -> dict[Path, dict[str, str]]:
+    """Labels per video from a CSV whose first column is `video` (a path as given, or a file name)
+    and whose other columns are labels; without one, each video is labelled by its folder."""
+    if path is None:
+        return {video: {"folder": video.parent.name or "."} for video in videos}
+    import csv
+
+    try:
+        with open(path, newline="", encoding="utf-8") as stream:
+            rows = list(csv.DictReader(stream))
+    except OSError as error:
+        raise ConfigError(f"cannot read the labels {path}: {error.strerror}") from None
+    if not rows or "video" not in rows[0]:
+        raise ConfigError(f"{path} must be a CSV whose first column is video, then one column per label")
+    by_name = {row["video"]: {k: v for k, v in row.items() if k != "video"} for row in rows}
+    return {video: by_name.get(str(video), by_name.get(video.name, {})) for video in videos}
+
+
+def summary_row(item: BatchItem) -> dict[str, Any]:
+    """Analyse one video into its summary row; a failure is a row too, never an exception."""
+    started = time.perf_counter()
+    row: dict[str, Any] = dict.fromkeys(SUMMARY_COLUMNS)
+    row["video"] = str(item.request.video)
+    try:
+        result = analyse(item.request).result
+    except USER_ERRORS as error:
+        row.update(status="failed", error=str(error))
+    except Exception as error:
+        where = traceback.extract_tb(error.__traceback__)[-1]
+        row.update(
+            status="failed",
+            error=f"unexpected {type(error).__name__} at {Path(where.filename).name}:{where.lineno}: {error} "
+            "(a bug: please report it with this video)",
+        )
+    else:
+        low, high = result.ci95_ms if result.ci95_ms is not None else (None, None)
+        row.update(
+            status="warning" if result.warnings or result.ambiguous else "ok",
+            latency_ms=result.latency_ms,
+            ci95_low_ms=low,
+            ci95_high_ms=high,
+            method=result.method,
+            model=result.model,
+            period_s=result.period_s,
+            frequency_hz=1.0 / result.period_s,
+            frames=result.frames,
+            frames_used=result.frames_used,
+            ambiguous=result.ambiguous,
+            warnings="; ".join(result.warnings),
+        )
+    row["seconds"] = time.perf_counter() - started
+    return row | item.labels
+
+
+def check_summary_path(summary: Path, overwrite: bool) -> None:
+    """Refuse a summary path that cannot be written, or that would replace one unless asked."""
+    if summary.suffix.lower() != ".csv":
+        raise ConfigError(f"--summary must name a .csv file (the JSON goes beside it), got {summary}")
+    if not summary.parent.is_dir():
+        raise ConfigError(f"cannot write the summary {summary}: folder {summary.parent} does not exist")
+    if summary.exists() and not overwrite:
+        raise ConfigError(f"{summary} already exists; choose another file or pass --overwrite")
+
+
+def _write_json(path: Path, rows: list[dict[str, Any]], partial: bool) -> None:
+    temporary = path.with_name(path.name + ".tmp")
+    temporary.write_text(json.dumps({"partial": partial, "rows": rows}, indent=1) + "\n", encoding="utf-8")
+    os.replace(temporary, path)
+
+
+@dataclass
+class BatchRun:
+    """A batch's rows so far, recorded into `summary` (and its JSON) as they come."""
+
+    summary: Path | None
+    columns: tuple[str, ...]
+    rows: list[dict[str, Any]] = field(default_factory=list)
+    _record: CsvRecord | None = None
+
+    def open(self) -> None:
+        if self.summary is not None:
+            self._record = CsvRecord(self.summary, self.columns, overwrite=True)
+
+    def add(self, row: dict[str, Any]) -> None:
+        self.rows.append(row)
+        if self._record is not None:
+            self._record.write([row.get(column) for column in self.columns])
+            _write_json(self.summary.with_suffix(".json"), self.rows, partial=True)
+
+    def finish(self) -> list[dict[str, Any]]:
+        """The rows in input order, and the summary rewritten so."""
+        self.rows.sort(key=lambda row: row["index"])
+        if self.summary is not None:
+            self.close()
+            temporary = self.summary.with_name(self.summary.name + ".tmp")
+            with CsvRecord(temporary, self.columns, overwrite=True) as record:
+                for row in self.rows:
+                    record.write([row.get(column) for column in self.columns])
+            os.replace(temporary, self.summary)
+            _write_json(self.summary.with_suffix(".json"), self.rows, partial=False)
+        return self.rows
+
+    def close(self) -> None:
+        if self._record is not None:
+            self._record.close()
+            self._record = None
+
+
+def _indexed(pair: tuple[int, BatchItem]) -> dict[str, Any]:
+    index, item = pair
+    return summary_row(item) | {"index": index}
+
+
+def run_batch(
+    items: Sequence[BatchItem],
+    summary: Path | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: Callable[[float, float], object] | None = None,
+) -> list[dict[str, Any]]:
+    """Analyse every item (serially, on `workers` local Dask processes, or on `scheduler`); the rows
+    in input order. The summary CSV and JSON are written as rows come (see the module docstring)."""
+    labels = list(dict.fromkeys(key for item in items for key in item.labels))
+    run = BatchRun(summary, (*SUMMARY_COLUMNS, *labels))
+    run.open()
+    try:
+        with executor(workers, scheduler) as jobs:
+            if progress is not None:
+                progress(0, len(items))
+            for _, row in jobs(_indexed, list(enumerate(items))):
+                run.add(row)
+                if progress is not None:
+                    progress(len(run.rows), len(items))
+        return run.finish()
+    finally:
+        run.close()
+
+
+def requests_for(videos: Sequence[Path], template: AnalysisRequest) -> list[AnalysisRequest]:
+    """One request per video, each as the template asks (ROIs, method, range...)."""
+    return [replace(template, video=video) for video in videos]

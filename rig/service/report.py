@@ -1,0 +1,195 @@
+"""A report a lab can keep: one measurement (a video, or a run folder) or a summary of many, as a
+self-contained HTML page and the same content as Markdown (`rig.report.document`).
+
+A run's report analyses its video again (with the run's board recording when the folder has one)
+and shows the latency in large type, the tracks over the whole film with the delayed LED laid on
+the sphere, the latency swing by swing, the residual, every method, every diagnostic with its
+verdict, the warnings, the configuration, the devices, the software versions and the project's
+commit. A simulated run's truth is shown beside the measurement. A summary's report (a CSV or JSON
+from `rig analyse --summary` or `rig sweep`) compares the runs.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import platform
+import subprocess
+from collections import defaultdict
+from importlib import metadata
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from analysis import LatencyResult
+from analysis.board.recording import METADATA
+from rig.errors import ConfigError
+from rig.report.document import Report, Section, write_html, write_markdown
+from rig.report.figures import latency_over_time_figure, residuals_figure, summary_figure, tracks_figure
+from rig.service.analyse import AnalysisRequest, Measurement, analyse
+from rig.service.batch import RESULT_COLUMNS
+
+PACKAGES = ("latency-rig", "numpy", "scipy", "opencv-contrib-python-headless", "jax", "jaxopt", "emcee", "matplotlib", "moderngl")
+RUN_VIDEO = "video.avi"
+TRUTH = "truth.json"
+BOARD = "board"
+# Diagnostics a good film passes, and the test each must pass.
+DIAGNOSTIC_CHECKS = {
+    "dropped_frames": lambda value: value == 0,
+    "repeated_frames": lambda value: value == 0,
+    "variable_frame_rate": lambda value: not value,
+    "detection_rate.led": lambda value: value >= 0.95,
+    "detection_rate.sphere": lambda value: value >= 0.95,
+    "clipped_frames.led": lambda value: value == 0,
+    "clipped_frames.sphere": lambda value: value == 0,
+}
+
+
+def software() -> list[tuple[str, str]]:
+    """Python, the packages a measurement depends on, and the project's commit where it is a checkout."""
+    rows = [("python", platform.python_version())]
+    for name in PACKAGES:
+        try:
+            rows.append((name, metadata.version(name)))
+        except metadata.PackageNotFoundError:
+            rows.append((name, "not installed"))
+    here = Path(__file__).resolve().parent
+    try:
+        commit = subprocess.run(["git", "-C", str(here), "rev-parse", "HEAD"], capture_output=True, text=True, timeout=5)
+        dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--untracked-files=no"], capture_output=True, text=True, timeout=5)
+        state = commit.stdout.strip() + (" (with uncommitted changes)" if dirty.stdout.strip() else "") if commit.returncode == 0 else "not a git checkout"
+    except (OSError, subprocess.TimeoutExpired):
+        state = "git not available"
+    return rows + [("project commit", state)]
+
+
+def _flatten(values: dict[str, Any], prefix: str = "") -> list[tuple[str, Any]]:
+    items: list[tuple[str, Any]] = []
+    for key, value in values.items():
+        if isinstance(value, dict):
+            items += _flatten(value, f"{prefix}{key}.")
+        else:
+            items.append((f"{prefix}{key}", value))
+    return items
+
+
+def _verdict(name: str, value: Any) -> str:
+    check = DIAGNOSTIC_CHECKS.get(name)
+    if check is None or value is None:
+        return "-"
+    return "ok" if check(value) else "check"
+
+
+def _headline(result: LatencyResult) -> str:
+    interval = f" (95 % interval {result.ci95_ms[0]:.2f} to {result.ci95_ms[1]:.2f} ms)" if result.ci95_ms else ""
+    return f"{result.latency_ms:.2f} ms{interval}"
+
+
+def _run_verdict(result: LatencyResult, truth: dict[str, Any] | None) -> str:
+    if result.ambiguous:
+        verdict = "AMBIGUOUS: the whole number of swing periods is not decided; see the warnings"
+    elif result.warnings:
+        verdict = f"measured, but read the {len(result.warnings)} warning(s)"
+    else:
+        verdict = "clean: every check passed"
+    if truth is not None:
+        verdict += f"; simulated truth {truth['latency_ms']:.2f} ms, error {result.latency_ms - truth['latency_ms']:+.3f} ms"
+    return verdict
+
+
+def run_report(path: Path) -> tuple[Report, Measurement]:
+    """The report of a video, or of a run folder holding video.avi (and maybe truth.json, board/)."""
+    path = Path(path)
+    folder = path if path.is_dir() and (path / RUN_VIDEO).exists() else None
+    video = folder / RUN_VIDEO if folder is not None else path
+    truth_path = (folder or video.parent) / TRUTH
+    truth = json.loads(truth_path.read_text()) if truth_path.exists() else None
+    board = (folder or video.parent) / BOARD
+    request = AnalysisRequest(video, board=board if (board / METADATA).exists() else None)
+    measurement = analyse(request)
+    result = measurement.result
+    report = Report(f"Latency of {video}", _headline(result), _run_verdict(result, truth))
+    report.sections.append(Section("Warnings", list(result.warnings) or ["none"]))
+    report.sections.append(Section("The film", [("tracks", tracks_figure(result)), ("latency_over_time", latency_over_time_figure(result)),
+                                                ("residual", residuals_figure(result))]))  # fmt: skip
+    methods = [(name, m.latency_ms, *(m.ci95_ms or (None, None)), m.model) for name, m in result.methods.items()]
+    report.sections.append(Section("Methods", [(("method", "latency (ms)", "95 % low", "95 % high", "model"), methods)]))
+    diagnostics = [(name, value, _verdict(name, value)) for name, value in _flatten(result.diagnostics)]
+    rows = [("period (s)", result.period_s, "-"), ("frames used", f"{result.frames_used}/{result.frames}", "-"),
+            ("ROIs", f"LED {result.led_roi.as_list()}, sphere {result.sphere_roi.as_list()} ({result.roi_source})", "-"),
+            ("LED told apart by", result.led_rule, "-"), *diagnostics]  # fmt: skip
+    report.sections.append(Section("Diagnostics", [(("diagnostic", "value", "verdict"), rows)]))
+    if measurement.board is not None:
+        report.sections.append(Section("Board", [(("field", "value"), _flatten(measurement.board.to_dict()))]))
+    configuration = [("video", str(video)), ("method", request.method), ("latency range (ms)", request.latency_range_ms)]
+    if truth is not None:
+        configuration += [(f"simulation.{k}", v) for k, v in _flatten(truth["config"])]
+    report.sections.append(Section("Configuration and devices", [(("setting", "value"), configuration)]))
+    report.sections.append(Section("Software", [(("software", "version"), software())]))
+    return report, measurement
+
+
+def read_summary(path: Path) -> list[dict[str, Any]]:
+    """The rows of a summary CSV or JSON (`rig analyse --summary`, `rig sweep`)."""
+    path = Path(path)
+    try:
+        if path.suffix.lower() == ".json":
+            return json.loads(path.read_text())["rows"]
+        with open(path, newline="", encoding="utf-8") as stream:
+            rows = list(csv.DictReader(stream))
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        raise ConfigError(f"cannot read the summary {path}: {error}") from None
+    numeric = ("latency_ms", "ci95_low_ms", "ci95_high_ms", "period_s", "frequency_hz", "seconds")
+    for row in rows:
+        for key in numeric:
+            if key in row:
+                row[key] = float(row[key]) if row[key] not in ("", None) else None
+    return rows
+
+
+def summary_report(path: Path, group: str | None = None) -> Report:
+    """The comparison across the runs of a summary, grouped by a label."""
+    rows = read_summary(path)
+    if not rows:
+        raise ConfigError(f"{path} holds no rows")
+    labels = [key for key in rows[0] if key not in RESULT_COLUMNS]
+    group = group or (labels[0] if labels else None)
+    if group is not None and group not in rows[0]:
+        raise ConfigError(f"no label {group!r} in {path}; labels: {', '.join(labels) or 'none'}")
+    measured = [row for row in rows if row.get("latency_ms") is not None]
+    failed = [row for row in rows if row.get("status") == "failed"]
+    report = Report(f"Summary of {path}", f"{len(measured)} of {len(rows)} videos measured",
+                    f"{len(failed)} failed, {sum(row.get('status') == 'warning' for row in rows)} with warnings")  # fmt: skip
+    report.sections.append(Section("Latency per video", [("summary", summary_figure(rows, group))]))
+    report.sections.append(Section(f"By {group or 'batch'}", [(("group", "videos", "median (ms)", "min (ms)", "max (ms)"), _groups(measured, group))]))
+    table = [(row["video"], row.get("status"), row.get("latency_ms"), row.get("ci95_low_ms"), row.get("ci95_high_ms"), row.get(group) if group else "-",
+              row.get("warnings") or row.get("error") or "") for row in rows]  # fmt: skip
+    report.sections.append(Section("Every video", [(("video", "status", "latency (ms)", "95 % low", "95 % high", group or "group", "warnings / error"), table)]))
+    report.sections.append(Section("Software", [(("software", "version"), software())]))
+    return report
+
+
+def _groups(rows: Sequence[dict[str, Any]], group: str | None) -> list[tuple[Any, ...]]:
+    members: dict[str, list[float]] = defaultdict(list)
+    for row in rows:
+        members[str(row.get(group, "")) if group else "all"].append(float(row["latency_ms"]))
+    return [(name, len(v), float(np.median(v)), min(v), max(v)) for name, v in sorted(members.items())]
+
+
+def check_report_path(out: Path) -> None:
+    """Refuse, before any work, a report path that is not an .html file in an existing folder."""
+    if out.suffix.lower() != ".html":
+        raise ConfigError(f"--out must name an .html file (the Markdown goes beside it), got {out}")
+    if not out.parent.is_dir():
+        raise ConfigError(f"cannot write {out}: folder {out.parent} does not exist")
+
+
+def write_report(report: Report, out: Path) -> tuple[Path, Path]:
+    """The page at `out` (.html) and the Markdown beside it (.md); both paths."""
+    out = Path(out)
+    check_report_path(out)
+    markdown = out.with_suffix(".md")
+    write_html(report, out)
+    write_markdown(report, markdown)
+    return out, markdown

@@ -1,0 +1,167 @@
+"""Sweeps: simulate-then-analyse every point of a grid over the simulation's options, on any executor,
+into the same summary a batch writes (`rig.service.batch`), with each point's settings as labels and
+the simulation's truth and the error beside the measured latency.
+
+A sweep is a TOML file:
+
+    [base]                       # SimulationConfig fields; nested ones as tables or dotted keys
+    duration_s = 6.0
+    camera.fps = 240.0
+
+    [grid]                       # every combination of these values
+    "pendulum.period_s" = [0.8, 1.0, 1.4]
+    predictor = ["hold", "slerp"]
+
+    [analysis]                   # how each video is analysed (rig analyse's options)
+    method = "sinefit"
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+from rig.errors import ConfigError
+from rig.executor import executor
+from rig.service.analyse import AnalysisRequest
+from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, summary_row
+from rig.service.simulate import simulate
+from rig.sim.board import SimulatedBoardConfig
+from rig.sim.config import SimulationConfig
+
+ANALYSIS_OPTIONS = ("method", "latency_range_ms", "seed", "led_side")
+_NESTED = {"board": SimulatedBoardConfig}
+
+
+@dataclass(frozen=True)
+class SweepPoint:
+    """One point of a sweep: its simulation, its labels (the grid's values) and its run folder."""
+
+    index: int
+    config: SimulationConfig
+    labels: dict[str, str]
+    out_dir: Path
+    analysis: AnalysisRequest
+
+
+@dataclass(frozen=True)
+class Sweep:
+    base: dict[str, Any]
+    grid: dict[str, list[Any]]
+    analysis: dict[str, Any] = field(default_factory=dict)
+
+    def points(self, out: Path) -> list[SweepPoint]:
+        names = list(self.grid)
+        template = AnalysisRequest(Path(), **{k: tuple(v) if isinstance(v, list) else v for k, v in self.analysis.items()})
+        points = []
+        for index, values in enumerate(itertools.product(*(self.grid[name] for name in names))):
+            settings = _merged(self.base, dict(zip(names, values)))
+            labels = {name: str(value) for name, value in zip(names, values)}
+            folder = out / f"point{index:03d}"
+            points.append(SweepPoint(index, build(SimulationConfig, settings), labels, folder, dataclasses.replace(template, video=folder / "video.avi")))
+        return points
+
+
+def _dotted(mapping: Mapping[str, Any]) -> dict[str, Any]:
+    """{"camera": {"fps": 1}} and {"camera.fps": 1} alike, as dotted keys."""
+    flat: dict[str, Any] = {}
+    for key, value in mapping.items():
+        if isinstance(value, Mapping):
+            flat.update({f"{key}.{k}": v for k, v in _dotted(value).items()})
+        else:
+            flat[key] = value
+    return flat
+
+
+def _merged(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:
+    return {**_dotted(base), **_dotted(overrides)}
+
+
+def build(kind: type, settings: Mapping[str, Any], prefix: str = "") -> Any:
+    """A config dataclass from dotted settings (`camera.fps`), every key checked against its fields."""
+    fields = {f.name: f for f in dataclasses.fields(kind)}
+    direct: dict[str, Any] = {}
+    nested: dict[str, dict[str, Any]] = {}
+    for key, value in settings.items():
+        head, _, rest = key.partition(".")
+        if head not in fields:
+            raise ConfigError(f"the sweep sets {prefix}{key}, but {kind.__name__} has no {head!r}; it has: {', '.join(fields)}")
+        if rest:
+            nested.setdefault(head, {})[rest] = value
+        else:
+            direct[head] = value
+    for head, values in nested.items():
+        default = getattr(kind(), head) if head not in _NESTED else None
+        if isinstance(default, dict):
+            direct[head] = values
+            continue
+        sub_kind = _NESTED.get(head) or type(default)
+        if not dataclasses.is_dataclass(sub_kind):
+            raise ConfigError(f"{prefix}{head} is a single value, not a group of settings")
+        direct[head] = build(sub_kind, values, f"{prefix}{head}.")
+    try:
+        return kind(**direct)
+    except TypeError as error:
+        raise ConfigError(f"bad sweep settings for {kind.__name__}: {error}") from None
+
+
+def read_sweep(path: Path) -> Sweep:
+    """A sweep from its TOML file; ConfigError naming what is wrong."""
+    try:
+        spec = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as error:
+        raise ConfigError(f"cannot read the sweep {path}: {error.strerror}") from None
+    except tomllib.TOMLDecodeError as error:
+        raise ConfigError(f"{path} is not valid TOML: {error}") from None
+    unknown = set(spec) - {"base", "grid", "analysis"}
+    if unknown:
+        raise ConfigError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}; a sweep has [base], [grid] and [analysis]")
+    grid = _dotted(spec.get("grid", {}))
+    if not grid:
+        raise ConfigError(f"{path} has no [grid]: name at least one setting and the values to sweep it over")
+    for name, values in grid.items():
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"{path}: grid.{name} must be a non-empty list of values")
+    analysis = spec.get("analysis", {})
+    bad = set(analysis) - set(ANALYSIS_OPTIONS)
+    if bad:
+        raise ConfigError(f"{path}: [analysis] takes {', '.join(ANALYSIS_OPTIONS)}, not {', '.join(sorted(bad))}")
+    return Sweep(spec.get("base", {}), grid, analysis)
+
+
+def run_point(point: SweepPoint) -> dict[str, Any]:
+    """Simulate one point and analyse its video: its summary row, with the truth and the error."""
+    simulation = simulate(point.config, point.out_dir, overwrite=True)
+    row = summary_row(BatchItem(point.analysis, point.labels)) | {"index": point.index}
+    truth = simulation.truth.latency_ms
+    row["truth_ms"] = truth
+    row["error_ms"] = row["latency_ms"] - truth if row["latency_ms"] is not None else None
+    return row
+
+
+def run_sweep(
+    sweep: Sweep,
+    out: Path,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: Callable[[float, float], object] | None = None,
+) -> tuple[list[dict[str, Any]], Path]:
+    """Every point of the sweep into out/pointNNN, and the summary out/summary.csv (and .json)."""
+    points = sweep.points(Path(out))
+    Path(out).mkdir(parents=True, exist_ok=True)
+    summary = Path(out) / "summary.csv"
+    run = BatchRun(summary, (*SUMMARY_COLUMNS, "truth_ms", "error_ms", *sweep.grid))
+    run.open()
+    try:
+        with executor(workers, scheduler) as jobs:
+            for _, row in jobs(run_point, points):
+                run.add(row)
+                if progress is not None:
+                    progress(len(run.rows), len(points))
+        return run.finish(), summary
+    finally:
+        run.close()

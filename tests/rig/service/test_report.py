@@ -1,0 +1,80 @@
+"""Reports: one page with everything, nothing fetched; plots a person can read."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+from rig.cli import main
+from rig.errors import ConfigError
+from rig.report.figures import latency_over_time_figure, residuals_figure, summary_figure, tracks_figure
+from rig.service.analyse import AnalysisRequest, analyse
+from rig.service.batch import BatchItem, run_batch
+
+
+@pytest.fixture(scope="module")
+def result(small_runs):
+    return analyse(AnalysisRequest(small_runs["fast"])).result
+
+
+def _legend_clear_of_data(figure) -> None:
+    """Every axis is labelled, and every legend lies outside its axes (so it covers no data)."""
+    FigureCanvasAgg(figure).draw()
+    renderer = figure.canvas.get_renderer()
+    for axes in figure.axes:
+        if axes.get_label() == "<colorbar>" or not axes.get_visible():
+            continue
+        assert axes.get_xlabel() and axes.get_ylabel(), axes.get_title()
+        legend = axes.get_legend()
+        if legend is not None:
+            box, area = legend.get_window_extent(renderer), axes.get_window_extent(renderer)
+            assert box.x0 >= area.x1 - 1 or box.y1 <= area.y0 + 1 or box.x1 <= area.x0 + 1 or box.y0 >= area.y1 - 1
+
+
+def test_run_figures_label_their_axes_and_keep_legends_off_the_data(result) -> None:
+    for make in (tracks_figure, latency_over_time_figure, residuals_figure):
+        _legend_clear_of_data(make(result))
+
+
+def test_the_tracks_show_the_whole_film(result) -> None:
+    figure = tracks_figure(result)
+    whole = figure.axes[0]
+    low, high = whole.get_xlim()
+    assert low <= result.led_track.t[0] + 0.05 and high >= result.led_track.t[-1] - 0.05
+
+
+def test_a_run_report_is_one_self_contained_page_and_markdown(small_runs, tmp_path: Path, capsys) -> None:
+    out = tmp_path / "report.html"
+    assert main(["report", str(small_runs["fast"].parent), "--out", str(out)]) == 0
+    page = out.read_text()
+    assert "simulated truth" in page and "Diagnostics" in page and "project commit" in page
+    assert not re.search(r"(src|href)=['\"]https?:", page)
+    assert page.count("data:image/png;base64,") == 3
+    markdown = out.with_suffix(".md").read_text()
+    assert "![tracks](report_files/tracks.png)" in markdown and (tmp_path / "report_files" / "tracks.png").exists()
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_a_summary_report_compares_the_runs(small_runs, tmp_path: Path) -> None:
+    items = [BatchItem(AnalysisRequest(small_runs[name]), {"system": name}) for name in ("fast", "slow", "broken")]
+    run_batch(items, tmp_path / "summary.csv")
+    assert main(["report", str(tmp_path / "summary.csv"), "--out", str(tmp_path / "summary.html")]) == 0
+    page = (tmp_path / "summary.html").read_text()
+    assert "2 of 3 videos measured" in page and "By system" in page
+    rows = [{"video": str(small_runs[n]), "latency_ms": value, "ci95_low_ms": value - 1, "ci95_high_ms": value + 1,
+             "frequency_hz": frequency, "system": n} for n, value, frequency in (("fast", 40.0, 1.4), ("slow", 42.0, 0.8))]  # fmt: skip
+    figure = summary_figure(rows, "system")
+    assert len(figure.axes) == 2
+    _legend_clear_of_data(figure)
+
+
+def test_a_report_needs_an_html_file_in_an_existing_folder(small_runs, tmp_path: Path) -> None:
+    assert main(["report", str(small_runs["fast"]), "--out", str(tmp_path / "report.pdf")]) == 2
+    assert main(["report", str(small_runs["fast"]), "--out", str(tmp_path / "no" / "report.html")]) == 2
+    with pytest.raises(ConfigError):
+        from rig.service.report import read_summary
+
+        read_summary(tmp_path / "missing.csv")
