@@ -15,12 +15,10 @@ import csv
 import json
 import platform
 import subprocess
-from collections import defaultdict
 from importlib import metadata
 from pathlib import Path
 from typing import Any, Sequence
 
-import numpy as np
 
 from analysis import LatencyResult
 from analysis.board.recording import METADATA
@@ -29,6 +27,7 @@ from rig.report.document import Report, Section, write_html, write_markdown
 from rig.report.figures import latency_over_time_figure, residuals_figure, summary_figure, tracks_figure
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
 from rig.service.batch import RESULT_COLUMNS
+from rig.service.compare import Z95, differences, group_latencies
 
 PACKAGES = ("latency-rig", "numpy", "scipy", "opencv-contrib-python-headless", "jax", "jaxopt", "emcee", "matplotlib", "moderngl")
 RUN_VIDEO = "video.avi"
@@ -162,19 +161,20 @@ def summary_report(path: Path, group: str | None = None) -> Report:
     report = Report(f"Summary of {path}", f"{len(measured)} of {len(rows)} videos measured",
                     f"{len(failed)} failed, {sum(row.get('status') == 'warning' for row in rows)} with warnings")  # fmt: skip
     report.sections.append(Section("Latency per video", [("summary", summary_figure(rows, group))]))
-    report.sections.append(Section(f"By {group or 'batch'}", [(("group", "videos", "median (ms)", "min (ms)", "max (ms)"), _groups(measured, group))]))
+    if group is not None:
+        pooled = group_latencies(measured, group)
+        table = [(g.name, g.videos, g.latency_ms, g.latency_ms - Z95 * g.se_ms, g.latency_ms + Z95 * g.se_ms) for g in pooled]
+        pairs = [(f"{d.b} - {d.a}", d.difference_ms, *d.ci95_ms, "differ" if d.differs else "not shown to differ") for d in differences(pooled)]
+        report.sections.append(Section(f"By {group}", [
+            "Each group pooled over its videos, weighted by their intervals (rig.service.compare).",
+            (("group", "videos", "latency (ms)", "95 % low", "95 % high"), table),
+            (("difference", "ms", "95 % low", "95 % high", "verdict"), pairs),
+        ]))  # fmt: skip
     table = [(row["video"], row.get("status"), row.get("latency_ms"), row.get("ci95_low_ms"), row.get("ci95_high_ms"), row.get(group) if group else "-",
               row.get("warnings") or row.get("error") or "") for row in rows]  # fmt: skip
     report.sections.append(Section("Every video", [(("video", "status", "latency (ms)", "95 % low", "95 % high", group or "group", "warnings / error"), table)]))
     report.sections.append(Section("Software", [(("software", "version"), software())]))
     return report
-
-
-def _groups(rows: Sequence[dict[str, Any]], group: str | None) -> list[tuple[Any, ...]]:
-    members: dict[str, list[float]] = defaultdict(list)
-    for row in rows:
-        members[str(row.get(group, "")) if group else "all"].append(float(row["latency_ms"]))
-    return [(name, len(v), float(np.median(v)), min(v), max(v)) for name, v in sorted(members.items())]
 
 
 def check_report_path(out: Path) -> None:

@@ -63,7 +63,7 @@ def test_a_summary_report_compares_the_runs(small_runs, tmp_path: Path) -> None:
     run_batch(items, tmp_path / "summary.csv")
     assert main(["report", str(tmp_path / "summary.csv"), "--out", str(tmp_path / "summary.html")]) == 0
     page = (tmp_path / "summary.html").read_text()
-    assert "2 of 3 videos measured" in page and "By system" in page
+    assert "2 of 3 videos measured" in page and "By system" in page and "slow - fast" in page
     rows = [{"video": str(small_runs[n]), "latency_ms": value, "ci95_low_ms": value - 1, "ci95_high_ms": value + 1,
              "frequency_hz": frequency, "system": n} for n, value, frequency in (("fast", 40.0, 1.4), ("slow", 42.0, 0.8))]  # fmt: skip
     figure = summary_figure(rows, "system")
