@@ -16,7 +16,8 @@ from typing import Any, Callable
 
 import predictors
 from predictors import read_trace
-from rig.bench import analyser, predictors as predictor_bench, renderer_report, renderers
+from rig.bench import analyser, batch, renderer_report, renderers
+from rig.bench import predictors as predictor_bench
 from rig.commands import options
 from rig.errors import ConfigError, RigError
 from rig.progress import ProgressBar
@@ -216,10 +217,43 @@ def _add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=_run_renderers)
 
 
+# -- batch ---------------------------------------------------------------------------------------
+
+
+def _run_batch(args: argparse.Namespace) -> int:
+    for path in (args.json, args.plot):
+        if path is not None and not path.parent.is_dir():
+            raise ConfigError(f"cannot write {path}: folder {path.parent} does not exist")
+    with tempfile.TemporaryDirectory(prefix="rig-bench-batch-") as scratch:
+        report = batch.run_bench(Path(scratch), args.videos, args.duration, args.clip_duration, args.workers, _log)
+    if args.json is not None:
+        _write_json(args.json, report)
+    if args.plot is not None:
+        _plot(lambda: batch.plot(report, args.plot), args.plot)
+    print(batch.table(report))
+    return 0
+
+
+def _add_batch(benchmarks: argparse._SubParsersAction) -> None:
+    parser = benchmarks.add_parser(
+        "batch",
+        help="what many measurements cost: a batch serially and on Dask, and the fixed cost per video",
+        description=batch.__doc__.split("\n\n")[0],
+    )
+    parser.add_argument("--videos", type=options.positive_int, default=24, help="videos in the batch (default: %(default)s)")
+    parser.add_argument("--duration", type=options.positive_float, default=6.0, help="seconds per batch video (default: %(default)s)")
+    parser.add_argument("--clip-duration", type=options.positive_float, default=20.0, help="seconds of the fixed-cost clip (default: %(default)s)")
+    parser.add_argument("--workers", type=options.positive_int, default=2, help="Dask worker processes (default: %(default)s)")
+    parser.add_argument("--json", type=Path, metavar="OUT", help="write the figures as JSON")
+    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="draw the wall times")
+    parser.set_defaults(func=_run_batch)
+
+
 SUBJECTS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
     "analyser": _add_analyser,
     "predictors": _add_predictors,
     "renderers": _add_renderers,
+    "batch": _add_batch,
 }
 
 

@@ -1,0 +1,133 @@
+"""The batch bench (`rig bench batch`): what many measurements cost, serially and on Dask.
+
+* **Scale-out**: a batch of simulated videos analysed serially, then on a local Dask cluster of
+  two worker processes (the cluster's start included), in the same run: the speed-up.
+* **Dask's overhead**: a batch of one video on the cluster against the same video serially.
+* **Fixed cost per video**: one longer clip analysed by `rig analyse` in a fresh process, against
+  decoding it alone in a fresh process, with the compiled-fit cache empty (the first run on a
+  machine) and then filled (every later run).
+
+Every figure is wall time on this machine with whatever else runs on it; compare ratios taken in
+one run.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, Callable
+
+from rig.service.analyse import AnalysisRequest
+from rig.service.batch import BatchItem, run_batch
+from rig.service.simulate import simulate
+from rig.sim.config import SimulationConfig
+from rig.sim.pendulum import PendulumConfig
+
+Log = Callable[[str], None]
+PERIODS_S = (0.7, 0.9, 1.1, 1.3)
+DECODE_ONLY = "import sys; from analysis.video.sources import open_frames; sum(1 for _ in open_frames(sys.argv[1]).frames())"
+
+
+def _seconds(run: Callable[[], Any]) -> float:
+    started = time.perf_counter()
+    run()
+    return time.perf_counter() - started
+
+
+def _process_seconds(arguments: list[str], environment: dict[str, str]) -> float:
+    started = time.perf_counter()
+    subprocess.run(arguments, check=True, capture_output=True, env=environment)
+    return time.perf_counter() - started
+
+
+def videos(folder: Path, count: int, duration_s: float, log: Log) -> list[Path]:
+    """`count` simulated videos over a few pendulum periods, each with its own seed."""
+    made = []
+    for index in range(count):
+        config = SimulationConfig(duration_s=duration_s, seed=index, pendulum=PendulumConfig(period_s=PERIODS_S[index % len(PERIODS_S)]))
+        made.append(simulate(config, folder / f"video{index:02d}", overwrite=True).video_path)
+        log(f"simulated {index + 1}/{count}")
+    return made
+
+
+def scale_out(paths: list[Path], workers: int, log: Log) -> dict[str, Any]:
+    items = [BatchItem(AnalysisRequest(path)) for path in paths]
+    serial = _seconds(lambda: run_batch(items))
+    log(f"{len(items)} videos serially: {serial:.1f} s")
+    parallel = _seconds(lambda: run_batch(items, workers=workers))
+    log(f"{len(items)} videos on {workers} Dask workers: {parallel:.1f} s")
+    one_serial = _seconds(lambda: run_batch(items[:1]))
+    one_dask = _seconds(lambda: run_batch(items[:1], workers=workers))
+    log(f"one video: {one_serial:.1f} s serially, {one_dask:.1f} s on Dask")
+    return {
+        "videos": len(items),
+        "workers": workers,
+        "serial_s": serial,
+        "dask_s": parallel,
+        "speed_up": serial / parallel,
+        "one_video_serial_s": one_serial,
+        "one_video_dask_s": one_dask,
+        "dask_overhead_s": one_dask - one_serial,
+    }
+
+
+def fixed_cost(clip: Path, log: Log) -> dict[str, Any]:
+    """`rig analyse` in a fresh process against decoding alone, with an empty then a filled cache."""
+    rig = str(Path(sys.executable).with_name("rig"))
+    with tempfile.TemporaryDirectory(prefix="rig-bench-cache-") as cache:
+        environment = {**os.environ, "JAX_COMPILATION_CACHE_DIR": cache}
+        decode = min(_process_seconds([sys.executable, "-c", DECODE_ONLY, str(clip)], environment) for _ in range(2))
+        cold = _process_seconds([rig, "analyse", str(clip), "--json"], environment)
+        warm = _process_seconds([rig, "analyse", str(clip), "--json"], environment)
+    log(f"fixed cost: decode alone {decode:.1f} s, analyse {cold:.1f} s (empty cache), {warm:.1f} s (filled)")
+    return {
+        "clip": str(clip),
+        "decode_s": decode,
+        "analyse_cold_cache_s": cold,
+        "analyse_warm_cache_s": warm,
+        "ratio_cold": cold / decode,
+        "ratio_warm": warm / decode,
+    }
+
+
+def run_bench(folder: Path, count: int, duration_s: float, clip_s: float, workers: int, log: Log) -> dict[str, Any]:
+    paths = videos(folder / "batch", count, duration_s, log)
+    clip = simulate(replace(SimulationConfig(duration_s=clip_s), seed=99), folder / "clip", overwrite=True).video_path
+    return {"scale_out": scale_out(paths, workers, log), "fixed_cost": fixed_cost(clip, log)}
+
+
+def table(report: dict[str, Any]) -> str:
+    s, f = report["scale_out"], report["fixed_cost"]
+    return "\n".join(
+        [
+            f"batch of {s['videos']} videos: serial {s['serial_s']:.1f} s, {s['workers']} Dask workers {s['dask_s']:.1f} s, "
+            f"speed-up {s['speed_up']:.2f}",
+            f"Dask overhead for one video: {s['dask_overhead_s']:+.1f} s ({s['one_video_dask_s']:.1f} s against {s['one_video_serial_s']:.1f} s)",
+            f"fixed cost of a clip in a fresh process: analyse / decode alone = {f['ratio_cold']:.2f} (empty cache), "
+            f"{f['ratio_warm']:.2f} (filled cache); decode alone {f['decode_s']:.1f} s",
+        ]
+    )
+
+
+def plot(report: dict[str, Any], path: Path) -> None:
+    """Wall times side by side: the batch serially and on Dask; a clip decoded, then analysed."""
+    from matplotlib.figure import Figure
+
+    s, f = report["scale_out"], report["fixed_cost"]
+    figure = Figure(figsize=(10, 3.8), layout="constrained")
+    batch, clip = figure.subplots(1, 2)
+    batch.bar(["serial", f"{s['workers']} Dask workers"], [s["serial_s"], s["dask_s"]], color=["C0", "C1"])
+    batch.set_ylabel("wall time (s)")
+    batch.set_xlabel(f"batch of {s['videos']} videos")
+    batch.set_title(f"speed-up {s['speed_up']:.2f}")
+    clip.bar(["decode alone", "analyse,\nempty cache", "analyse,\nfilled cache"],
+             [f["decode_s"], f["analyse_cold_cache_s"], f["analyse_warm_cache_s"]], color=["grey", "C3", "C2"])  # fmt: skip
+    clip.set_ylabel("wall time in a fresh process (s)")
+    clip.set_xlabel("one clip")
+    clip.set_title(f"fixed cost: {f['ratio_warm']:.2f} x decoding (filled cache)")
+    figure.savefig(path, dpi=100)
