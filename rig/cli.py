@@ -9,6 +9,7 @@ from typing import Sequence
 from analysis.errors import AnalysisError
 from predictors import PredictorError
 from rig.commands import analyse, bench, board, demo, report, simulate, sweep, tune
+from rig.commands import devices, emulate, record_tracker
 from rig.compile_cache import keep_compiled_fits
 from rig.errors import RigError
 
@@ -23,7 +24,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Measure motion-to-photon latency with a pendulum, an LED and a camera; simulate the rig.",
     )
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for command in (demo, simulate, analyse, sweep, report, bench, tune, board):
+    for command in (demo, simulate, analyse, sweep, report, bench, tune, board, record_tracker, devices, emulate):
         command.add_parser(subparsers)
     return parser
 

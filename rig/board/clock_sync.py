@@ -15,6 +15,7 @@ emulator. Intersecting many round trips narrows the interval; measuring again la
 
 from __future__ import annotations
 
+import bisect
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -92,14 +93,16 @@ class ClockModel:
     """Converts board time to rig time from the offset intervals measured so far.
 
     Between two measurements the offset is interpolated linearly; after the latest it is
-    extrapolated with the drift measured over the current run of the board's clock. A measurement
-    far from its prediction means the board's clock restarted (a reset): earlier measurements no
-    longer apply and a new run starts.
+    extrapolated with the drift measured over the current run of the board's clock. Intervals are
+    added in time order (`at` never decreasing). A measurement far from its prediction means the
+    board's clock restarted (a reset): earlier measurements no longer apply and a new run starts.
     """
 
     def __init__(self) -> None:
         self._history: list[OffsetInterval] = []
         self._run: list[OffsetInterval] = []
+        self._run_at: list[float] = []
+        self._drift: Drift | None = None
 
     @property
     def intervals(self) -> tuple[OffsetInterval, ...]:
@@ -113,11 +116,17 @@ class ClockModel:
     def add(self, interval: OffsetInterval) -> None:
         if self._run and abs(interval.midpoint - self.offset_at(interval.at)) > CLOCK_RESTART_S:
             self._run = []
+            self._run_at = []
         self._history.append(interval)
         self._run.append(interval)
+        self._run_at.append(interval.at)
+        self._drift = self._measure_drift()
 
     def drift(self) -> Drift | None:
         """Drift over the current run, once its measurements span MIN_DRIFT_BASELINE_S."""
+        return self._drift
+
+    def _measure_drift(self) -> Drift | None:
         if len(self._run) < 2:
             return None
         first, last = self._run[0], self._run[-1]
@@ -132,10 +141,11 @@ class ClockModel:
         if not self._run:
             raise ValueError("the clock has not been synchronised")
         run = self._run
-        for before, after in zip(run, run[1:]):
-            if before.at <= rig_time <= after.at and after.at > before.at:
-                fraction = (rig_time - before.at) / (after.at - before.at)
-                return before.midpoint + fraction * (after.midpoint - before.midpoint)
+        after = bisect.bisect_left(self._run_at, rig_time)
+        if 0 < after < len(run):
+            before, after = run[after - 1], run[after]
+            fraction = (rig_time - before.at) / (after.at - before.at)
+            return before.midpoint + fraction * (after.midpoint - before.midpoint)
         drift = self.drift()
         anchor = run[-1] if rig_time > run[-1].at else run[0]
         return anchor.midpoint + (drift.rate * (rig_time - anchor.at) if drift else 0.0)
@@ -153,29 +163,34 @@ class ClockModel:
 
 
 class TickUnwrapper:
-    """Places the board's 32-bit ticks on its 48-bit time line, using full times from SYNC and
-    STATUS messages as anchors and the latest tick as the reference for the next."""
+    """Places a wrapping counter's ticks on a time line that does not wrap, using the latest tick as
+    the reference for the next (no two ticks may be half a wrap apart). The board's 32-bit ticks
+    (the default) also take full times from SYNC and STATUS messages as anchors; a tracker's
+    16- or 32-bit timestamps and record counters are unwrapped with their own width.
+    """
 
     WRAP = 1 << 32
 
-    def __init__(self) -> None:
+    def __init__(self, bits: int = 32) -> None:
+        self.wrap = 1 << bits
         self._reference: int | None = None
 
     def reset(self) -> None:
         self._reference = None
 
     def anchor(self, epoch: int, tick: int) -> int:
-        self._reference = (epoch << 32) | tick
+        self._reference = epoch * self.wrap + tick
         return self._reference
 
     def unwrap(self, tick: int) -> int:
         if self._reference is None:
             self._reference = tick
             return tick
-        full = self._reference - self._reference % self.WRAP + tick
-        if full - self._reference > self.WRAP // 2:
-            full -= self.WRAP
-        elif self._reference - full > self.WRAP // 2:
-            full += self.WRAP
+        wrap = self.wrap
+        full = self._reference - self._reference % wrap + tick
+        if full - self._reference > wrap // 2:
+            full -= wrap
+        elif self._reference - full > wrap // 2:
+            full += wrap
         self._reference = full
         return full

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 import tempfile
 from dataclasses import replace
@@ -249,10 +250,51 @@ def _add_batch(benchmarks: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=_run_batch)
 
 
+# -- trackers ------------------------------------------------------------------------------------
+
+
+def _run_trackers(args: argparse.Namespace) -> int:
+    from rig.bench import trackers
+
+    duration = 2.0 if args.quick else args.duration
+    with tempfile.TemporaryDirectory(prefix="rig-bench-trackers-") as scratch:
+        folder = args.runs if args.runs is not None else Path(scratch)
+        report = trackers.run_bench(args.rate, duration, folder, _log)
+    if args.json is not None:
+        _write_json(args.json, report["rows"])
+    if args.plot is not None:
+        _plot(lambda: trackers.plot(report["rows"], args.plot), args.plot)
+    print(trackers.table(report["rows"]))
+    for target, met in report["targets_met"].items():
+        print(f"{target}: {'met' if met else 'not met'}")
+    loads = [row["load_average_1min"] for row in report["rows"]]
+    print(f"machine noise: {os.cpu_count()} CPUs, 1-minute load average {min(loads):.2f} to {max(loads):.2f} over the cases")
+    return 0
+
+
+def _add_trackers(benchmarks: argparse._SubParsersAction) -> None:
+    parser = benchmarks.add_parser(
+        "trackers",
+        help="the serial and LSL tracker sources fed by the emulators: loss, fabrication, CPU per sample, added latency",
+        description="Stream the simulated pendulum from `rig emulate-tracker` (a pseudo-terminal, TCP, LSL), clean and "
+        "with faults (1%% of bytes corrupted and a 0.5 s disconnect; a disconnect for LSL), record each with the rig's "
+        "tracker source as `rig record-tracker` does, and report per case what was sent, recorded, missing, fabricated "
+        "and counted corrupt, the CPU per sample, and the latency from the emulator's write to the recording loop.",
+    )
+    parser.add_argument("--json", type=Path, metavar="OUT", help="write the rows as a JSON list")
+    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot CPU per sample and latency per case")
+    parser.add_argument("--rate", type=options.positive_float, default=1000.0, help="records a second (default: %(default)s)")
+    parser.add_argument("--duration", type=options.positive_float, default=10.0, help="seconds per case (default: %(default)s)")
+    parser.add_argument("--quick", action="store_true", help="2 s per case (a smoke test)")
+    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the recordings and emulator logs here (default: a temporary folder)")
+    parser.set_defaults(func=_run_trackers)
+
+
 SUBJECTS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
     "analyser": _add_analyser,
     "predictors": _add_predictors,
     "renderers": _add_renderers,
+    "trackers": _add_trackers,
     "batch": _add_batch,
 }
 

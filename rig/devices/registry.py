@@ -4,11 +4,12 @@
     make_device("tracker", "mytracker:COM3")     a third party's, found through its entry point
 
 The scheme names a factory registered for the kind (tracker, display, camera); the address, the
-rest of the spec, goes to it. Built in today: `sim` for every kind, the simulated twins of
-`rig.sim`, which exist only inside a simulated run. Third-party devices are entry points in the
-groups `rig.trackers`, `rig.displays` and `rig.cameras` (see `rig.plugins`): a callable taking
-`(address, context)` and returning an unconnected device that satisfies the kind's protocol in
-`rig.devices.protocols`.
+rest of the spec, goes to it. Built in: `sim` for every kind, the simulated twins of `rig.sim`,
+which exist only inside a simulated run; for trackers also `serial:URL`, `hid:VID:PID[:PROFILE]`
+and `lsl:NAME`, the real trackers of `rig.devices.trackers`. Third-party devices are entry points
+in the groups `rig.trackers`, `rig.displays` and `rig.cameras` (see `rig.plugins`): a callable
+taking `(address, context)` and returning an unconnected device that satisfies the kind's protocol
+in `rig.devices.protocols`.
 """
 
 from __future__ import annotations
@@ -17,6 +18,10 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable
 
 from rig.devices.protocols import Camera, Display, TrackerSource
+from rig.devices.trackers.hid_tracker import hid_tracker
+from rig.devices.trackers.lsl_tracker import lsl_tracker
+from rig.devices.trackers.serial_tracker import serial_tracker
+from rig.devices.trackers.stream import TrackerStream
 from rig.errors import ConfigError, RigError
 from rig.plugins import load_plugin, plugin_names
 
@@ -45,6 +50,10 @@ class DeviceKind:
     built_in: dict[str, DeviceFactory]
 
 
+def _real_tracker(make: Callable[[str], TrackerStream]) -> DeviceFactory:
+    return lambda address, context: make(address)
+
+
 def _simulated(kind: str) -> DeviceFactory:
     def make(address: str, context: DeviceContext) -> Any:
         if address:
@@ -59,7 +68,17 @@ def _simulated(kind: str) -> DeviceFactory:
 KINDS: dict[str, DeviceKind] = {
     kind.name: kind
     for kind in (
-        DeviceKind("tracker", "rig.trackers", TrackerSource, {"sim": _simulated("tracker")}),
+        DeviceKind(
+            "tracker",
+            "rig.trackers",
+            TrackerSource,
+            {
+                "sim": _simulated("tracker"),
+                "serial": _real_tracker(serial_tracker),
+                "hid": _real_tracker(hid_tracker),
+                "lsl": _real_tracker(lsl_tracker),
+            },
+        ),
         DeviceKind("display", "rig.displays", Display, {"sim": _simulated("display")}),
         DeviceKind("camera", "rig.cameras", Camera, {"sim": _simulated("camera")}),
     )

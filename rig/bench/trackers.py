@@ -1,0 +1,220 @@
+"""The tracker bench (`rig bench trackers`): the real tracker sources fed by the emulators, clean and
+with faults, measured for loss, fabrication, order, reading cost and added latency.
+
+Each case starts `rig emulate-tracker` in a process of its own (a pseudo-terminal, a TCP socket or
+an LSL outlet, with the emulator's log of every record's fate) and records it in this process with
+`rig.service.record.record_tracker`, as `rig record-tracker` does. Then:
+
+* sent, recorded: records the emulator wrote (intact or damaged) and rows in tracker.csv;
+* missing: intact records sent that are not in tracker.csv; fabricated: rows that match no intact
+  record sent (a damaged record let through); in_order: the rows' device times only increase;
+* corrupt: what the source counted as damaged, beside damaged_sent, what the emulator damaged;
+* us_per_sample: this process's CPU time over the run (the reader thread, liblsl's threads, the
+  recording loop writing both files), per recorded sample; reader_us_per_sample: the reader
+  thread's alone (reading, decoding, checking, mapping the clock);
+* latency_ms_median, latency_ms_p95: from the emulator's write of a record to the moment the
+  recording loop had it in hand (where a predictor would get it), both on the monotonic clock.
+
+Rows are keyed by the device's time (to the microsecond), which every emulated record carries.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import resource
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from rig.clock import MonotonicClock
+from rig.devices.trackers.stream import TrackerRecord
+from rig.errors import RigError
+from rig.service.record import record_tracker
+
+TARGET_US_PER_SAMPLE = 50.0
+TARGET_LATENCY_MEDIAN_MS = 1.0
+TARGET_LATENCY_P95_MS = 2.0
+# Recording runs this much longer than the emulator sends, for it to find its reader and finish.
+RECORD_MARGIN_S = 3.0
+START_TIMEOUT_S = 30.0
+
+
+@dataclass(frozen=True)
+class Case:
+    source: str
+    transport: str
+    profile: str
+    faults: str
+
+
+def cases(fault_at_s: float) -> list[Case]:
+    """The bench's cases: serial over a pty (binary and CSV lines), over TCP, and LSL; clean, and the
+    binary pty and LSL with faults (a disconnect of 0.5 s at `fault_at_s`, 1 % of bytes corrupted)."""
+    disconnect = f"disconnect={fault_at_s:g}:0.5"
+    return [
+        Case("serial", "pty", "binary-pose", "none"),
+        Case("serial", "pty", "csv", "none"),
+        Case("serial", "tcp", "binary-pose", "none"),
+        Case("lsl", "lsl", "", "none"),
+        Case("serial", "pty", "binary-pose", f"corrupt=0.01,{disconnect}"),
+        Case("lsl", "lsl", "", disconnect),
+    ]
+
+
+def _emulator_command(case: Case, address: str, rate_hz: float, duration_s: float, log: Path) -> list[str]:
+    command = [sys.executable, "-m", "rig.cli", "emulate-tracker", "lsl" if case.transport == "lsl" else "serial"]
+    if case.transport == "lsl":
+        command += ["--name", address]
+    else:
+        command += [f"--{case.transport}", address, "--profile", case.profile]
+    return command + ["--rate", f"{rate_hz:g}", "--duration", f"{duration_s:g}", "--faults", case.faults, "--log", str(log)]
+
+
+def _start_emulator(command: list[str], folder: Path) -> tuple[subprocess.Popen, str]:
+    """Starts the emulator; returns it and the tracker spec it printed once ready."""
+    errors = open(folder / "emulator.err", "w")
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=errors, text=True)
+    errors.close()
+    line = process.stdout.readline()
+    if "--tracker " not in line:
+        process.kill()
+        raise RigError(f"the tracker emulator did not start: {(folder / 'emulator.err').read_text()[-500:]}")
+    return process, line.rsplit("--tracker ", 1)[1].strip()
+
+
+def _sent(log: Path) -> tuple[dict[int, float], int, int]:
+    """The intact records' write times by device time (us), and counts of damaged and lost ones."""
+    intact: dict[int, float] = {}
+    damaged = lost = 0
+    with log.open() as stream:
+        for row in csv.DictReader(stream):
+            if row["fate"] == "intact":
+                intact[round(float(row["device_time"]) * 1e6)] = float(row["t_write"])
+            elif row["fate"] == "damaged":
+                damaged += 1
+            else:
+                lost += 1
+    return intact, damaged, lost
+
+
+def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: Callable[[str], None]) -> dict[str, Any]:
+    folder.mkdir(parents=True, exist_ok=True)
+    sent_log = folder / "sent.csv"
+    address = str(folder / "tracker") if case.transport == "pty" else "0" if case.transport == "tcp" else f"rig-bench-{os.getpid()}-{folder.name}"
+    process, spec = _start_emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder)
+    clock = MonotonicClock()
+    arrivals: list[tuple[float, float]] = []
+
+    def on_batch(records: list[TrackerRecord], t_available: float) -> None:
+        available = clock.origin_ns / 1e9 + t_available
+        arrivals.extend((record.device_time, available) for record in records)
+
+    cpu = resource.getrusage(resource.RUSAGE_SELF)
+    try:
+        recording = record_tracker(spec, duration_s + RECORD_MARGIN_S, folder / "recording", overwrite=True,
+                                   on_batch=on_batch, clock=clock)  # fmt: skip
+    except BaseException:
+        process.kill()
+        process.wait()
+        raise
+    process.wait(timeout=START_TIMEOUT_S)
+    used = resource.getrusage(resource.RUSAGE_SELF)
+    cpu_s = (used.ru_utime - cpu.ru_utime) + (used.ru_stime - cpu.ru_stime)
+    intact, damaged, lost = _sent(sent_log)
+    keys = [round(device_time * 1e6) for device_time, _ in arrivals]
+    latencies = np.array([available - intact[key] for key, (_, available) in zip(keys, arrivals) if key in intact]) * 1e3
+    counters = recording.sidecar["counters"]
+    tracker_latency = recording.sidecar.get("latency") or {}
+    row = {
+        "source": case.source,
+        "transport": case.transport,
+        "profile": case.profile or "pose (7 channels)",
+        "faults": case.faults,
+        "rate_hz": rate_hz,
+        "duration_s": duration_s,
+        "sent": len(intact) + damaged,
+        "damaged_sent": damaged,
+        "lost_sent": lost,
+        "recorded": recording.samples,
+        "missing": len(set(intact) - set(keys)),
+        "fabricated": sum(key not in intact for key in keys),
+        "in_order": bool(np.all(np.diff(keys) > 0)),
+        "corrupt": counters["corrupt"],
+        "rejected": counters["rejected"],
+        "dropped": counters["dropped"],
+        "reconnects": counters["reconnects"],
+        "us_per_sample": cpu_s / max(recording.samples, 1) * 1e6,
+        "reader_us_per_sample": recording.sidecar["reader_cpu_us_per_sample"],
+        "latency_ms_median": float(np.median(latencies)) if latencies.size else None,
+        "latency_ms_p95": float(np.percentile(latencies, 95)) if latencies.size else None,
+        "tracker_latency_ms_median": tracker_latency.get("median_ms"),
+    }
+    log(f"{case.source}/{case.transport}/{row['profile']} faults {case.faults}: sent {row['sent']}, recorded {row['recorded']}, "
+        f"missing {row['missing']}, fabricated {row['fabricated']}, corrupt {row['corrupt']} (damaged {damaged})")  # fmt: skip
+    return row
+
+
+def targets(rows: list[dict[str, Any]]) -> dict[str, bool]:
+    """The issue's targets, met or not, in this run."""
+    clean = [r for r in rows if r["faults"] == "none"]
+    faulty = [r for r in rows if r["faults"] != "none"]
+    return {
+        "clean runs: every sample sent recorded, in order": all(r["recorded"] == r["sent"] and r["missing"] == 0 and r["in_order"] for r in clean),
+        "faults: every intact record recovered, nothing fabricated": all(r["missing"] == 0 and r["fabricated"] == 0 for r in faulty),
+        "faults: every damaged record counted": all(r["corrupt"] >= r["damaged_sent"] for r in faulty),
+        f"CPU <= {TARGET_US_PER_SAMPLE:g} us per sample": all(r["us_per_sample"] <= TARGET_US_PER_SAMPLE for r in rows),
+        f"added latency median <= {TARGET_LATENCY_MEDIAN_MS:g} ms, p95 <= {TARGET_LATENCY_P95_MS:g} ms": all(
+            r["latency_ms_median"] is not None and r["latency_ms_median"] <= TARGET_LATENCY_MEDIAN_MS
+            and r["latency_ms_p95"] <= TARGET_LATENCY_P95_MS for r in rows
+        ),
+    }  # fmt: skip
+
+
+def run_bench(rate_hz: float, duration_s: float, folder: Path, log: Callable[[str], None]) -> dict[str, Any]:
+    """Every case in turn; each row also holds the machine's 1-minute load average when it started
+    (the noise its figures carry)."""
+    rows = []
+    for index, case in enumerate(cases(fault_at_s=duration_s / 2.0)):
+        load = os.getloadavg()[0]
+        rows.append({**run_case(case, rate_hz, duration_s, folder / f"case{index}", log), "load_average_1min": load})
+    return {"rows": rows, "targets_met": targets(rows)}
+
+
+def table(rows: list[dict[str, Any]]) -> str:
+    head = "| source | transport | profile | faults | sent | recorded | missing | fabricated | corrupt (damaged) | us/sample (reader) | latency ms median, p95 |"
+    lines = [head, "|" + " --- |" * (head.count("|") - 1)]
+    for r in rows:
+        latency = f"{r['latency_ms_median']:.3f}, {r['latency_ms_p95']:.3f}" if r["latency_ms_median"] is not None else "n/a"
+        lines.append(
+            f"| {r['source']} | {r['transport']} | {r['profile']} | {r['faults']} | {r['sent']} | {r['recorded']} | {r['missing']} | "
+            f"{r['fabricated']} | {r['corrupt']} ({r['damaged_sent']}) | {r['us_per_sample']:.1f} ({r['reader_us_per_sample']:.1f}) | {latency} |"
+        )
+    return "\n".join(lines)
+
+
+def plot(rows: list[dict[str, Any]], path: Path) -> None:
+    """CPU per sample and added latency (median and 95th percentile) per case."""
+    from matplotlib.figure import Figure
+
+    labels = [f"{r['source']}/{r['transport']}\n{r['faults']}" for r in rows]
+    x = np.arange(len(rows))
+    figure = Figure(figsize=(max(6.0, 1.6 * len(rows)), 6.5))
+    cost, latency = figure.subplots(2, 1, sharex=True)
+    cost.bar(x, [r["us_per_sample"] for r in rows], color="tab:blue")
+    cost.axhline(TARGET_US_PER_SAMPLE, color="k", linestyle="--", label="target")
+    cost.set_ylabel("CPU per sample (us)")
+    cost.legend()
+    latency.bar(x - 0.2, [r["latency_ms_median"] or 0.0 for r in rows], width=0.4, label="median")
+    latency.bar(x + 0.2, [r["latency_ms_p95"] or 0.0 for r in rows], width=0.4, label="95th percentile")
+    latency.axhline(TARGET_LATENCY_MEDIAN_MS, color="k", linestyle="--")
+    latency.axhline(TARGET_LATENCY_P95_MS, color="k", linestyle=":")
+    latency.set_ylabel("emulator write to recording loop (ms)")
+    latency.set_xticks(x, labels, fontsize=8)
+    latency.legend()
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)

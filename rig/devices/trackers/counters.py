@@ -1,0 +1,102 @@
+"""What a tracker source counts while it reads, reported at the end of every run.
+
+* received: samples handed on (intact, possible, in or out of order);
+* corrupt: records that arrived damaged (a failed check, a field that does not parse, a malformed
+  report) and were discarded; a binary stream's damaged stretch counts as many records as its
+  length holds;
+* rejected: intact records with impossible values (not finite, a quaternion not of unit norm),
+  discarded and logged;
+* dropped: records the device numbered that never arrived at all (gaps in its counter not taken
+  up by corrupt or rejected ones), known only for profiles with a `seq` field;
+* out_of_order: samples whose device time (or counter) is not after their predecessor's;
+* reconnects: times the link was lost and restored.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from rig.board.clock_sync import TickUnwrapper
+
+# Latency histogram: 10 us bins up to 2 s; later ones count in the last bin.
+_BIN_S = 1e-5
+_BINS = 200_000
+
+
+@dataclass
+class TrackerCounters:
+    received: int = 0
+    corrupt: int = 0
+    rejected: int = 0
+    dropped: int | None = None
+    out_of_order: int = 0
+    reconnects: int = 0
+
+    def as_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+class SequenceCheck:
+    """Counts dropped and out-of-order records from a record counter of `bits` bits, or from device
+    times where there is none (out-of-order only)."""
+
+    def __init__(self, counters: TrackerCounters, bits: int | None) -> None:
+        self._counters = counters
+        self._unwrap = TickUnwrapper(bits) if bits else None
+        if bits:
+            counters.dropped = 0
+        self._last_seq: int | None = None
+        self._last_time: float | None = None
+        self._discarded_since = 0
+
+    def discarded(self, count: int) -> None:
+        """Records were discarded (corrupt or rejected) since the last one handed on."""
+        self._discarded_since += count
+
+    def link_restored(self) -> None:
+        """After a reconnection the counter may restart; nothing is counted across the gap."""
+        self._last_seq = None
+        self._last_time = None
+        if self._unwrap is not None:
+            self._unwrap.reset()
+
+    def accept(self, seq: int | None, device_time: float | None) -> None:
+        counters = self._counters
+        if self._unwrap is not None and seq is not None:
+            full = self._unwrap.unwrap(seq)
+            if self._last_seq is not None:
+                step = full - self._last_seq
+                if step <= 0:
+                    counters.out_of_order += 1
+                else:
+                    counters.dropped += max(0, step - 1 - self._discarded_since)
+            self._last_seq = full if self._last_seq is None else max(full, self._last_seq)
+        elif device_time is not None:
+            if self._last_time is not None and device_time <= self._last_time:
+                counters.out_of_order += 1
+            self._last_time = device_time if self._last_time is None else max(device_time, self._last_time)
+        self._discarded_since = 0
+
+
+class LatencyHistogram:
+    """Tracker-to-host latencies (s) in 10 us bins: median and 95th percentile in ms at any time."""
+
+    def __init__(self) -> None:
+        self._counts = np.zeros(_BINS, dtype=np.int64)
+        self.count = 0
+
+    def add(self, latency_s: float) -> None:
+        self._counts[min(max(int(latency_s / _BIN_S), 0), _BINS - 1)] += 1
+        self.count += 1
+
+    def quantile_ms(self, q: float) -> float | None:
+        if not self.count:
+            return None
+        index = int(np.searchsorted(np.cumsum(self._counts), q * self.count))
+        return (index + 0.5) * _BIN_S * 1e3
+
+    def summary(self) -> dict[str, Any]:
+        return {"samples": self.count, "median_ms": self.quantile_ms(0.5), "p95_ms": self.quantile_ms(0.95)}

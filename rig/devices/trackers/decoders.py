@@ -1,0 +1,183 @@
+"""Records out of a tracker's byte stream, as its profile describes them, resynchronising after damage.
+
+Each decoder is fed bytes as they arrive (`feed(data, t_arrival)`) and returns the readings of the
+records completed by them; what it could not decode it discards and counts in `corrupt`:
+
+* `TextDecoder`: records end in the profile's terminator; a line with the wrong number of fields
+  or a field that is not a number is one corrupt record. A line of the field names (a header) is
+  skipped. A run of bytes longer than MAX_LINE without a terminator is corrupt.
+* `BinaryDecoder`: records start with the sync bytes and have a fixed length. Where a checksum
+  fails the decoder moves on by one byte and looks for the next sync, so a damaged record never
+  takes an intact neighbour with it; a damaged stretch counts as the records its length holds.
+* `HidReportDecoder`: one input report is one record, after its report id where the device uses
+  them; reports of other ids are someone else's and ignored, short ones are corrupt.
+
+`reset()` forgets a partial record and the time counter's history (after a reconnection).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+
+from rig.board.clock_sync import TickUnwrapper
+from rig.devices.trackers.checksums import CHECK_BYTES, CHECKSUMS
+from rig.devices.trackers.profile import TIME, Profile
+from rig.devices.trackers.readings import Reading, ReadingMaker
+
+MAX_LINE = 4096
+
+
+class DeviceTime:
+    """The device's time field in seconds: integer counters unwrapped at their width."""
+
+    def __init__(self, profile: Profile, maker: ReadingMaker) -> None:
+        time_field = profile.field(TIME)
+        bits = time_field.integer_bits if time_field else None
+        self._unwrap = TickUnwrapper(bits) if bits else None
+        self._maker = maker
+
+    def seconds(self, values: tuple | list) -> float | None:
+        raw = self._maker.raw_device_time(values)
+        if raw is None:
+            return None
+        if self._unwrap is not None:
+            raw = self._unwrap.unwrap(int(raw))
+        return self._maker.seconds(raw)
+
+    def reset(self) -> None:
+        if self._unwrap is not None:
+            self._unwrap.reset()
+
+
+class TextDecoder:
+    def __init__(self, profile: Profile) -> None:
+        self.corrupt = 0
+        self._maker = ReadingMaker(profile)
+        self._time = DeviceTime(profile, self._maker)
+        self._terminator = profile.terminator
+        self._separator = profile.separator
+        self._count = len(profile.fields)
+        self._header = [name.encode("ascii", "replace") for name in profile.names]
+        self._buffer = bytearray()
+
+    def feed(self, data: bytes, t_arrival: float) -> list[Reading]:
+        buffer = self._buffer
+        buffer += data
+        readings = []
+        terminator = self._terminator
+        start = 0
+        while (end := buffer.find(terminator, start)) >= 0:
+            reading = self._line(bytes(buffer[start:end]), t_arrival)
+            if reading is not None:
+                readings.append(reading)
+            start = end + len(terminator)
+        del buffer[:start]
+        if len(buffer) > MAX_LINE:
+            buffer.clear()
+            self.corrupt += 1
+        return readings
+
+    def _line(self, line: bytes, t_arrival: float) -> Reading | None:
+        parts = line.split(self._separator.encode("ascii")) if self._separator else line.split()
+        if len(parts) != self._count:
+            if parts and [part.strip() for part in parts] != self._header:
+                self.corrupt += 1
+            return None
+        try:
+            values = [float(part) for part in parts]
+        except ValueError:
+            self.corrupt += 1
+            return None
+        return self._maker.make(values, t_arrival, self._time.seconds(values))
+
+    def reset(self) -> None:
+        self._buffer.clear()
+        self._time.reset()
+
+
+class BinaryDecoder:
+    def __init__(self, profile: Profile) -> None:
+        self.corrupt = 0
+        self._maker = ReadingMaker(profile)
+        self._time = DeviceTime(profile, self._maker)
+        self._sync = profile.sync
+        self._body = struct.Struct(profile.struct_format)
+        self._check = CHECKSUMS[profile.checksum]
+        self._check_bytes = CHECK_BYTES[profile.checksum]
+        self._order = profile.byte_order
+        self.record_bytes = len(self._sync) + self._body.size + self._check_bytes
+        self._buffer = bytearray()
+        self._discarded = 0
+
+    def feed(self, data: bytes, t_arrival: float) -> list[Reading]:
+        buffer = self._buffer
+        buffer += data
+        readings = []
+        sync, size = self._sync, self.record_bytes
+        body_start, body_end = len(sync), size - self._check_bytes
+        start = 0
+        while True:
+            found = buffer.find(sync, start)
+            if found < 0:
+                keep = max(start, len(buffer) - len(sync) + 1)
+                self._discarded += keep - start
+                start = keep
+                break
+            self._discarded += found - start
+            start = found
+            if len(buffer) - start < size:
+                break
+            body = bytes(buffer[start + body_start : start + body_end])
+            if self._check_bytes and self._check(body, self._order) != buffer[start + body_end : start + size]:
+                self._discarded += 1
+                start += 1
+                continue
+            self._end_stretch()
+            values = self._body.unpack(body)
+            readings.append(self._maker.make(values, t_arrival, self._time.seconds(values)))
+            start += size
+        del buffer[:start]
+        return readings
+
+    def _end_stretch(self) -> None:
+        if self._discarded:
+            self.corrupt += max(1, math.floor(self._discarded / self.record_bytes + 0.5))
+            self._discarded = 0
+
+    def reset(self) -> None:
+        self._discarded += len(self._buffer)
+        self._end_stretch()
+        self._buffer.clear()
+        self._time.reset()
+
+
+class HidReportDecoder:
+    def __init__(self, profile: Profile) -> None:
+        self.corrupt = 0
+        self._maker = ReadingMaker(profile)
+        self._time = DeviceTime(profile, self._maker)
+        self._report_id = profile.report_id
+        self._body = struct.Struct(profile.struct_format)
+        self.report_bytes = self._body.size + (1 if self._report_id else 0)
+
+    def feed(self, report: bytes, t_arrival: float) -> list[Reading]:
+        if self._report_id:
+            if not report or report[0] != self._report_id:
+                return []
+            report = report[1:]
+        if len(report) < self._body.size:
+            self.corrupt += 1
+            return []
+        values = self._body.unpack_from(report)
+        return [self._maker.make(values, t_arrival, self._time.seconds(values))]
+
+    def reset(self) -> None:
+        self._time.reset()
+
+
+Decoder = TextDecoder | BinaryDecoder | HidReportDecoder
+
+
+def decoder_for(profile: Profile) -> Decoder:
+    return {"text": TextDecoder, "binary": BinaryDecoder, "hid": HidReportDecoder}[profile.format](profile)

@@ -1,0 +1,119 @@
+"""`hid:VID:PID[:PROFILE]`: a tracker that sends USB HID input reports (an IMU, a headset), read
+through hidapi; VID and PID in hex as `rig devices` lists them, PROFILE a shipped profile's name
+or a .toml path (default hid-quat16).
+
+The device is opened through an injected opener returning an object with hidapi's `hid.device`
+methods (`read(max_length, timeout_ms)` giving a list of byte values, empty when none came in time;
+`close()`); tests pass a fake that replays recorded reports.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Protocol
+
+from rig.clock import Clock
+from rig.devices.trackers.clock_mapping import mapping_for
+from rig.devices.trackers.decoders import HidReportDecoder
+from rig.devices.trackers.profile import Profile, load_profile
+from rig.devices.trackers.readings import Reading
+from rig.devices.trackers.stream import LinkLost, TrackerStream
+from rig.errors import ConfigError, RigError
+
+DEFAULT_PROFILE = "hid-quat16"
+READ_TIMEOUT_MS = 50
+# Longest report read: full-speed USB interrupt reports are at most 64 bytes, high-speed 1024.
+MAX_REPORT_BYTES = 1024
+
+
+class HidDevice(Protocol):
+    """What a tracker needs of hidapi's `hid.device`."""
+
+    def read(self, max_length: int, timeout_ms: int = 0) -> list[int]: ...
+
+    def close(self) -> None: ...
+
+
+def open_hid_device(vendor_id: int, product_id: int) -> HidDevice:
+    """The default opener: hidapi's first device with these ids."""
+    import hid
+
+    device = hid.device()
+    device.open(vendor_id, product_id)
+    return device
+
+
+def parse_hid_address(address: str) -> tuple[int, int, str]:
+    """(vendor id, product id, profile) from `VID:PID[:PROFILE]`."""
+    parts = address.split(":", 2)
+    if len(parts) < 2:
+        raise ConfigError(f"hid:{address}: expected hid:VID:PID[:PROFILE] with the ids in hex, such as hid:046d:c52b")
+    try:
+        vendor, product = (int(part, 16) for part in parts[:2])
+    except ValueError:
+        raise ConfigError(f"hid:{address}: the vendor and product ids must be hex numbers, such as hid:046d:c52b") from None
+    if not (0 <= vendor <= 0xFFFF and 0 <= product <= 0xFFFF):
+        raise ConfigError(f"hid:{address}: vendor and product ids are 16-bit (at most ffff)")
+    return vendor, product, parts[2] if len(parts) > 2 and parts[2] else DEFAULT_PROFILE
+
+
+class HidLink:
+    """One HID device's input reports through the profile's decoder."""
+
+    def __init__(self, vendor: int, product: int, profile: Profile, open_device: Callable[[int, int], HidDevice]) -> None:
+        self.ids = f"{vendor:04x}:{product:04x}"
+        self.description = f"HID device {self.ids}"
+        self._vendor, self._product = vendor, product
+        self._open_device = open_device
+        self._decoder = HidReportDecoder(profile)
+        self._read_bytes = max(self._decoder.report_bytes, 64)
+        self._device: HidDevice | None = None
+
+    @property
+    def corrupt(self) -> int:
+        return self._decoder.corrupt
+
+    def open(self, clock: Clock) -> None:
+        try:
+            self._device = self._open_device(self._vendor, self._product)
+        except (OSError, ValueError) as error:
+            raise RigError(
+                f"cannot open HID device {self.ids} ({error}): check that it is plugged in (`rig devices` lists "
+                "what it sees) and that your user may read its /dev/hidraw* node (a udev rule)"
+            ) from None
+        self._decoder.reset()
+
+    def read(self, clock: Clock) -> list[Reading]:
+        device = self._device
+        if device is None:
+            raise LinkLost("the device is closed")
+        try:
+            report = device.read(self._read_bytes, READ_TIMEOUT_MS)
+        except (OSError, ValueError) as error:
+            raise LinkLost(str(error)) from None
+        if not report:
+            return []
+        return self._decoder.feed(bytes(report), clock.now())
+
+    def close(self) -> None:
+        device, self._device = self._device, None
+        if device is not None:
+            try:
+                device.close()
+            except (OSError, ValueError):
+                pass
+
+
+def hid_tracker(address: str, open_device: Callable[[int, int], HidDevice] = open_hid_device) -> TrackerStream:
+    """An unconnected HID tracker for `VID:PID[:PROFILE]`."""
+    vendor, product, profile_name = parse_hid_address(address)
+    profile = load_profile(profile_name)
+    if profile.format != "hid":
+        raise ConfigError(f"profile {profile.name} is a {profile.format} profile; a HID tracker needs format = \"hid\"")
+    return TrackerStream(
+        f"hid:{address}",
+        HidLink(vendor, product, profile, open_device),
+        mapping_for(profile),
+        unit_tolerance=profile.unit_tolerance,
+        sequence_bits=profile.sequence_bits,
+        describe=lambda: {"profile": profile.describe()},
+    )

@@ -1,0 +1,149 @@
+"""`lsl:NAME`: a pose stream on Lab Streaming Layer, as motion capture systems and game engines
+publish them: 7 channels, position in metres (px, py, pz) then a unit quaternion w first (qw, qx,
+qy, qz), each sample stamped on the sender's LSL clock.
+
+The sender's stamps are mapped onto the rig clock with liblsl's own clock offset, measured by round
+trips (`lsl_time_correction_ex`, which gives the offset's uncertainty beside it; pylsl exposes only
+the offset) and refreshed every CORRECTION_INTERVAL_S, so the tracker's latency to the host is
+known. The inlet recovers a sender that restarts (same source id) by itself. pylsl is imported only
+when an LSL stream is used or listed, and liblsl's own console log is kept to fatal errors: the rig
+logs what happens to the link itself.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from types import ModuleType
+from typing import Any
+
+from rig.clock import Clock, MonotonicClock
+from rig.devices.trackers.clock_mapping import CorrectedMapping
+from rig.devices.trackers.profile import DEFAULT_UNIT_TOLERANCE
+from rig.devices.trackers.readings import Reading
+from rig.devices.trackers.stream import LinkLost, TrackerStream
+from rig.errors import ConfigError, RigError
+
+CHANNELS = ("px", "py", "pz", "qw", "qx", "qy", "qz")
+RESOLVE_TIMEOUT_S = 2.0
+OPEN_TIMEOUT_S = 2.0
+READ_TIMEOUT_S = 0.05
+CORRECTION_INTERVAL_S = 1.0
+CORRECTION_TIMEOUT_S = 2.0
+# Seconds of samples the inlet buffers while the reader is busy: far more than it ever is.
+BUFFER_S = 30
+_LIBLSL_CONFIG = "[log]\nlevel = -3\n"
+_pylsl: ModuleType | None = None
+
+
+def pylsl() -> ModuleType:
+    """pylsl, imported on first use with liblsl's console log kept to fatal errors."""
+    global _pylsl
+    if _pylsl is None:
+        import pylsl as module
+
+        module.set_config_content(_LIBLSL_CONFIG)
+        _pylsl = module
+    return _pylsl
+
+
+def time_correction(inlet: Any, timeout_s: float) -> tuple[float, float]:
+    """(offset, uncertainty) in seconds: local time = the sender's time + offset, within +-uncertainty."""
+    lsl = pylsl()
+    function = lsl.lib.lib.lsl_time_correction_ex
+    function.restype = ctypes.c_double
+    function.argtypes = [
+        ctypes.c_void_p, ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double), ctypes.c_double,
+        ctypes.POINTER(ctypes.c_int32),
+    ]  # fmt: skip
+    remote, uncertainty, error = ctypes.c_double(), ctypes.c_double(), ctypes.c_int32()
+    offset = function(inlet.obj, ctypes.byref(remote), ctypes.byref(uncertainty), timeout_s, ctypes.byref(error))
+    lsl.util.handle_error(error)
+    return offset, uncertainty.value
+
+
+def lsl_origin(clock: Clock) -> float:
+    """The LSL clock's reading at the rig clock's zero. LSL's clock is the system's monotonic clock,
+    the same as a MonotonicClock's; another clock is assumed to run at its rate."""
+    if isinstance(clock, MonotonicClock):
+        return clock.origin_ns / 1e9
+    return pylsl().local_clock() - clock.now()
+
+
+class LslLink:
+    """The inlet of the LSL stream called `name`."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.description = f"LSL stream {name!r}"
+        self.corrupt = 0
+        self.mapping = CorrectedMapping()
+        self.source_id = ""
+        self._inlet: Any = None
+        self._next_correction = 0.0
+
+    def open(self, clock: Clock) -> None:
+        lsl = pylsl()
+        streams = lsl.resolve_byprop("name", self.name, timeout=RESOLVE_TIMEOUT_S)
+        if not streams:
+            raise RigError(f"no LSL stream named {self.name!r} answered within {RESOLVE_TIMEOUT_S:g} s; `rig devices` lists the streams it sees")
+        info = streams[0]
+        if info.channel_count() != len(CHANNELS):
+            raise ConfigError(
+                f"LSL stream {self.name!r} has {info.channel_count()} channels; a pose stream has {len(CHANNELS)}: "
+                f"{', '.join(CHANNELS)} (metres, then a unit quaternion w first)"
+            )
+        self.source_id = info.source_id()
+        inlet = lsl.StreamInlet(info, max_buflen=BUFFER_S, recover=True)
+        try:
+            # The first correction takes a good fraction of a second: measured before the samples flow.
+            correction, uncertainty = time_correction(inlet, CORRECTION_TIMEOUT_S)
+            inlet.open_stream(timeout=OPEN_TIMEOUT_S)
+        except (lsl.TimeoutError, lsl.LostError) as error:
+            raise RigError(f"LSL stream {self.name!r} did not answer: {error}") from None
+        if self.mapping.origin_s is None:
+            self.mapping.origin_s = lsl_origin(clock)
+        self.mapping.add_correction(correction, uncertainty, clock.now())
+        self._next_correction = clock.now() + CORRECTION_INTERVAL_S
+        self._inlet = inlet
+
+    def read(self, clock: Clock) -> list[Reading]:
+        lsl = pylsl()
+        inlet = self._inlet
+        if inlet is None:
+            raise LinkLost("the inlet is closed")
+        try:
+            first, stamp = inlet.pull_sample(timeout=READ_TIMEOUT_S)
+            if first is None:
+                return []
+            rest, stamps = inlet.pull_chunk(timeout=0.0)
+            t_arrival = clock.now()
+            if t_arrival >= self._next_correction:
+                self.mapping.add_correction(*time_correction(inlet, 0.0), t_arrival)
+                self._next_correction = t_arrival + CORRECTION_INTERVAL_S
+        except lsl.LostError as error:
+            raise LinkLost(f"the sender is gone ({error})") from None
+        readings = []
+        for values, device_time in zip([first, *rest], [stamp, *stamps]):
+            px, py, pz, qw, qx, qy, qz = values
+            readings.append(Reading(t_arrival, device_time, None, (px, py, pz), (qw, qx, qy, qz)))
+        return readings
+
+    def close(self) -> None:
+        inlet, self._inlet = self._inlet, None
+        if inlet is not None:
+            inlet.close_stream()
+
+
+def lsl_tracker(address: str) -> TrackerStream:
+    """An unconnected LSL tracker for the stream called `address`."""
+    if not address:
+        raise ConfigError("an LSL tracker needs the stream's name: lsl:NAME (`rig devices` lists the streams)")
+    link = LslLink(address)
+    return TrackerStream(
+        f"lsl:{address}",
+        link,
+        link.mapping,
+        unit_tolerance=DEFAULT_UNIT_TOLERANCE,
+        sequence_bits=None,
+        describe=lambda: {"lsl": {"name": address, "source_id": link.source_id, "channels": list(CHANNELS)}},
+    )

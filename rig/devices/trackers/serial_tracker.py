@@ -1,0 +1,159 @@
+"""`serial:URL`: a tracker on a serial line, a TCP socket or anything pyserial's `serial_for_url`
+opens (/dev/ttyUSB0, socket://HOST:PORT, rfc2217://HOST:PORT, loop://).
+
+    serial:/dev/ttyUSB0?profile=polhemus-ascii&baud=115200
+    serial:socket://localhost:7777?profile=binary-pose
+
+`profile` (a shipped profile's name or a .toml path; default csv) and `baud` (default 115200) are
+the rig's; any other query option goes to pyserial with the URL.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import select
+from typing import Callable, Protocol
+from urllib.parse import parse_qsl, urlencode
+
+import serial
+
+from rig.clock import Clock
+from rig.devices.trackers.clock_mapping import mapping_for
+from rig.devices.trackers.decoders import BinaryDecoder, TextDecoder, decoder_for
+from rig.devices.trackers.profile import Profile, load_profile
+from rig.devices.trackers.readings import Reading
+from rig.devices.trackers.stream import LinkLost, TrackerStream
+from rig.errors import ConfigError, RigError
+
+DEFAULT_PROFILE = "csv"
+DEFAULT_BAUD = 115200
+READ_TIMEOUT_S = 0.05
+# Most bytes taken from a port with a file descriptor in one read.
+CHUNK_BYTES = 65536
+
+
+class SerialPort(Protocol):
+    """What a tracker needs of a pyserial port."""
+
+
+    @property
+    def in_waiting(self) -> int: ...
+
+    def read(self, size: int = 1) -> bytes: ...
+
+    def close(self) -> None: ...
+
+
+def open_serial_url(url: str, baud: int) -> SerialPort:
+    """The default opener: pyserial's serial_for_url."""
+    return serial.serial_for_url(url, baudrate=baud, timeout=READ_TIMEOUT_S)
+
+
+def parse_serial_address(address: str) -> tuple[str, str, int]:
+    """(pyserial URL, profile, baud rate) from `URL[?profile=NAME&baud=N&...]`."""
+    url, _, query = address.partition("?")
+    options = dict(parse_qsl(query, keep_blank_values=True))
+    profile = options.pop("profile", DEFAULT_PROFILE)
+    baud_text = options.pop("baud", str(DEFAULT_BAUD))
+    if not url:
+        raise ConfigError("a serial tracker needs a port: serial:/dev/ttyUSB0, serial:socket://HOST:PORT, serial:loop://")
+    if not baud_text.isdigit() or int(baud_text) <= 0:
+        raise ConfigError(f"baud={baud_text!r} in serial:{address}; expected a positive whole number such as 115200")
+    if options:
+        url = f"{url}?{urlencode(options)}"
+    return url, profile, int(baud_text)
+
+
+def _file_descriptor(port: SerialPort) -> int | None:
+    """The port's file descriptor where it has one (a device, a pty, a socket), else None (loop://)."""
+    try:
+        return port.fileno()  # type: ignore[attr-defined]
+    except (AttributeError, NotImplementedError, serial.SerialException, OSError):
+        return None
+
+
+def _open_problem(url: str, error: Exception) -> RigError:
+    code = getattr(error, "errno", None)
+    if code == errno.EACCES:
+        return RigError(
+            f"no permission to open {url}: add your user to the group that owns it (often dialout: "
+            "sudo usermod -aG dialout $USER, then log in again)"
+        )
+    if code == errno.ENOENT:
+        return RigError(f"no serial port {url}: check the cable; `rig devices` lists the ports it sees")
+    return RigError(f"cannot open the tracker's serial port {url}: {error}")
+
+
+class SerialLink:
+    """A pyserial port read through the profile's decoder. A port with a file descriptor (a device, a
+    pty, a socket; pyserial keeps no buffer of its own for these) is waited on with select and read
+    straight from the descriptor, whatever it holds: pyserial's socket handler counts a waiting
+    socket as one byte, which would make reads byte by byte, and its read loop costs more than the
+    decoding. Others (loop://, rfc2217://) are read through pyserial with its timeout."""
+
+    def __init__(self, url: str, baud: int, profile: Profile, open_port: Callable[[str, int], SerialPort]) -> None:
+        self.url = url
+        self.baud = baud
+        self.description = f"serial {url} at {baud} baud"
+        self._open_port = open_port
+        self._decoder: TextDecoder | BinaryDecoder = decoder_for(profile)  # type: ignore[assignment]
+        self._port: SerialPort | None = None
+        self._fd: int | None = None
+
+    @property
+    def corrupt(self) -> int:
+        return self._decoder.corrupt
+
+    def open(self, clock: Clock) -> None:
+        try:
+            port = self._open_port(self.url, self.baud)
+        except (serial.SerialException, OSError, ValueError) as error:
+            raise _open_problem(self.url, error) from None
+        self._fd = _file_descriptor(port)
+        self._port = port
+        self._decoder.reset()
+
+    def read(self, clock: Clock) -> list[Reading]:
+        port = self._port
+        if port is None:
+            raise LinkLost("the port is closed")
+        try:
+            if self._fd is not None:
+                if not select.select([self._fd], [], [], READ_TIMEOUT_S)[0]:
+                    return []
+                data = os.read(self._fd, CHUNK_BYTES)
+                if not data:
+                    raise LinkLost("the port reports data but returned none (disconnected)")
+            else:
+                data = port.read(max(1, port.in_waiting))
+        except (serial.SerialException, OSError, TypeError, ValueError) as error:
+            # pyserial raises TypeError when close() takes the port away in the middle of a read.
+            raise LinkLost(str(error)) from None
+        if not data:
+            return []
+        return self._decoder.feed(data, clock.now())
+
+    def close(self) -> None:
+        port, self._port = self._port, None
+        if port is not None:
+            try:
+                port.close()
+            except (serial.SerialException, OSError):
+                pass
+
+
+def serial_tracker(address: str, open_port: Callable[[str, int], SerialPort] = open_serial_url) -> TrackerStream:
+    """An unconnected serial tracker for `URL[?profile=...&baud=...]`."""
+    url, profile_name, baud = parse_serial_address(address)
+    profile = load_profile(profile_name)
+    if profile.format == "hid":
+        raise ConfigError(f"profile {profile.name} describes HID reports; a serial tracker needs a text or binary profile")
+    return TrackerStream(
+        f"serial:{address}",
+        SerialLink(url, baud, profile, open_port),
+        mapping_for(profile),
+        unit_tolerance=profile.unit_tolerance,
+        sequence_bits=profile.sequence_bits,
+        describe=lambda: {"profile": profile.describe()},
+    )

@@ -1,0 +1,92 @@
+"""Records as a tracker with a given profile would send them: the inverse of the rig's decoders.
+
+Values go in in the rig's units (s, m, unit quaternion, rad/s) and come out as the profile's
+bytes: a text line, a binary record with its sync and check, or a HID report with its id. Integer
+fields are rounded and wrap at their width, as a device's counters do.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from rig.devices.trackers.checksums import CHECKSUMS
+from rig.devices.trackers.profile import (
+    EULER,
+    METRES_PER,
+    POSITION,
+    QUATERNION,
+    RADIANS_PER,
+    RATE,
+    SECONDS_PER,
+    SEQUENCE,
+    TIME,
+    Profile,
+)
+
+
+@dataclass(frozen=True)
+class Emission:
+    """One record the emulated device sends: its counter, its own time (s), the pose and angular rate."""
+
+    seq: int
+    device_time: float
+    position: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
+    angular_rate: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+class RecordEncoder:
+    """Encodes emissions in `profile`'s format."""
+
+    def __init__(self, profile: Profile) -> None:
+        self.profile = profile
+        self._struct = struct.Struct(profile.struct_format) if profile.format != "text" else None
+        self._check = CHECKSUMS[profile.checksum]
+
+    def _physical(self, emission: Emission) -> dict[str, float]:
+        profile = self.profile
+        values: dict[str, float] = {SEQUENCE: float(emission.seq), TIME: emission.device_time / SECONDS_PER[profile.time_unit]}
+        metres = METRES_PER[profile.position_unit]
+        radians = RADIANS_PER[profile.angle_unit]
+        values.update({name: v / metres for name, v in zip(POSITION, emission.position)})
+        values.update(zip(QUATERNION, emission.orientation))
+        values.update({name: v / radians for name, v in zip(RATE, emission.angular_rate)})
+        if profile.euler:
+            w, x, y, z = emission.orientation
+            angles = Rotation.from_quat([x, y, z, w]).as_euler(profile.euler)
+            values.update({name: float(a) / radians for name, a in zip(EULER, angles)})
+        return values
+
+    def raw_values(self, emission: Emission) -> list[float | int]:
+        """The record's fields in profile order, scaled, integers rounded and wrapped."""
+        values = self._physical(emission)
+        raw: list[float | int] = []
+        for field in self.profile.fields:
+            if field.code.endswith("x"):
+                continue
+            value = values.get(field.name, 0.0) / self.profile.scale.get(field.name, 1.0)
+            bits = field.integer_bits
+            if bits is not None:
+                signed = field.code.islower()
+                whole = int(np.rint(value)) % (1 << bits)
+                if signed and whole >= 1 << (bits - 1):
+                    whole -= 1 << bits
+                raw.append(whole)
+            else:
+                raw.append(value)
+        return raw
+
+    def encode(self, emission: Emission) -> bytes:
+        profile = self.profile
+        raw = self.raw_values(emission)
+        if profile.format == "text":
+            separator = profile.separator or " "
+            return separator.join(f"{v:.9g}" for v in raw).encode("ascii") + profile.terminator
+        body = self._struct.pack(*raw)
+        if profile.format == "hid":
+            return (bytes([profile.report_id]) if profile.report_id else b"") + body
+        return profile.sync + body + self._check(body, profile.byte_order)

@@ -1,0 +1,192 @@
+"""Where an emulated tracker sends its records: a pseudo-terminal, a TCP socket, or an LSL outlet.
+
+Each sink waits for a reader before it streams (`wait_for_reader`), as a tracker told to start by
+its host would, so a recording can hold every record sent. `disconnect` takes the port away (the
+pty is destroyed, the socket and its listener closed, the outlet deleted) and `reconnect` brings
+it back at the same address and waits for the reader to return.
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import socket
+import time
+import tty
+from pathlib import Path
+from typing import Any, Sequence
+
+from rig.devices.trackers.lsl_tracker import CHANNELS, pylsl
+from rig.emulate.encode import Emission, RecordEncoder
+from rig.emulate.faults import ByteFaults
+from rig.errors import RigError
+
+# After a reader opens the port it may flush what is waiting (pyserial does): start a little later.
+READER_GRACE_S = 0.1
+POLL_S = 0.02
+
+
+class PtySink:
+    """A pseudo-terminal whose slave is reachable at `link` (a symlink kept pointing at the live one)."""
+
+    def __init__(self, link: Path, encoder: RecordEncoder, faults: ByteFaults) -> None:
+        self.link = Path(link)
+        self.address = str(self.link)
+        self._encoder = encoder
+        self._faults = faults
+        self._master = -1
+        self._open()
+
+    def _open(self) -> None:
+        master, slave = os.openpty()
+        tty.setraw(slave)
+        name = os.ttyname(slave)
+        os.close(slave)
+        staged = self.link.with_name(self.link.name + ".new")
+        staged.unlink(missing_ok=True)
+        os.symlink(name, staged)
+        os.replace(staged, self.link)
+        self._master = master
+
+    def _reader_present(self) -> bool:
+        poller = select.poll()
+        poller.register(self._master, select.POLLHUP)
+        return not any(event & select.POLLHUP for _, event in poller.poll(0))
+
+    def wait_for_reader(self, stop_at: float) -> bool:
+        while not self._reader_present():
+            if time.monotonic() >= stop_at:
+                return False
+            time.sleep(POLL_S)
+        time.sleep(READER_GRACE_S)
+        return True
+
+    def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
+        """Writes the records at once; (damaged per record, the monotonic time of the write)."""
+        chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
+        written = time.monotonic()
+        os.write(self._master, b"".join(chunks))
+        return list(damaged), written
+
+    def connected(self) -> bool:
+        return self._reader_present()
+
+    def disconnect(self) -> None:
+        os.close(self._master)
+        self._master = -1
+
+    def reconnect(self, stop_at: float) -> bool:
+        self._open()
+        return self.wait_for_reader(stop_at)
+
+    def close(self) -> None:
+        if self._master >= 0:
+            os.close(self._master)
+            self._master = -1
+        self.link.unlink(missing_ok=True)
+
+
+class TcpSink:
+    """A TCP server on 127.0.0.1 (port 0: any free one) that streams to one client at a time."""
+
+    def __init__(self, port: int, encoder: RecordEncoder, faults: ByteFaults) -> None:
+        self._encoder = encoder
+        self._faults = faults
+        self._client: socket.socket | None = None
+        self._listener = self._listen(port)
+        self.port = self._listener.getsockname()[1]
+        self.address = f"socket://127.0.0.1:{self.port}"
+
+    @staticmethod
+    def _listen(port: int) -> socket.socket:
+        listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        listener.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            listener.bind(("127.0.0.1", port))
+        except OSError as error:
+            listener.close()
+            raise RigError(f"cannot listen on 127.0.0.1:{port}: {error.strerror}; choose another --tcp port") from None
+        listener.listen(1)
+        return listener
+
+    def wait_for_reader(self, stop_at: float) -> bool:
+        while time.monotonic() < stop_at:
+            ready, _, _ = select.select([self._listener], [], [], POLL_S)
+            if ready:
+                self._client, _ = self._listener.accept()
+                self._client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                time.sleep(READER_GRACE_S)
+                return True
+        return False
+
+    def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
+        chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
+        written = time.monotonic()
+        try:
+            self._client.sendall(b"".join(chunks))
+        except OSError:
+            self._client = None
+        return list(damaged), written
+
+    def connected(self) -> bool:
+        return self._client is not None
+
+    def disconnect(self) -> None:
+        for sock in (self._client, self._listener):
+            if sock is not None:
+                sock.close()
+        self._client = None
+
+    def reconnect(self, stop_at: float) -> bool:
+        self._listener = self._listen(self.port)
+        return self.wait_for_reader(stop_at)
+
+    def close(self) -> None:
+        self.disconnect()
+
+
+class LslSink:
+    """An LSL outlet of a 7-channel pose stream, stamped with the record's time on the LSL clock."""
+
+    def __init__(self, name: str, rate_hz: float, source_id: str) -> None:
+        self.name = name
+        self.address = f"lsl:{name}"
+        self._rate = rate_hz
+        self._source_id = source_id
+        self._outlet: Any = self._make_outlet()
+
+    def _make_outlet(self) -> Any:
+        lsl = pylsl()
+        info = lsl.StreamInfo(self.name, "MoCap", len(CHANNELS), self._rate, lsl.cf_double64, self._source_id)
+        channels = info.desc().append_child("channels")
+        for label in CHANNELS:
+            channel = channels.append_child("channel")
+            channel.append_child_value("label", label)
+            channel.append_child_value("unit", "metres" if label.startswith("p") else "normalised")
+        return lsl.StreamOutlet(info)
+
+    def wait_for_reader(self, stop_at: float) -> bool:
+        while time.monotonic() < stop_at:
+            if self._outlet.wait_for_consumers(POLL_S):
+                time.sleep(READER_GRACE_S)
+                return True
+        return False
+
+    def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
+        written = time.monotonic()
+        for emission in emissions:
+            self._outlet.push_sample([*emission.position, *emission.orientation], emission.device_time)
+        return [False] * len(emissions), written
+
+    def connected(self) -> bool:
+        return self._outlet is not None and self._outlet.have_consumers()
+
+    def disconnect(self) -> None:
+        self._outlet = None
+
+    def reconnect(self, stop_at: float) -> bool:
+        self._outlet = self._make_outlet()
+        return self.wait_for_reader(stop_at)
+
+    def close(self) -> None:
+        self._outlet = None

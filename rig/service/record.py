@@ -1,0 +1,109 @@
+"""Recording a tracker: `record_tracker(spec, duration, out)` writes its samples as they arrive.
+
+The folder gets `tracker.csv` (the one tracker sample format, `predictors.SAMPLE_COLUMNS`, what
+`rig bench predictors --trace` and `rig tune --trace` read), `tracker_device.csv` (row for row
+beside it: what the device said besides the pose, its own time, record counter and angular rate)
+and `tracker.json` (the device, its profile, the clock mapping with its uncertainty, the counters,
+link events, and whether the run was interrupted). Rows are flushed as each batch arrives; Ctrl-C
+ends the recording cleanly: the reader is stopped, what it had queued is written, the sidecar
+too, and the interrupt goes on to the caller.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+from predictors import SAMPLE_COLUMNS, sample_row
+from rig.clock import MonotonicClock
+from rig.devices.registry import DeviceContext, make_device
+from rig.devices.trackers.stream import TrackerRecord, TrackerStream
+from rig.errors import RigError
+from rig.records import CsvRecord
+
+TRACKER_FILE = "tracker.csv"
+DEVICE_FILE = "tracker_device.csv"
+SIDECAR_FILE = "tracker.json"
+DEVICE_COLUMNS = ("t_arrival", "device_time", "seq", "wx", "wy", "wz")
+WAIT_S = 0.1
+
+
+@dataclass(frozen=True)
+class TrackerRecording:
+    """What a recording wrote: its folder, how many samples, and the sidecar's content."""
+
+    out_dir: Path
+    samples: int
+    sidecar: dict[str, Any]
+
+
+def _records(tracker: Any, timeout_s: float) -> list[TrackerRecord]:
+    if isinstance(tracker, TrackerStream):
+        return tracker.wait_records(timeout_s)
+    return [TrackerRecord(sample, None, None, None) for sample in tracker.wait(timeout_s)]
+
+
+def record_tracker(
+    spec: str,
+    duration_s: float | None,
+    out_dir: Path,
+    *,
+    overwrite: bool = False,
+    progress: Callable[[float, float], None] = lambda done, total: None,
+    on_batch: Callable[[list[TrackerRecord], float], None] = lambda records, t: None,
+    clock: MonotonicClock | None = None,
+) -> TrackerRecording:
+    """Records the tracker `spec` for `duration_s` seconds (None: until interrupted) into `out_dir`,
+    on `clock` (a new MonotonicClock by default).
+
+    `on_batch(records, t_available)` sees every batch with the rig time it was handed over.
+    """
+    tracker = make_device("tracker", spec, DeviceContext())
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise RigError(f"cannot create {out_dir}: {error.strerror}") from None
+    clock = clock or MonotonicClock()
+    end = math.inf if duration_s is None else duration_s
+    samples = 0
+    interrupted = True
+    with (
+        CsvRecord(out_dir / TRACKER_FILE, SAMPLE_COLUMNS, overwrite=overwrite, flush_each_row=False) as sample_csv,
+        CsvRecord(out_dir / DEVICE_FILE, DEVICE_COLUMNS, overwrite=overwrite, flush_each_row=False) as device_csv,
+    ):
+
+        def write(records: list[TrackerRecord]) -> None:
+            for record in records:
+                sample_csv.write(sample_row(record.sample))
+                device_csv.write((record.sample.t_arrival, record.device_time, record.seq, *(record.angular_rate or (None,) * 3)))
+            sample_csv.flush()
+            device_csv.flush()
+
+        tracker.connect(clock)
+        try:
+            while (now := clock.now()) < end:
+                records = _records(tracker, min(WAIT_S, end - now))
+                if records:
+                    write(records)
+                    samples += len(records)
+                    on_batch(records, clock.now())
+                progress(min(now, end), end)
+            interrupted = False
+        finally:
+            tracker.close()
+            left = tracker.take_queued() if isinstance(tracker, TrackerStream) else []
+            write(left)
+            samples += len(left)
+            sidecar = {
+                "spec": spec,
+                "duration_s": clock.now(),
+                "interrupted": interrupted,
+                "samples": samples,
+                "files": {"samples": TRACKER_FILE, "device": DEVICE_FILE},
+                **(tracker.report() if isinstance(tracker, TrackerStream) else {"tracker": spec}),
+            }
+            (out_dir / SIDECAR_FILE).write_text(json.dumps(sidecar, indent=1) + "\n", encoding="utf-8")
+    return TrackerRecording(out_dir, samples, sidecar)
