@@ -15,7 +15,6 @@ from rig.commands.simulation_options import add_simulation_options, config_from_
 from rig.progress import ProgressBar
 from rig.service import compare_renderers, comparison_config, demo
 from rig.service.demo import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
-from rig.session import DEFAULT_SERVER_MS
 from rig.sim.config import SimulationConfig
 
 EXIT_MISMATCH = 1
@@ -56,7 +55,7 @@ def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
         print(
             f"comparing {' and '.join(COMPARE_RENDERERS)} on one scene: {config.scene_triangles} load triangles, "
             f"{_cost_text(config.app_frame_ms, 'application frame')}, "
-            f"{_cost_text(config.warp_ms if config.warp_ms is not None else DEFAULT_SERVER_MS, 'warp per refresh')}; "
+            f"{_cost_text(config.warp_ms, 'warp per refresh')}; "
             f"{config.duration_s:g} s at {config.display.refresh_hz:g} Hz, predictor {config.predictor} -> {args.out}/<renderer>"
         )
     reports = compare_renderers(config, args.out, ProgressBar)

@@ -24,6 +24,7 @@ def _run(args: argparse.Namespace) -> int:
             f"{truth.latency_ms:.2f} ms (sensor-to-photon delay per display frame "
             f"{d.mean:.2f} +/- {d.sd:.2f} ms)"
         )
+        print(result.cost_line())
     return 0
 
 

@@ -10,7 +10,7 @@ import predictors
 from rig.commands import options
 from rig.render import renderer_names
 from rig.service import SimulationConfig
-from rig.session import DEFAULT_SERVER_MS
+from rig.session import PHOTON_TARGETS
 from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -48,9 +48,25 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument(
         "--warp-ms",
+        type=options.app_frame_cost,
+        default=defaults.warp_ms,
+        help="modelled cost of each image a compositing (warp) renderer composes, in ms, or 'measured' for the "
+        "real GL time: a composition that takes longer than a refresh misses it (default: %(default)s)",
+    )
+    group.add_argument(
+        "--predict-to",
+        choices=PHOTON_TARGETS,
+        default=defaults.photon_target,
+        help="the instant each frame's pose is predicted for, at the sphere's row: 'photons' the middle of the "
+        "interval the row emits it (scan-out plus half the persistence), 'scanout' when scan-out reaches the row "
+        "(default: %(default)s)",
+    )
+    group.add_argument(
+        "--persistence",
         type=options.positive_float,
-        default=None,
-        help=f"modelled warp cost per display frame in ms (default for the warp renderer: {DEFAULT_SERVER_MS:g})",
+        default=defaults.persistence,
+        help="share of a refresh each display row emits a frame: 1 for sample-and-hold (the simulated display), "
+        "less for a low-persistence panel (default: %(default)s)",
     )
     group.add_argument(
         "--transport-delay-ms",
@@ -78,6 +94,8 @@ def config_from_args(args: argparse.Namespace) -> SimulationConfig:
         scene_triangles=args.scene_triangles,
         app_frame_ms=args.app_frame_ms,
         warp_ms=args.warp_ms,
+        photon_target=args.predict_to,
+        persistence=args.persistence,
     )
 
 

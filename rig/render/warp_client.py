@@ -5,6 +5,10 @@ front of dim load triangles, on a black background. Each object has a 16-bit ID;
 background. Load triangles are stored in the display's NDC, so the load's object matrix is
 inverse(world_to_clip): it maps those coordinates into the world, where any client view can see
 them. There is no multisampling: a pixel has one depth and one object for the warp to move.
+
+For the adaptive-grid warp each client frame also carries its grid cells (`rig.render.warp_grid`);
+for re-rendering holes the scene can draw chosen leaves of the load's kd-tree
+(`rig.render.warp_holes`).
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ import moderngl
 import numpy as np
 
 from rig.render import gl
+from rig.render.warp_grid import grid_cells
 from rig.render.warp_shaders import (
     CLIENT_LOAD_FRAGMENT_SHADER,
     CLIENT_LOAD_VERTEX_SHADER,
@@ -32,10 +37,15 @@ OBJECT_COUNT = 3
 
 class ClientTarget:
     """One client view's images: RGBA8 colour, R16 object ID (id / ID_SCALE) and depth textures,
-    and the RGBA32F surface texture the warp reads (see `ClientScene.prepare_surface`)."""
+    the RGBA32F surface texture the warp reads (see `ClientScene.prepare_surface`), and with
+    `grid` the buffer of its adaptive grid's cells (`grid_count` of them) and the server's vertex
+    array over it (`grid_vao`, made by the server)."""
 
-    def __init__(self, ctx: moderngl.Context, size: tuple[int, int]) -> None:
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int], grid: bool = False) -> None:
         self.size = size
+        self.grid_buffer = ctx.buffer(reserve=size[0] * size[1] * 12) if grid else None
+        self.grid_count = 0
+        self.grid_vao: moderngl.VertexArray | None = None
         self.colour = ctx.texture(size, 4)
         self.object_id = ctx.texture(size, 1, dtype="nu2")
         self.depth = ctx.depth_texture(size)
@@ -55,8 +65,14 @@ class ClientTarget:
         depth = np.frombuffer(self.depth.read(), dtype=np.float32).reshape(h, w)
         return colour.copy(), ids, depth.copy()
 
+    def read_surface(self) -> np.ndarray:
+        """The surface texture (h, w, 4) float32, OpenGL rows."""
+        w, h = self.size
+        return np.frombuffer(self.surface.read(), dtype=np.float32).reshape(h, w, 4)
+
     def release(self) -> None:
-        for resource in (self.surface_framebuffer, self.framebuffer, self.surface, self.colour, self.object_id, self.depth):
+        extra = [r for r in (self.grid_vao, self.grid_buffer) if r is not None]
+        for resource in (*extra, self.surface_framebuffer, self.framebuffer, self.surface, self.colour, self.object_id, self.depth):
             resource.release()
 
 
@@ -70,7 +86,10 @@ class ClientView:
 class ClientScene:
     """The scene's GL objects in one context, drawn from any `ClientView` into a `ClientTarget`."""
 
-    def __init__(self, ctx: moderngl.Context, sphere_radius_m: float, triangles: np.ndarray) -> None:
+    def __init__(
+        self, ctx: moderngl.Context, sphere_radius_m: float, triangles: np.ndarray, leaf_order: np.ndarray | None = None
+    ) -> None:
+        """`leaf_order`: the load's triangles in kd-tree leaf order, for `draw_load_leaves`."""
         self.ctx = ctx
         self._resources: list = []
         mesh = gl.sphere_mesh(sphere_radius_m)
@@ -95,11 +114,19 @@ class ClientScene:
         self._surface_program["id_scale"].value = ID_SCALE
         self._surface_vao = self._keep(ctx.vertex_array(self._surface_program, []))
         self._load_vao = None
+        self._leaf_vao = None
         self.triangle_count = len(triangles)
         if len(triangles):
-            self._load_vao = self._keep(
-                ctx.vertex_array(self._load_program, [(self._keep(ctx.buffer(triangles.tobytes())), "3f", "in_ndc")])
-            )
+            vertices = self._keep(ctx.buffer(triangles.tobytes()))
+            self._load_vao = self._keep(ctx.vertex_array(self._load_program, [(vertices, "3f", "in_ndc")]))
+            if leaf_order is not None:
+                indices = (3 * np.asarray(leaf_order, dtype=np.uint32)[:, np.newaxis] + np.arange(3, dtype=np.uint32)).ravel()
+                self._leaf_vao = self._keep(
+                    ctx.vertex_array(
+                        self._load_program, [(vertices, "3f", "in_ndc")], index_buffer=self._keep(ctx.buffer(indices.tobytes())),
+                        index_element_size=4,
+                    )
+                )
 
     def _keep(self, resource):
         self._resources.append(resource)
@@ -126,14 +153,27 @@ class ClientScene:
         self.ctx.enable(moderngl.DEPTH_TEST)
         self._sphere_vao.render(moderngl.TRIANGLES)
 
+    def draw_load_leaves(self, world_to_clip: np.ndarray, load_model: np.ndarray, leaves: list[tuple[int, int]]) -> None:
+        """Draw the load's triangles in the leaf ranges (first, count) of `leaf_order` into the
+        framebuffer in use, depth-tested, seen through `world_to_clip`."""
+        gl.write_matrix(self._load_program, "object_to_clip", world_to_clip @ load_model)
+        self.ctx.enable(moderngl.DEPTH_TEST)
+        for first, count in leaves:
+            self._leaf_vao.render(moderngl.TRIANGLES, vertices=3 * count, first=3 * first)
+
     def prepare_surface(self, target: ClientTarget) -> None:
         """Fill `target.surface` from its depth and object IDs: per pixel (NDC depth, depth slopes
-        along x and y, object id), computed once per client frame instead of once per warp."""
+        along x and y, object id), computed once per client frame instead of once per warp; and
+        the target's grid cells where it has a grid."""
         self.ctx.disable(moderngl.DEPTH_TEST)
         target.surface_framebuffer.use()
         target.object_id.use(0)
         target.depth.use(1)
         self._surface_vao.render(moderngl.TRIANGLES, vertices=3)
+        if target.grid_buffer is not None:
+            cells = grid_cells(target.read_surface())
+            target.grid_buffer.write(cells.tobytes())
+            target.grid_count = len(cells)
 
     def release(self) -> None:
         for resource in reversed(self._resources):

@@ -1,16 +1,25 @@
 """The warp renderer's server: re-projects client frames to the display with per-object matrices.
 
-Every client pixel is one vertex (its pixel from gl_VertexID; no vertex buffer), moved by its
-object's warp matrix and drawn as a depth-tested point splat sized by the warp's Jacobian, or as a
-quad splat (the warped pixel's parallelogram, through a geometry shader). Several client views
-composite through the same depth buffer. The work is one vertex per client pixel whatever the scene
-holds, so its cost depends on pixels only.
+Reconstructions (Smit et al. 2010, section 4.1; Schollmeyer et al., section 4.1):
+
+* "point": every client pixel is one vertex (its pixel from gl_VertexID; no vertex buffer), drawn
+  as a depth-tested point splat sized by the warp's Jacobian;
+* "quad": the same vertex drawn as the warped pixel's parallelogram (a geometry shader);
+* "mesh": the client pixels as a triangle mesh, two triangles per 2x2 pixels, colours interpolated,
+  triangles across object or depth edges dropped;
+* "grid": the adaptive grid's cells (`rig.render.warp_grid`), one quad each.
+
+The primitives drawn per client view are counted in `primitives`.
+
+With two client views, the second only fills what the first left empty: its fragments are
+discarded wherever the first view's warp covered the pixel, so a second view never makes a pixel
+worse than the first alone would (Mark et al.'s two reference frames, with the first as the trusted
+one).
 
 Background pixels (object 0) are warped too, as a static object just inside the far plane: the
 clear colour redraws the background, and a pixel nothing was warped to is then a true level-0 hole
-(Smit et al. 2010, section 4.2.1), never mistaken for background. Holes are filled cheaply in one
-full-screen pass: a hole shows what lay behind the object that moved away, so it takes the colour
-of the farthest of the first covered pixels found in 8 directions. Only hole pixels search.
+(section 4.2.1), never mistaken for background. Holes of higher levels are found and re-rendered by
+`rig.render.warp_holes`; what is left is filled by `rig.render.warp_fill`.
 """
 
 from __future__ import annotations
@@ -23,26 +32,37 @@ import numpy as np
 from rig.errors import ConfigError
 from rig.render.gl import read_rgb
 from rig.render.warp_client import ClientTarget
+from rig.render.warp_fill import HoleFill
 from rig.render.warp_matrices import SPLAT_ROUNDING
 from rig.render.warp_shaders import (
-    FILL_FRAGMENT_SHADER,
-    FULLSCREEN_VERTEX_SHADER,
+    GRID_FRAGMENT_SHADER,
+    ID_SCALE,
     WARP_FRAGMENT_SHADER,
+    WARP_MESH_GEOMETRY_SHADER,
     WARP_QUAD_GEOMETRY_SHADER,
     warp_vertex_shader,
 )
 
-RECONSTRUCTIONS = ("point", "quad")
+RECONSTRUCTIONS = ("point", "quad", "mesh", "grid")
 MAX_SPLAT_PX = 8.0
 """Largest point splat (pixels a side): a pixel magnified more than this leaves holes instead."""
 BACKGROUND_NDC_Z = 1.0 - 2.0**-10
 """NDC depth the background is warped to: behind every object, inside the far plane."""
-FILL_SEARCH_FRACTION = 1.0 / 16.0
-"""A hole searches this fraction of the display's larger side, in pixels, in each direction."""
+MESH_DEPTH_STEP = 0.01
+"""Largest client NDC depth difference within a mesh triangle: beyond it the pixels are taken to
+show different surfaces."""
+
+
+def mesh_indices(size: tuple[int, int]) -> np.ndarray:
+    """Vertex indices (uint32) of the pixel mesh of a (w, h) image: two triangles per 2x2 pixels."""
+    w, h = size
+    corner = (np.arange(h - 1)[:, np.newaxis] * w + np.arange(w - 1)[np.newaxis, :]).ravel()
+    quads = np.stack([corner, corner + 1, corner + w, corner + 1, corner + w + 1, corner + w], axis=1)
+    return quads.astype(np.uint32).ravel()
 
 
 class WarpServer:
-    """The server's GL objects for one display size: warp, hole marking and fill, readback."""
+    """The server's GL objects for one display size: warp, hole fill, readback."""
 
     def __init__(
         self,
@@ -51,6 +71,7 @@ class WarpServer:
         server_size: tuple[int, int],
         object_count: int,
         reconstruction: str = "point",
+        fill: str = "nearest",
         background: tuple[float, float, float] = (0.0, 0.0, 0.0),
     ) -> None:
         if reconstruction not in RECONSTRUCTIONS:
@@ -60,67 +81,94 @@ class WarpServer:
         self.server_size = server_size
         self.reconstruction = reconstruction
         self.background = background
+        self.primitives: list[int] = []
+        """How many primitives the latest warp drew, per client view."""
         self._resources: list = []
         keep = self._keep
         self.max_splat = float(min(MAX_SPLAT_PX, ctx.info["GL_POINT_SIZE_RANGE"][1]))
 
-        geometry = WARP_QUAD_GEOMETRY_SHADER if reconstruction == "quad" else None
-        self.warp_program = keep(
-            ctx.program(
-                vertex_shader=warp_vertex_shader(object_count), geometry_shader=geometry, fragment_shader=WARP_FRAGMENT_SHADER
-            )
+        geometry = {"quad": WARP_QUAD_GEOMETRY_SHADER, "mesh": WARP_MESH_GEOMETRY_SHADER}.get(reconstruction)
+        fragment = GRID_FRAGMENT_SHADER if reconstruction == "grid" else WARP_FRAGMENT_SHADER
+        program = keep(
+            ctx.program(vertex_shader=warp_vertex_shader(reconstruction, object_count), geometry_shader=geometry, fragment_shader=fragment)
         )
-        self.warp_program["client_colour"].value = 0
-        self.warp_program["client_surface"].value = 1
-        self.warp_program["client_size"].value = client_size
-        self.warp_program["server_size"].value = tuple(float(v) for v in server_size)
-        self.warp_program["max_splat"].value = self.max_splat
-        self.warp_program["splat_rounding"].value = SPLAT_ROUNDING
-        self.warp_program["background_ndc_z"].value = BACKGROUND_NDC_Z
-        self.warp_vao = keep(ctx.vertex_array(self.warp_program, []))
+        self.warp_program = program
+        settings = {
+            "client_colour": 0, "client_surface": 1, "coverage": 2, "client_size": client_size, "id_scale": ID_SCALE,
+            "background_ndc_z": BACKGROUND_NDC_Z, "server_size": tuple(float(v) for v in server_size),
+            "max_splat": self.max_splat, "splat_rounding": SPLAT_ROUNDING, "max_depth_step": MESH_DEPTH_STEP,
+        }  # fmt: skip
+        for name, value in settings.items():
+            if name in program:
+                program[name].value = value
+        if reconstruction == "mesh":
+            indices = keep(ctx.buffer(mesh_indices(client_size).tobytes()))
+            self._warp_vao = keep(ctx.vertex_array(program, [], index_buffer=indices, index_element_size=4))
+        elif reconstruction != "grid":
+            self._warp_vao = keep(ctx.vertex_array(program, []))
 
         self.warped = keep(ctx.texture(server_size, 4))
+        self.warped_id = keep(ctx.texture(server_size, 1, dtype="nu2"))
         self.warped_depth = keep(ctx.depth_texture(server_size))
-        for texture in (self.warped, self.warped_depth):
+        self.coverage = keep(ctx.texture(server_size, 4))
+        for texture in (self.warped, self.warped_id, self.warped_depth, self.coverage):
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self.warped_depth.compare_func = ""
-        self.warped_fbo = keep(ctx.framebuffer(color_attachments=[self.warped], depth_attachment=self.warped_depth))
+        self.warped_fbo = keep(ctx.framebuffer(color_attachments=[self.warped, self.warped_id], depth_attachment=self.warped_depth))
+        self._coverage_fbo = keep(ctx.framebuffer(color_attachments=[self.coverage]))
 
         self.output = keep(ctx.texture(server_size, 4))
         self.output_fbo = keep(ctx.framebuffer(color_attachments=[self.output]))
-        self.fill_program = keep(ctx.program(vertex_shader=FULLSCREEN_VERTEX_SHADER, fragment_shader=FILL_FRAGMENT_SHADER))
-        self.fill_program["warped"].value = 0
-        self.fill_program["warped_depth"].value = 1
-        self.fill_program["max_steps"].value = int(np.ceil(FILL_SEARCH_FRACTION * max(server_size)))
-        self.fill_program["background"].value = background
-        self.fill_vao = keep(ctx.vertex_array(self.fill_program, []))
+        self._fill = keep(HoleFill(ctx, server_size, fill, background))
 
     def _keep(self, resource):
         self._resources.append(resource)
         return resource
 
-    def warp(self, targets: Sequence[ClientTarget], matrices: Sequence[np.ndarray]) -> None:
-        """Redraw the background, then warp each client view's pixels with its (objects, 4, 4) matrices."""
-        ctx = self.ctx
+    def begin(self) -> None:
+        """Redraw the background: clear the warped image (alpha 0: nothing warped yet) and its depth."""
         self.warped_fbo.use()
         self.warped_fbo.clear(*self.background, 0.0, depth=1.0)
-        ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
-        ctx.depth_func = "<"
-        for target, view_matrices in zip(targets, matrices, strict=True):
+        self.primitives = []
+
+    def warp(self, targets: Sequence[ClientTarget], matrices: Sequence[np.ndarray]) -> None:
+        """Warp each client view's pixels with its (objects, 4, 4) matrices; views after the first
+        only fill what the first left empty."""
+        ctx = self.ctx
+        self.begin()
+        for view, (target, view_matrices) in enumerate(zip(targets, matrices, strict=True)):
+            if view == 1:
+                ctx.copy_framebuffer(self.coverage, self.warped_fbo)
+            self.warped_fbo.use()
+            ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
+            ctx.depth_func = "<"
             # moderngl takes matrices column-major; numpy holds them row-major
             columns = np.asarray(view_matrices, dtype=np.float64).transpose(0, 2, 1)
             self.warp_program["warp_matrices"].write(np.ascontiguousarray(columns, dtype=np.float32).tobytes())
+            if "arbitrate" in self.warp_program:
+                self.warp_program["arbitrate"].value = view > 0
             target.colour.use(0)
             target.surface.use(1)
-            self.warp_vao.render(moderngl.POINTS, vertices=self.client_size[0] * self.client_size[1])
+            self.coverage.use(2)
+            self.primitives.append(self._draw(target))
+
+    def _draw(self, target: ClientTarget) -> int:
+        """Draw one client view's primitives; how many."""
+        pixels = self.client_size[0] * self.client_size[1]
+        if self.reconstruction == "grid":
+            if target.grid_vao is None:
+                target.grid_vao = self.ctx.vertex_array(self.warp_program, [(target.grid_buffer, "3i/i", "cell")])
+            target.grid_vao.render(moderngl.TRIANGLE_STRIP, vertices=4, instances=target.grid_count)
+            return target.grid_count
+        if self.reconstruction == "mesh":
+            self._warp_vao.render(moderngl.TRIANGLES)
+            return 2 * (self.client_size[0] - 1) * (self.client_size[1] - 1)
+        self._warp_vao.render(moderngl.POINTS, vertices=pixels)
+        return pixels
 
     def fill(self) -> None:
-        """Fill level-0 holes of the warped image into the output image (alpha 0 marks them)."""
-        self.ctx.disable(moderngl.DEPTH_TEST)
-        self.output_fbo.use()
-        self.warped.use(0)
-        self.warped_depth.use(1)
-        self.fill_vao.render(moderngl.TRIANGLES, vertices=3)
+        """Fill the level-0 holes of the warped image into the output image (alpha 0 marks them)."""
+        self._fill.fill(self.warped, self.warped_depth, self.output_fbo)
 
     def read_rgb(self) -> np.ndarray:
         """The output image, RGB uint8 (h, w, 3), row 0 at the top."""

@@ -1,7 +1,10 @@
-"""GLSL (3.3 core) of the warp renderer: the client's object-ID outputs, the per-pixel warp, the hole fill.
+"""GLSL (3.3 core) of the warp renderer's client (object-ID outputs, surface) and of the server's
+warps: point and quad splats, the pixel mesh, the adaptive grid. The hole and fill passes are in
+`rig.render.fill_shaders`.
 
 Object IDs are stored normalised in a 16-bit channel (R16), id / 65535, as the seeds store 16-bit
-IDs: a normalised format clears and renders like any colour, where an integer one would not.
+IDs: a normalised format clears and renders like any colour, where an integer one would not. A warp
+writes the colour (alpha 1: something was warped here) and the object ID of what it warped.
 """
 
 from __future__ import annotations
@@ -95,22 +98,46 @@ void main() {
 }
 """
 
-WARP_VERTEX_SHADER = """
+_WARP_HEADER = """
 #version 330
-// One vertex per client pixel, pixel (i, j) = (gl_VertexID % width, gl_VertexID / width), OpenGL
-// rows (j = 0 at the bottom). P' = M_id (x, y, z, 1) with the object's warp matrix M_id.
+// P' = M_id (x, y, z, 1): client pixel (i, j) in OpenGL rows (j = 0 at the bottom), at NDC (x, y)
+// with NDC depth z, moved by its object's warp matrix M_id.
 const int OBJECTS = %OBJECTS%;
 uniform mat4 warp_matrices[OBJECTS];
 uniform sampler2D client_colour;
 uniform sampler2D client_surface;  // (NDC depth, depth slope x, depth slope y, object id)
 uniform ivec2 client_size;
+uniform float background_ndc_z;
+
+int object_of(vec4 surface) {
+    return clamp(int(surface.w + 0.5), 0, OBJECTS - 1);
+}
+
+vec2 pixel_ndc(vec2 pixel) {
+    return pixel / vec2(client_size) * 2.0 - 1.0;
+}
+
+// The warped clip position of a client surface point at `ndc` (depth z) of object `id`.
+vec4 warped(int id, vec2 ndc, float z) {
+    vec4 p = warp_matrices[id] * vec4(ndc, z, 1.0);
+    if (id == 0) {
+        p.z = background_ndc_z * p.w;  // the background stays just inside the far plane
+    }
+    if (!(p.w > 0.0)) {
+        p = vec4(0.0, 0.0, 2.0, 1.0);  // behind the server's eye: outside the clip volume
+    }
+    return p;
+}
+"""
+
+_SPLAT_VERTEX_MAIN = """
+// One vertex per client pixel, from gl_VertexID; the splat covers the warped pixel.
 uniform vec2 server_size;
 uniform float max_splat;
 uniform float splat_rounding;
-uniform float background_ndc_z;
 
 out Splat {
-    vec4 colour;
+    vec4 colour;  // rgb, and the object id in alpha
     vec2 half_x;  // clip-space offset of half a client pixel along client x, after the warp
     vec2 half_y;
 } splat;
@@ -118,9 +145,9 @@ out Splat {
 void main() {
     ivec2 texel = ivec2(gl_VertexID % client_size.x, gl_VertexID / client_size.x);
     vec4 surface = texelFetch(client_surface, texel, 0);
-    int id = clamp(int(surface.w + 0.5), 0, OBJECTS - 1);
+    int id = object_of(surface);
     mat4 m = warp_matrices[id];
-    vec2 ndc = (vec2(texel) + 0.5) / vec2(client_size) * 2.0 - 1.0;
+    vec2 ndc = pixel_ndc(vec2(texel) + 0.5);
     vec4 p = m * vec4(ndc, surface.x, 1.0);
     // Jacobian of the warp after the homogeneous division (Smit et al. 2010, section 3.4)
     vec4 dpx = m[0] + m[2] * surface.y;
@@ -129,24 +156,53 @@ void main() {
     vec2 jy = (p.w * dpy.xy - p.xy * dpy.w) / (p.w * p.w);
     vec2 extent = (abs(jx) / float(client_size.x) + abs(jy) / float(client_size.y)) * server_size;
     gl_PointSize = clamp(ceil(max(extent.x, extent.y) - splat_rounding), 1.0, max_splat);
-    if (id == 0) {
-        p.z = background_ndc_z * p.w;  // the background stays just inside the far plane
-    }
-    if (!(p.w > 0.0)) {
-        p = vec4(0.0, 0.0, 2.0, 1.0);  // behind the server's eye: outside the clip volume
-    }
+    p = warped(id, ndc, surface.x);
     gl_Position = p;
-    splat.colour = vec4(texelFetch(client_colour, texel, 0).rgb, 1.0);
+    splat.colour = vec4(texelFetch(client_colour, texel, 0).rgb, float(id));
     splat.half_x = jx / float(client_size.x) * p.w;
     splat.half_y = jy / float(client_size.y) * p.w;
 }
 """
 
+_MESH_VERTEX_MAIN = """
+// One vertex per client pixel centre; triangles of neighbouring pixels are drawn by index.
+out Vertex {
+    vec4 colour;  // rgb, and the object id in alpha
+    float client_depth;
+} vertex;
 
-def warp_vertex_shader(object_count: int) -> str:
-    """WARP_VERTEX_SHADER for a scene of `object_count` objects (IDs 0 to object_count - 1)."""
-    return WARP_VERTEX_SHADER.replace("%OBJECTS%", str(int(object_count)))
+void main() {
+    ivec2 texel = ivec2(gl_VertexID % client_size.x, gl_VertexID / client_size.x);
+    vec4 surface = texelFetch(client_surface, texel, 0);
+    int id = object_of(surface);
+    gl_Position = warped(id, pixel_ndc(vec2(texel) + 0.5), surface.x);
+    vertex.colour = vec4(texelFetch(client_colour, texel, 0).rgb, float(id));
+    vertex.client_depth = surface.x;
+}
+"""
 
+_GRID_VERTEX_MAIN = """
+// One instance per grid cell (x, y, side in client pixels), drawn as a 4-vertex strip. A cell is a
+// flat patch of one object: each corner's depth follows the plane of the cell's pixel beside it.
+in ivec3 cell;
+out vec2 client_pixel;
+flat out ivec4 cell_bounds;
+flat out float object_id;
+
+void main() {
+    ivec2 corner = ivec2(gl_VertexID & 1, gl_VertexID >> 1);
+    ivec2 inside = cell.xy + corner * (cell.z - 1);
+    vec4 surface = texelFetch(client_surface, inside, 0);
+    int id = object_of(texelFetch(client_surface, cell.xy, 0));
+    vec2 offset = (vec2(corner) - 0.5) * 2.0 / vec2(client_size);
+    float z = surface.x + dot(surface.yz, offset);
+    vec2 pixel = vec2(cell.xy + corner * cell.z);
+    gl_Position = warped(id, pixel_ndc(pixel), z);
+    client_pixel = pixel;
+    cell_bounds = ivec4(cell.xy, cell.xy + cell.z - 1);
+    object_id = float(id);
+}
+"""
 
 WARP_QUAD_GEOMETRY_SHADER = """
 #version 330
@@ -178,18 +234,103 @@ void main() {
 }
 """
 
-WARP_FRAGMENT_SHADER = """
+WARP_MESH_GEOMETRY_SHADER = """
+#version 330
+// Mesh reconstruction (section 4.1; Mark and McMillan's connected pixel mesh): a triangle of three
+// neighbouring client pixels is drawn only where they show one surface: the same object, client
+// depths within max_depth_step of each other. Others would stretch a rubber sheet across a
+// silhouette; they are dropped and leave a hole for the fill.
+layout(triangles) in;
+layout(triangle_strip, max_vertices = 3) out;
+uniform float max_depth_step;
+in Vertex {
+    vec4 colour;
+    float client_depth;
+} vertex[];
+out Splat {
+    vec4 colour;
+    vec2 half_x;
+    vec2 half_y;
+} splat;
+void main() {
+    float id = vertex[0].colour.a;
+    if (vertex[1].colour.a != id || vertex[2].colour.a != id) {
+        return;
+    }
+    float lo = min(vertex[0].client_depth, min(vertex[1].client_depth, vertex[2].client_depth));
+    float hi = max(vertex[0].client_depth, max(vertex[1].client_depth, vertex[2].client_depth));
+    if (hi - lo > max_depth_step) {
+        return;
+    }
+    for (int i = 0; i < 3; ++i) {
+        gl_Position = gl_in[i].gl_Position;
+        splat.colour = vertex[i].colour;
+        splat.half_x = vec2(0.0);
+        splat.half_y = vec2(0.0);
+        EmitVertex();
+    }
+    EndPrimitive();
+}
+"""
+
+_COVERAGE_TEST = """
+uniform float id_scale;
+uniform sampler2D coverage;  // a first view's warp: alpha 1 where it covered the pixel
+uniform bool arbitrate;      // true: this view may only fill the first view's holes
+layout(location = 0) out vec4 f_colour;  // alpha 1: something warped here
+layout(location = 1) out float f_id;
+
+void write(vec3 colour, float id) {
+    if (arbitrate && texelFetch(coverage, ivec2(gl_FragCoord.xy), 0).a > 0.5) {
+        discard;
+    }
+    f_colour = vec4(colour, 1.0);
+    f_id = floor(id + 0.5) / id_scale;
+}
+"""
+
+WARP_FRAGMENT_SHADER = (
+    """
 #version 330
 in Splat {
     vec4 colour;
     vec2 half_x;
     vec2 half_y;
 } splat;
-out vec4 f_colour;  // alpha 1: something warped here
+"""
+    + _COVERAGE_TEST
+    + """
 void main() {
-    f_colour = splat.colour;
+    write(splat.colour.rgb, splat.colour.a);
 }
 """
+)
+
+GRID_FRAGMENT_SHADER = (
+    """
+#version 330
+// A grid cell's colour: the client texel under the fragment, nearest, never outside the cell.
+uniform sampler2D client_colour;
+in vec2 client_pixel;
+flat in ivec4 cell_bounds;
+flat in float object_id;
+"""
+    + _COVERAGE_TEST
+    + """
+void main() {
+    ivec2 texel = clamp(ivec2(floor(client_pixel)), cell_bounds.xy, cell_bounds.zw);
+    write(texelFetch(client_colour, texel, 0).rgb, object_id);
+}
+"""
+)
+
+
+def warp_vertex_shader(reconstruction: str, object_count: int) -> str:
+    """The warp's vertex shader for a reconstruction ("point", "quad", "mesh", "grid") and a scene
+    of `object_count` objects (IDs 0 to object_count - 1)."""
+    main = {"point": _SPLAT_VERTEX_MAIN, "quad": _SPLAT_VERTEX_MAIN, "mesh": _MESH_VERTEX_MAIN, "grid": _GRID_VERTEX_MAIN}[reconstruction]
+    return _WARP_HEADER.replace("%OBJECTS%", str(int(object_count))) + main
+
 
 FULLSCREEN_VERTEX_SHADER = """
 #version 330
@@ -197,49 +338,5 @@ FULLSCREEN_VERTEX_SHADER = """
 void main() {
     vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
     gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
-}
-"""
-
-FILL_FRAGMENT_SHADER = """
-#version 330
-// A level-0 hole (nothing warped here, alpha 0) shows what lay behind what moved: from the first
-// covered pixel in each of 8 directions (up to max_steps away) it takes the farthest one's colour.
-// Covered pixels pass through; alpha stays the hole mask.
-uniform sampler2D warped;
-uniform sampler2D warped_depth;
-uniform int max_steps;
-uniform vec3 background;
-out vec4 f_colour;
-const ivec2 DIRECTIONS[8] = ivec2[8](
-    ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
-    ivec2(1, 1), ivec2(-1, 1), ivec2(1, -1), ivec2(-1, -1));
-void main() {
-    ivec2 texel = ivec2(gl_FragCoord.xy);
-    vec4 c = texelFetch(warped, texel, 0);
-    if (c.a > 0.5) {
-        f_colour = c;
-        return;
-    }
-    ivec2 size = textureSize(warped, 0);
-    float farthest = -1.0;
-    vec3 fill = background;
-    for (int d = 0; d < 8; ++d) {
-        for (int step = 1; step <= max_steps; ++step) {
-            ivec2 n = texel + DIRECTIONS[d] * step;
-            if (any(lessThan(n, ivec2(0))) || any(greaterThanEqual(n, size))) {
-                break;
-            }
-            vec4 v = texelFetch(warped, n, 0);
-            if (v.a > 0.5) {
-                float depth = texelFetch(warped_depth, n, 0).r;
-                if (depth > farthest) {
-                    farthest = depth;
-                    fill = v.rgb;
-                }
-                break;
-            }
-        }
-    }
-    f_colour = vec4(fill, 0.0);
 }
 """

@@ -17,7 +17,7 @@ from rig.clock import VirtualClock
 from rig.devices.registry import DeviceContext, make_device
 from rig.errors import RigError
 from rig.render import RenderSetup, make_renderer
-from rig.session import RUN_FILES, RunRecord, Session, SessionParts, cost_model, timing_for
+from rig.session import RUN_FILES, PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
 from rig.session.session import Progress
 from rig.sim.board import BOARD_FOLDER, remove_recording
 from rig.sim.config import SimulationConfig
@@ -44,11 +44,32 @@ class SimulationResult:
             "video": str(self.video_path),
             "latency_ms": truth.latency_ms,
             "display_frame_delay_ms": {"mean": truth.display_frame_delay_ms.mean, "sd": truth.display_frame_delay_ms.sd},
+            "refreshes": {"shown": truth.refreshes.shown, "missed": truth.refreshes.missed},
+            "app_frame_cost": truth.app_frame_cost,
+            "display_frame_cost": truth.display_frame_cost,
+            "photon_target": {"mode": truth.config.photon_target, "persistence": truth.config.persistence},
             "frames": truth.frames,
             "camera_fps": truth.camera_fps,
             "led_roi": truth.led_roi,
             "sphere_roi": truth.sphere_roi,
         }
+
+    def cost_line(self) -> str:
+        """What the run's renderer cost on the clock and how many refreshes it missed, in one line."""
+        truth = self.truth
+        parts = [f"application frame {_cost_text(truth.app_frame_cost)}"]
+        if truth.display_frame_cost is not None:
+            parts.append(f"composed image {_cost_text(truth.display_frame_cost)}")
+        refreshes = truth.refreshes
+        return f"costs: {', '.join(parts)}; {refreshes.missed} of {refreshes.shown} refreshes missed (repeated the last image)"
+
+
+def _cost_text(cost: dict[str, Any]) -> str:
+    if cost["source"] == "modelled":
+        return f"{cost['ms']:g} ms (modelled)"
+    if not cost["frames"]:
+        return "measured (none drawn)"
+    return f"measured, median {cost['median_ms']:.1f} ms, largest {cost['max_ms']:.1f} ms"
 
 
 def _prepare(out_dir: Path, overwrite: bool) -> None:
@@ -81,7 +102,7 @@ def simulate(
     camera = make_device("camera", "sim", context)
     renderer = make_renderer(config.renderer)
     board = world.board(out_dir / BOARD_FOLDER)
-    timing = timing_for(renderer, config.warp_ms)
+    timing = timing_for(renderer, cost_model(config.warp_ms))
     setup = RenderSetup(
         width=config.display.width,
         height=config.display.height,
@@ -91,6 +112,7 @@ def simulate(
         wait_for_gpu=config.app_frame_ms is None,
         seed=config.seed,
     )
+    app_cost = cost_model(config.app_frame_ms)
     parts = SessionParts(
         clock=VirtualClock(world.t_begin),
         tracker=make_device("tracker", "sim", context),
@@ -98,10 +120,11 @@ def simulate(
         renderer=renderer,
         render_setup=setup,
         timing=timing,
-        app_cost=cost_model(config.app_frame_ms),
+        app_cost=app_cost,
         display=display,
         camera=camera,
         instruments=[board] if board is not None else [],
+        target=PhotonTarget(config.photon_target, config.persistence),
     )
     _prepare(out_dir, overwrite)
     with RunRecord(out_dir, (camera.fps, camera.width, camera.height), overwrite=overwrite) as record:
@@ -114,7 +137,7 @@ def simulate(
         camera_span=(0.0, float(camera.frame_times[-1] + config.camera.exposure)),
         frames=len(camera.frame_times),
         rois=(list(world.layout.led_roi), list(world.layout.sphere_roi)),
-        display_frame_cost=timing.display_frame_cost(),
+        costs=(app_cost.describe(log.app_costs_s), timing.display_frame_cost()),
         board=board.truth() if board is not None else None,
     )
     truth.write(out_dir / TRUTH_FILE)

@@ -10,11 +10,13 @@ from rig.session.record import RUN_FILES, RunRecord
 from rig.session.session import Session, SessionLog, SessionParts, ShownImage
 from rig.session.timing import (
     DEFAULT_SERVER_MS,
+    PHOTON_TARGETS,
     CompositeEveryRefresh,
     CostModel,
     MeasuredCost,
     ModelledCost,
     OneImagePerAppFrame,
+    PhotonTarget,
     TimingPolicy,
     cost_model,
     timing_for,
@@ -22,12 +24,14 @@ from rig.session.timing import (
 
 __all__ = [
     "DEFAULT_SERVER_MS",
+    "PHOTON_TARGETS",
     "RUN_FILES",
     "CompositeEveryRefresh",
     "CostModel",
     "MeasuredCost",
     "ModelledCost",
     "OneImagePerAppFrame",
+    "PhotonTarget",
     "RunRecord",
     "Session",
     "SessionLog",

@@ -5,7 +5,9 @@
   came from, when it finished, the photon time it predicted for, the newest sample behind it, and
   the position drawn;
 * `display_frames.csv` every refresh that shows an image: which image, the row it lights, its
-  photon time, the newest sample behind it, the sensor-to-photon delay, and the x drawn;
+  photon time, the newest sample behind it, the sensor-to-photon delay, the x drawn, whether the
+  refresh missed (the display repeats the previous refresh's image: the renderer had no new one
+  ready), and what the work that made the image cost on the clock and where that figure came from;
 * `video.avi` the camera's frames, where the run has a camera it records itself.
 """
 
@@ -25,7 +27,10 @@ RUN_FILES = (VIDEO_FILE, TRACKER_FILE, APP_FRAMES_FILE, DISPLAY_FRAMES_FILE)
 APP_FRAME_COLUMNS = (
     "index", "t_start", "cost_s", "cost_source", "t_finish", "t_photon_target", "t_sensor_newest", "x", "y", "z",
 )  # fmt: skip
-DISPLAY_FRAME_COLUMNS = ("refresh", "t_vblank", "image", "row_fraction", "t_photon", "t_sensor_newest", "delay_ms", "x")
+DISPLAY_FRAME_COLUMNS = (
+    "refresh", "t_vblank", "image", "row_fraction", "t_photon", "t_sensor_newest", "delay_ms", "x",
+    "missed", "image_cost_s", "cost_source",
+)  # fmt: skip
 
 
 class RunRecord:

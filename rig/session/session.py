@@ -3,9 +3,11 @@
 The session handles events in time order against the devices' protocols
 (`rig.devices.protocols`), whatever implements them: tracker samples reach the predictor (and
 `tracker.csv`) once they have arrived; application frames start when the timing policy says the
-renderer is ready, and ask the predictor for the pose at the photon time they expect; at every
-refresh the renderer's own work happens (`rig.session.timing`), the refresh is logged, the camera's
-finished frames are recorded, and the instruments beside the rig record up to the present.
+renderer is ready, and ask the predictor for the pose at the time the photon target says
+(`rig.session.timing.PhotonTarget`) of the refresh they expect to reach; at every refresh the
+renderer's own work happens (`rig.session.timing`), the refresh is logged (with whether it missed,
+repeating the last image), the camera's finished frames are recorded, and the instruments beside the
+rig record up to the present.
 
 On a virtual clock that is a simulation, deterministic for a seed; on a monotonic clock, waiting
 means sleeping until an event is due. Every file is written as the run goes (`rig.session.record`),
@@ -28,33 +30,38 @@ from rig.errors import RigError
 from rig.records import CsvRecord
 from rig.render.protocol import AppFrameRequest, Renderer, RenderSetup
 from rig.session.record import RunRecord
-from rig.session.timing import CostModel, TimingPolicy
+from rig.session.timing import CostModel, PhotonTarget, TimingPolicy
 
 Progress = Callable[[float, float], None]
 
 
 @dataclass(frozen=True)
 class ShownImage:
-    """What one image on the display is: the x drawn, the display row it lights, and the newest
-    sensor time behind it."""
+    """What one image on the display is: the x drawn, the display row it lights, the newest sensor
+    time behind it, and what the work that made it cost on the clock (and where that figure came from)."""
 
     x_m: float
     row_fraction: float
     t_sensor_newest: float
+    cost_s: float
+    cost_source: str
 
 
 @dataclass
 class SessionLog:
-    """What a run showed: every image by id, and the id each refresh showed (NO_IMAGE: dark)."""
+    """What a run showed: every image by id, the id each refresh showed (NO_IMAGE: dark), and what
+    the application frames cost."""
 
     shown: dict[int, ShownImage] = field(default_factory=dict)
     content: list[int] = field(default_factory=list)
+    app_costs_s: list[float] = field(default_factory=list)
+    """What each application frame cost on the clock."""
 
 
 @dataclass
 class SessionParts:
     """What a run is made of: the clock, the devices, the predictor, and the renderer with its
-    setup, timing policy and application-frame cost model."""
+    setup, timing policy, application-frame cost model and photon target."""
 
     clock: Clock
     tracker: TrackerSource
@@ -66,6 +73,7 @@ class SessionParts:
     display: Display
     camera: Camera | None = None
     instruments: Sequence[Instrument] = ()
+    target: PhotonTarget = PhotonTarget()
 
 
 class SampleFeed:
@@ -128,13 +136,22 @@ class Session:
             self._loop()
         return self.log
 
-    def show(self, image: np.ndarray | None, t_ready: float, image_id: int, position: np.ndarray) -> int:
-        """Hand the display an image drawn at `position`, ready at `t_ready`; the refresh it appears at."""
+    def show(
+        self, image: np.ndarray | None, t_ready: float, image_id: int, position: np.ndarray, cost_s: float, cost_source: str
+    ) -> int:
+        """Hand the display an image drawn at `position`, ready at `t_ready` after work that cost
+        `cost_s` (`cost_source`: measured or modelled); the refresh it appears at."""
         if image is None:
             raise RigError(f"renderer {self.renderer.name!r} returned no image for a frame it was to display")
         self.row_estimate = self.parts.render_setup.row_fraction(position)
-        self.log.shown[image_id] = ShownImage(float(position[0]), self.row_estimate, self.feed.newest_sensor_time)
+        self.log.shown[image_id] = ShownImage(
+            float(position[0]), self.row_estimate, self.feed.newest_sensor_time, float(cost_s), cost_source
+        )
         return self.display.present(image, t_ready, image_id)
+
+    def photon_target(self, k: int) -> float:
+        """The instant refresh k's pose is predicted for, at the row the sphere was last drawn at."""
+        return self.parts.target.time(self.display, k, self.row_estimate)
 
     def _loop(self) -> None:
         clock, display, timing = self.parts.clock, self.display, self.parts.timing
@@ -167,30 +184,33 @@ class Session:
         self.parts.clock.wait_until(start)
         self.feed.deliver()
         display = self.display
-        present_estimate = display.refresh_after(start + self._last_cost)
-        t_photon = display.photon_time(present_estimate, self.row_estimate)
+        t_photon = self.photon_target(display.refresh_after(start + self._last_cost))
         result = self.renderer.render_app_frame(AppFrameRequest(index, start, t_photon, self.feed.predict))
         cost = self.parts.app_cost.charge(result.cost_s)
         finish = start + cost
         self._last_cost = cost
+        self.log.app_costs_s.append(cost)
         position = result.pose.position
         self.record.app_frames.write(
             [index, start, cost, self.parts.app_cost.source, finish, t_photon, self.feed.newest_sensor_time, *position.tolist()]
         )
         self._app_frames += 1
-        return self.parts.timing.app_frame_done(self, index, result, finish)
+        return self.parts.timing.app_frame_done(self, index, result, finish, cost)
 
     def _log_refresh(self, k: int) -> None:
+        """Log refresh k; it missed if it repeats the previous refresh's image."""
         image_id = self.display.shown(k)
+        missed = bool(self.log.content) and self.log.content[-1] == image_id
         self.log.content.append(image_id)
         if image_id == NO_IMAGE:
             return
         shown = self.log.shown[image_id]
         t_photon = self.display.photon_time(k, shown.row_fraction)
         delay_ms = (t_photon - shown.t_sensor_newest) * 1e3
-        self.record.display_frames.write(
-            [k, self.display.vblank_time(k), image_id, shown.row_fraction, t_photon, shown.t_sensor_newest, delay_ms, shown.x_m]
-        )
+        self.record.display_frames.write([
+            k, self.display.vblank_time(k), image_id, shown.row_fraction, t_photon, shown.t_sensor_newest, delay_ms, shown.x_m,
+            int(missed), shown.cost_s, shown.cost_source,
+        ])  # fmt: skip
 
     def _record_camera(self) -> None:
         if self.parts.camera is None or self.record.video is None:

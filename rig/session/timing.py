@@ -1,29 +1,41 @@
-"""How a renderer's work meets the display: its timing policy, and what its work costs on the clock.
+"""How a renderer's work meets the display: its timing policy, what its work costs on the clock,
+and the time its poses are predicted for.
 
 A **cost model** says what a piece of the renderer's work costs on the rig clock:
 
 * `ModelledCost(ms)`: a configured number, the same every frame (deterministic, labelled
   "modelled" in the run's logs and truth);
-* `MeasuredCost()`: what the renderer reports its work took on this machine ("measured").
+* `MeasuredCost()`: what the renderer reports its work took on this machine ("measured"); on a
+  machine with a GPU that is the GPU's time, on software OpenGL the CPU's.
 
 A **timing policy** says when the renderer works and when its images reach the display:
 
 * `OneImagePerAppFrame` (a direct renderer): each application frame is an image. It is handed to
   the display when finished and appears at the first refresh after that (at most one new image a
   refresh); the next application frame starts at the blank that shows it, as a double-buffered
-  renderer under vsync does.
+  renderer under vsync does. A frame that takes longer than a refresh leaves the display
+  repeating the previous image.
 * `CompositeEveryRefresh` (a warp renderer): application frames run back to back at their own
-  pace; at every refresh the renderer composes a new image from the newest finished one, starting
-  the server's cost before the blank so that the image is ready for it.
+  pace; a server composes images from the newest finished one. It aims each composition at a
+  refresh and starts it that refresh's expected cost (plus `SWAP_MARGIN_S`) before its blank. A
+  modelled cost is known in advance; a measured one is expected to be the largest of the last
+  `EXPECTED_COST_WINDOW` measured. A composition that overruns its blank misses it, and one that
+  costs more than a refresh cannot be aimed at every refresh: either way the display repeats the
+  last image at the refreshes the server missed.
 
-The session (`rig.session.session`) is handed one of each and never asks what kind of renderer it
+A **photon target** (`PhotonTarget`) says which instant a display frame's pose is predicted for:
+the moment the frame's scan-out reaches the tracked object's row, or the middle of the interval
+during which that row then emits it (scan-out plus half the persistence).
+
+The session (`rig.session.session`) is handed one policy and never asks what kind of renderer it
 drives.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Sequence
 
 import numpy as np
 
@@ -33,6 +45,24 @@ from rig.render.protocol import AppFrameResult, DisplayFrameRequest, Renderer
 if TYPE_CHECKING:
     from rig.devices.protocols import Display
     from rig.session.session import Session
+
+EXPECTED_COST_WINDOW = 8
+"""A measured server cost is expected to be the largest of this many latest measurements."""
+SWAP_MARGIN_S = 2e-4
+"""A composition aims to be ready this long before its blank: a swap at the blank misses it."""
+PHOTON_TARGETS = ("photons", "scanout")
+
+
+def _cost_figures(charged_s: Sequence[float]) -> dict[str, Any]:
+    costs_ms = np.asarray(charged_s, dtype=np.float64) * 1e3
+    if not len(costs_ms):
+        return {"frames": 0}
+    return {
+        "frames": int(len(costs_ms)),
+        "median_ms": float(np.median(costs_ms)),
+        "p95_ms": float(np.percentile(costs_ms, 95)),
+        "max_ms": float(costs_ms.max()),
+    }
 
 
 @dataclass(frozen=True)
@@ -51,8 +81,12 @@ class ModelledCost:
         return self.ms / 1e3
 
     def expected_s(self, fallback_s: float) -> float:
-        """What the next piece of work is expected to cost before any has been done."""
+        """What the next piece of work is expected to cost, given what recent work suggests."""
         return self.ms / 1e3
+
+    def describe(self, charged_s: Sequence[float]) -> dict[str, Any]:
+        """The cost as the run's truth records it."""
+        return {"ms": self.ms, "source": self.source}
 
 
 @dataclass(frozen=True)
@@ -67,6 +101,9 @@ class MeasuredCost:
     def expected_s(self, fallback_s: float) -> float:
         return fallback_s
 
+    def describe(self, charged_s: Sequence[float]) -> dict[str, Any]:
+        return {"source": self.source, **_cost_figures(charged_s)}
+
 
 CostModel = ModelledCost | MeasuredCost
 
@@ -76,20 +113,49 @@ def cost_model(ms: float | None) -> CostModel:
     return MeasuredCost() if ms is None else ModelledCost(ms)
 
 
+@dataclass(frozen=True)
+class PhotonTarget:
+    """The instant a display frame's pose is predicted for, at the tracked object's display row.
+
+    mode "scanout": when the frame's scan-out reaches the row; "photons": the middle of the interval
+    the row then emits the frame, scan-out plus half the persistence. `persistence` is the share of
+    a refresh period a row emits each frame: 1 for a sample-and-hold display (the simulated one),
+    less for a low-persistence (strobed) panel.
+    """
+
+    mode: str = "photons"
+    persistence: float = 1.0
+
+    def __post_init__(self) -> None:
+        if self.mode not in PHOTON_TARGETS:
+            raise ConfigError(f"the photon target must be one of {', '.join(PHOTON_TARGETS)}, got {self.mode!r}")
+        if not (math.isfinite(self.persistence) and 0.0 < self.persistence <= 1.0):
+            raise ConfigError(f"persistence is the share of a refresh a row emits, in (0, 1], got {self.persistence!r}")
+
+    def time(self, display: Display, k: int, row_fraction: float) -> float:
+        """The instant refresh k's pose is predicted for, for an object at `row_fraction`."""
+        t = display.photon_time(k, row_fraction)
+        if self.mode == "photons":
+            t += 0.5 * self.persistence / display.refresh_hz
+        return t
+
+
 class TimingPolicy(Protocol):
     """When the renderer works and when its images reach the display."""
 
     def refresh_start(self, display: Display, k: int) -> float:
-        """When refresh k's own work starts (application frames starting by then come first)."""
+        """When refresh k's own work starts (application frames starting by then come first);
+        no later than the start of any work the policy has planned for a later refresh."""
 
-    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float) -> float:
-        """Take application frame `index`, finished at `finish`; when the next one starts."""
+    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float, cost_s: float) -> float:
+        """Take application frame `index`, finished at `finish` after `cost_s` on the clock; when
+        the next one starts."""
 
     def at_refresh(self, session: Session, k: int, t_start: float) -> None:
         """Refresh k's own work, at `t_start`."""
 
     def display_frame_cost(self) -> dict[str, Any] | None:
-        """The cost charged per refresh, for the run's truth; None when refreshes cost nothing."""
+        """The cost charged per composed image, for the run's truth; None when refreshes cost nothing."""
 
 
 class OneImagePerAppFrame:
@@ -98,8 +164,8 @@ class OneImagePerAppFrame:
     def refresh_start(self, display: Display, k: int) -> float:
         return display.vblank_time(k)
 
-    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float) -> float:
-        refresh = session.show(result.image, finish, index, result.pose.position)
+    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float, cost_s: float) -> float:
+        refresh = session.show(result.image, finish, index, result.pose.position, cost_s, session.parts.app_cost.source)
         return session.display.vblank_time(refresh)
 
     def at_refresh(self, session: Session, k: int, t_start: float) -> None:
@@ -111,46 +177,76 @@ class OneImagePerAppFrame:
 
 @dataclass
 class CompositeEveryRefresh:
-    """A warp renderer's timing; see the module docstring. The server's cost is modelled: it must be
-    known before the blank to start in time."""
+    """A warp renderer's timing; see the module docstring."""
 
-    server_cost: ModelledCost
+    server_cost: CostModel
     _finished: list[float] = field(default_factory=list)
+    _charged: list[float] = field(default_factory=list)
+    _target: int = 0
+    _start: float | None = None
+    """When the composition for refresh `_target` starts (None: not planned yet)."""
+
+    def _expected_s(self, display: Display) -> float:
+        recent = self._charged[-EXPECTED_COST_WINDOW:]
+        return self.server_cost.expected_s(max(recent) if recent else 1.0 / display.refresh_hz)
+
+    def _plan(self, display: Display, k: int) -> float:
+        if self._start is None:
+            self._start = display.vblank_time(k) - self._expected_s(display) - SWAP_MARGIN_S
+        return self._start
 
     def refresh_start(self, display: Display, k: int) -> float:
-        return display.vblank_time(k) - self.server_cost.ms / 1e3
+        start = self._plan(display, self._target)
+        return start if k == self._target else min(display.vblank_time(k), start)
 
-    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float) -> float:
+    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float, cost_s: float) -> float:
         self._finished.append(finish)
         return finish
 
     def at_refresh(self, session: Session, k: int, t_start: float) -> None:
-        """Compose from the newest application frame finished by now; before the first one is, the
-        server has nothing to warp (nor, maybe, a tracker sample to warp with): the display stays dark."""
+        """Compose for refresh k if the server aimed at it, from the newest application frame
+        finished by now; before the first one is, the server has nothing to warp (nor, maybe, a
+        tracker sample to warp with): the display stays dark."""
+        if k != self._target:
+            return
+        display = session.display
         ready = int(np.searchsorted(self._finished, t_start, side="right")) - 1
         if ready < 0:
+            self._aim_after(display, k, t_start)
             return
         session.feed.deliver()
-        display = session.display
-        t_photon = display.photon_time(k, session.row_estimate)
         result = session.renderer.render_display_frame(
-            DisplayFrameRequest(k, display.vblank_time(k), t_photon, session.feed.predict, ready)
+            DisplayFrameRequest(k, display.vblank_time(k), session.photon_target(k), session.feed.predict, ready)
         )
-        session.show(result.image, t_start, k, result.pose.position)
+        cost = self.server_cost.charge(result.cost_s)
+        self._charged.append(cost)
+        finish = t_start + cost
+        session.show(result.image, finish, k, result.pose.position, cost, self.server_cost.source)
+        self._aim_after(display, k, finish)
+
+    def _aim_after(self, display: Display, k: int, free_at: float) -> None:
+        """Aim the next composition at the first refresh after k it can be ready for, starting
+        once the server is free at `free_at`."""
+        lead = self._expected_s(display) + SWAP_MARGIN_S
+        target = max(k + 1, display.refresh_after(free_at + lead))
+        if display.vblank_time(target - 1) - lead >= free_at and target - 1 > k:
+            target -= 1
+        self._target = target
+        self._start = max(display.vblank_time(target) - lead, free_at)
 
     def display_frame_cost(self) -> dict[str, Any] | None:
-        return {"ms": self.server_cost.ms, "source": self.server_cost.source}
+        return self.server_cost.describe(self._charged)
 
 
 DEFAULT_SERVER_MS = 2.0
-"""Modelled server cost per refresh of a renderer that composes at every refresh, where a run gives
-none: a GPU's point warp of a display-sized image, well inside a refresh. Software OpenGL takes
-longer; `rig bench renderers` reports the real cost beside the modelled one."""
+"""Modelled server cost per composed image of a renderer that composes at every refresh: a GPU's
+point warp of a display-sized image, well inside a refresh. Software OpenGL takes longer, which a
+run with measured costs shows as missed refreshes."""
 
 
-def timing_for(renderer: Renderer, server_ms: float | None) -> TimingPolicy:
-    """The timing policy a renderer's kind asks for; `server_ms` models a compositing server's cost
-    per refresh (DEFAULT_SERVER_MS when None)."""
+def timing_for(renderer: Renderer, server_cost: CostModel) -> TimingPolicy:
+    """The timing policy a renderer's kind asks for; `server_cost` is what a compositing server's
+    work costs per image."""
     if renderer.per_display_frame:
-        return CompositeEveryRefresh(ModelledCost(server_ms if server_ms is not None else DEFAULT_SERVER_MS))
+        return CompositeEveryRefresh(server_cost)
     return OneImagePerAppFrame()

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from rig.errors import ConfigError
+from rig.session.timing import DEFAULT_SERVER_MS, PhotonTarget
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -18,7 +19,14 @@ from rig.sim.tracker import TrackerConfig
 
 @dataclass(frozen=True)
 class SimulationConfig:
-    """Everything that defines a simulated run; the same config and seed give the same video."""
+    """Everything that defines a simulated run; the same config and seed give the same video
+    (with modelled costs: a measured cost is this machine's).
+
+    app_frame_ms, warp_ms: what an application frame and a composed display frame cost on the
+    virtual clock, in ms (modelled), or None for what they take on this machine (measured).
+    photon_target, persistence: the instant each frame's pose is predicted for
+    (`rig.session.PhotonTarget`).
+    """
 
     duration_s: float = 10.0
     seed: int = 0
@@ -31,7 +39,9 @@ class SimulationConfig:
     predictor_params: dict[str, Any] = field(default_factory=dict)
     scene_triangles: int = 0
     app_frame_ms: float | None = 5.0
-    warp_ms: float | None = None
+    warp_ms: float | None = DEFAULT_SERVER_MS
+    photon_target: str = "photons"
+    persistence: float = 1.0
     warmup_s: float = 0.5
     board: SimulatedBoardConfig | None = None
 
@@ -44,6 +54,7 @@ class SimulationConfig:
             raise ConfigError(f"application frame cost must be a positive number of ms, got {self.app_frame_ms}")
         if self.warp_ms is not None and not (np.isfinite(self.warp_ms) and self.warp_ms > 0):
             raise ConfigError(f"warp cost must be a positive number of ms, got {self.warp_ms}")
+        PhotonTarget(self.photon_target, self.persistence)
         if self.warmup_s < 0:
             raise ConfigError(f"warm-up must be >= 0 s, got {self.warmup_s}")
         release = self.pendulum.release_s

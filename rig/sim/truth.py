@@ -83,12 +83,24 @@ class DelayStats:
 
 
 @dataclass(frozen=True)
+class RefreshCount:
+    """Refreshes within the filmed span that showed an image, and how many of them missed (repeated
+    the previous refresh's image because the renderer had no new one ready)."""
+
+    shown: int
+    missed: int
+
+
+@dataclass(frozen=True)
 class Truth:
     """What a simulated run knows to be true, as written to truth.json.
 
     latency_ms: the true effective latency (see the module docstring); display_frame_delay_ms: the
-    sensor-to-photon delay of each display frame; display_frame_cost: the cost charged per refresh
-    by a renderer composing at every refresh (None for one that does not); led_roi, sphere_roi:
+    sensor-to-photon delay of each display frame (a repeated image's delay grows with each repeat);
+    refreshes: how many refreshes showed an image and how many missed; app_frame_cost: what the
+    clock charged per application frame; display_frame_cost: what it charged per composed image, for
+    a renderer composing at refreshes (None for one that does not); each cost says whether it was
+    "modelled" (its ms) or "measured" (median, 95th percentile and largest ms); led_roi, sphere_roi:
     where the LED and the sphere swing in the video; board: the rig board's clock offset, the
     pendulum's release and the blink (None without a board); config: the run's whole configuration.
     """
@@ -96,9 +108,11 @@ class Truth:
     latency_ms: float
     latency_definition: str
     display_frame_delay_ms: DelayStats
+    refreshes: RefreshCount
     camera_fps: float
     frames: int
     period_s: float
+    app_frame_cost: dict[str, Any]
     display_frame_cost: dict[str, Any] | None
     led_roi: list[int]
     sphere_roi: list[int]
@@ -124,16 +138,20 @@ def run_truth(
     camera_span: tuple[float, float],
     frames: int,
     rois: tuple[list[int], list[int]],
-    display_frame_cost: dict[str, Any] | None,
+    costs: tuple[dict[str, Any], dict[str, Any] | None],
     board: dict[str, Any] | None,
 ) -> Truth:
-    """The truth of a finished run: what its display showed (`log`), against the pendulum's motion."""
+    """The truth of a finished run: what its display showed (`log`), against the pendulum's motion;
+    `costs` are the application frames' and the composed display frames' (`Truth`)."""
     rows = [(k, log.shown[i]) for k, i in enumerate(log.content) if i != NO_IMAGE]
+    content = np.array(log.content)
+    repeated = np.r_[False, (content[1:] == content[:-1]) & (content[1:] != NO_IMAGE)]
     refreshes = np.array([k for k, _ in rows])
     switch_times = display.vblank_time(refreshes) + display.scanout_delay(np.array([s.row_fraction for _, s in rows]))
     x_shown = np.array([s.x_m for _, s in rows])
     newest = np.array([s.t_sensor_newest for _, s in rows])
     in_span = (switch_times >= camera_span[0]) & (switch_times <= camera_span[1])
+    missed = int(repeated[refreshes[in_span]].sum())
     delays_ms = (switch_times - newest)[in_span] * 1e3
     latency_s = effective_latency(
         switch_times,
@@ -151,10 +169,12 @@ def run_truth(
             sd=float(delays_ms.std(ddof=1)) if len(delays_ms) > 1 else 0.0,
             values=[round(float(d), 6) for d in delays_ms],
         ),
+        refreshes=RefreshCount(shown=int(in_span.sum()), missed=missed),
         camera_fps=config.camera.fps,
         frames=frames,
         period_s=pendulum.period_s,
-        display_frame_cost=display_frame_cost,
+        app_frame_cost=costs[0],
+        display_frame_cost=costs[1],
         led_roi=rois[0],
         sphere_roi=rois[1],
         board=board,

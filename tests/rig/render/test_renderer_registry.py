@@ -9,6 +9,8 @@ from predictors import Pose
 from rig.errors import ConfigError, RigError
 from rig.render import AppFrameRequest, Renderer, RenderSetup, make_renderer, renderer_names
 from rig.render.direct import DirectRenderer
+from rig.render.warp import WarpRenderer
+from rig.render.warp_options import WarpOptions
 
 TINY_RENDERER = '''
 import numpy as np
@@ -92,3 +94,67 @@ def test_built_in_name_wins_over_an_entry_point(site):
     site.install("tiny-renderer", "tiny_renderer", TINY_RENDERER, "rig.renderers", "direct = tiny_renderer:TinyRenderer")
     assert renderer_names().count("direct") == 1
     assert isinstance(make_renderer("direct"), DirectRenderer)
+
+
+OPTION_RENDERER = '''
+import numpy as np
+
+from rig.render.protocol import AppFrameResult
+
+
+class ShadeRenderer:
+    """Fills the frame with one grey level, an option."""
+
+    name = "shade"
+    per_display_frame = False
+
+    def __init__(self, level=128):
+        self.level = level
+
+    def open(self, setup):
+        self.shape = (setup.height, setup.width, 3)
+
+    def render_app_frame(self, request):
+        return AppFrameResult(0.001, request.predict(request.t_photon), np.full(self.shape, self.level, dtype=np.uint8))
+
+    def render_display_frame(self, request):
+        raise RuntimeError("shade shows application frames only")
+
+    def close(self):
+        pass
+'''
+
+
+def test_a_spec_with_options_makes_a_configured_warp_renderer():
+    renderer = make_renderer("warp:holes=2,recon=grid,views=2,fill=lowpass,spin=12.5")
+    assert isinstance(renderer, WarpRenderer)
+    assert renderer.options == WarpOptions(views=2, recon="grid", holes=2, fill="lowpass", spin=12.5)
+    assert renderer.options.spec() == "warp:views=2,recon=grid,holes=2,fill=lowpass,spin=12.5"
+    assert make_renderer(renderer.options.spec()).options == renderer.options
+    assert make_renderer("warp").options == WarpOptions() and WarpOptions().spec() == "warp"
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ("warp:wings=2", r"renderer 'warp' has no option 'wings'; its options: views, recon, holes, fill, border, untracked, spin"),
+        ("warp:holes", r"key=value separated by commas, got 'holes'"),
+        ("warp:holes=9", r"warp option holes must be one of 0, 1, 2, got 9"),
+        ("warp:recon=voxel", r"warp option recon must be one of point, quad, mesh, grid"),
+        ("direct:views=2", r"renderer 'direct' has no option 'views'; it takes no options"),
+        ("nope:views=2", r"unknown renderer 'nope'"),
+    ],
+)
+def test_bad_specs_are_config_errors_that_say_what_is_allowed(spec, message):
+    with pytest.raises(ConfigError, match=message):
+        make_renderer(spec)
+
+
+def test_a_third_party_renderer_takes_its_options_as_keyword_arguments(site):
+    site.install("shade-renderer", "shade_renderer", OPTION_RENDERER, "rig.renderers", "shade = shade_renderer:ShadeRenderer")
+    assert make_renderer("shade:level=40").level == 40 and make_renderer("shade").level == 128
+    with pytest.raises(ConfigError, match=r"renderer 'shade' has no option 'hue'; its options: level"):
+        make_renderer("shade:hue=3")
+    site.install("tiny-renderer", "tiny_renderer", TINY_RENDERER, "rig.renderers", "tiny = tiny_renderer:TinyRenderer")
+    with pytest.raises(ConfigError, match=r"renderer 'tiny' has no option 'level'; it takes no options"):
+        make_renderer("tiny:level=40")

@@ -1,4 +1,4 @@
-"""The image-error figures the warp is judged by: the seeds' blurred Lab threshold, and PSNR."""
+"""The image-error figures the warp is judged by: the seeds' blurred Lab threshold, SSIM and DSSIM, PSNR."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from rig.errors import RigError
-from rig.render.image_error import lab_error_percent, psnr_db
+from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
 
 
 def grey(value: int, size=(40, 50)) -> np.ndarray:
@@ -48,3 +48,26 @@ def test_images_must_match_in_size_and_type():
         lab_error_percent(grey(0, (10, 10)), grey(0, (10, 12)))
     with pytest.raises(RigError, match="RGB uint8"):
         psnr_db(grey(0).astype(np.float32), grey(0))
+
+
+def test_ssim_is_one_for_equal_images_and_dssim_zero():
+    image = np.random.default_rng(1).integers(0, 256, (40, 50, 3), dtype=np.uint8)
+    assert ssim(image, image) == pytest.approx(1.0, abs=1e-12)
+    assert dssim(image, image) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_ssim_of_a_uniform_shift_is_its_luminance_term():
+    """Flat images have no variance: SSIM is the luminance comparison (2 mx my + C1) / (mx^2 + my^2 + C1)."""
+    c1 = (0.01 * 255) ** 2
+    expected = (2 * 100 * 150 + c1) / (100**2 + 150**2 + c1)
+    assert ssim(grey(100), grey(150)) == pytest.approx(expected, rel=1e-9)
+    assert dssim(grey(100), grey(150)) == pytest.approx((1 - expected) / 2, rel=1e-9)
+
+
+def test_noise_lowers_ssim_more_than_a_small_brightness_change():
+    rng = np.random.default_rng(2)
+    reference = np.clip(rng.normal(128, 40, (60, 60, 3)), 0, 255).astype(np.uint8)
+    brighter = np.clip(reference.astype(int) + 5, 0, 255).astype(np.uint8)
+    noisy = np.clip(reference.astype(int) + rng.normal(0, 40, reference.shape), 0, 255).astype(np.uint8)
+    assert ssim(brighter, reference) > 0.99 > 0.8 > ssim(noisy, reference)
+    assert 0.0 < dssim(brighter, reference) < dssim(noisy, reference) <= 1.0

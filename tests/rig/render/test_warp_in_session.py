@@ -21,7 +21,7 @@ SMALL_CAMERA = CameraConfig(fps=120.0, width=320, height=240, subsamples=4)
 REFRESH_MS = 1e3 / 60.0
 
 
-def warp_run(out: Path, app_frame_ms: float, warp_ms: float | None = None):
+def warp_run(out: Path, app_frame_ms: float, warp_ms: float | None = DEFAULT_SERVER_MS):
     config = SimulationConfig(
         duration_s=1.5,
         camera=SMALL_CAMERA,

@@ -1,0 +1,256 @@
+"""The seeds' warp features on headless GL, each against the numpy reference where there is one:
+two reference views chosen by prediction, hole levels and their re-rendering, the depth-aware
+low-pass fill; and the adaptive grid's cells and the load's kd-tree, in numpy."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from predictors import Pose
+from rig.render import gl
+from rig.render.fill_shaders import LOWPASS_SEARCH_LEVELS
+from rig.render.image_error import lab_error_percent, ssim
+from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, RenderSetup
+from rig.render.warp import WarpRenderer
+from rig.render.warp_grid import GRID_TILE, grid_cells
+from rig.render.warp_holes import build_leaves, hole_blocks, leaves_hit
+from rig.render.warp_matrices import translation
+from rig.render.warp_reference import arbitrate_views, hole_levels, lowpass_fill, reference_warp
+from rig.render.warp_server import BACKGROUND_NDC_Z
+
+WIDTH, HEIGHT = 96, 72
+RADIUS = 0.06
+IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+ORTHOGRAPHIC = np.diag([1 / 0.4, 1 / 0.3, -0.5, 1.0])
+PX_PER_M = WIDTH / 0.8
+SPEED = np.array([10.0 / PX_PER_M, 0.0, 0.0])
+"""The sphere's speed in the moving scene: 10 pixels a second, from the centre."""
+
+
+def moving(t: float) -> Pose:
+    return Pose(t, SPEED * t, IDENTITY)
+
+
+def warp_once(t_display: float = 0.5, triangles: int = 3000, **options) -> tuple[WarpRenderer, np.ndarray, np.ndarray]:
+    """An open renderer whose client frame started at 0 with its photons expected at 0.5 s (a
+    second view predicted for 1 s), warped to the sphere's place at `t_display`: (renderer, image,
+    reference render). The caller closes the renderer."""
+    renderer = WarpRenderer(**options)
+    renderer.open(RenderSetup(WIDTH, HEIGHT, ORTHOGRAPHIC, RADIUS, scene_triangles=triangles, seed=3))
+    renderer.render_app_frame(AppFrameRequest(0, 0.0, 0.5, moving))
+    image = renderer.render_display_frame(DisplayFrameRequest(0, t_display, t_display, moving, 0)).image
+    return renderer, image, renderer.render_reference(moving(t_display).position)
+
+
+def figures(**options) -> dict[str, float]:
+    renderer, image, reference = warp_once(**options)
+    try:
+        return {"holes": renderer.hole_fraction(), "lab": lab_error_percent(image, reference), "ssim": ssim(image, reference),
+                "equal": float(np.all(image == reference, axis=2).mean())}  # fmt: skip
+    finally:
+        renderer.close()
+
+
+def test_the_second_view_is_drawn_where_the_predictor_says_the_frames_use_ends():
+    asked = []
+
+    def predict(t: float) -> Pose:
+        asked.append(t)
+        return moving(t)
+
+    renderer = WarpRenderer(views=2)
+    renderer.open(RenderSetup(WIDTH, HEIGHT, ORTHOGRAPHIC, RADIUS))
+    try:
+        renderer.render_app_frame(AppFrameRequest(0, t_start=1.0, t_photon=1.25, predict=predict))
+    finally:
+        renderer.close()
+    assert asked == [1.0, 1.5]
+
+
+def test_two_predicted_views_fill_the_holes_of_one_and_never_do_worse():
+    one, two = figures(), figures(views=2)
+    assert one["holes"] > 0.005 and two["holes"] < one["holes"] / 10
+    assert two["lab"] <= one["lab"] and two["ssim"] >= one["ssim"] and two["equal"] > one["equal"]
+
+
+def test_the_gl_arbitration_of_two_views_agrees_with_the_numpy_reference():
+    renderer, _, _ = warp_once(views=2)
+    try:
+        frame = renderer._frames[0]
+        matrices = renderer._matrices(frame, moving(0.5).position, None)
+        with renderer._ctx:
+            views = [
+                reference_warp(*target.read(), m, (WIDTH, HEIGHT), renderer._server.max_splat, BACKGROUND_NDC_Z)
+                for target, m in zip(frame.targets, matrices)
+            ]
+            warped, _ = renderer._server.read_warped()
+    finally:
+        renderer.close()
+    expected, _ = arbitrate_views(*views)
+    assert (views[0][0][:, :, 3] == 0).sum() > 30  # the first view alone leaves holes the second fills
+    assert np.all(warped == expected, axis=2).mean() >= 0.99
+
+
+def test_re_rendering_resolves_the_holes_a_moving_sphere_leaves():
+    """Where the sphere was, the load it hid is drawn again at the server: fewer holes for the
+    fill, and where they were resolved the image is the reference's."""
+    plain, resolved = figures(), figures(holes=1)
+    assert resolved["holes"] < plain["holes"] and resolved["equal"] > plain["equal"]
+    assert resolved["lab"] <= plain["lab"]
+    renderer, _, _ = warp_once(holes=1)
+    try:
+        stats = renderer.last_holes
+    finally:
+        renderer.close()
+    assert stats["level_0"] > 30 and 0 < stats["leaves"] and stats["triangles"] > 0
+
+
+@pytest.mark.parametrize("max_level", [1, 2])
+def test_the_gl_hole_levels_agree_with_the_numpy_reference(max_level):
+    """A spinning (untracked) load and a moving sphere give holes of every level to classify."""
+    renderer, _, _ = warp_once(t_display=0.6, holes=max_level, spin=40.0)
+    try:
+        server, finder = renderer._server, renderer._holes
+        load = renderer._load_pose(0.6)
+        object_to_clip = np.stack([
+            ORTHOGRAPHIC,
+            gl.FRONT_HALF_DEPTH @ ORTHOGRAPHIC @ translation(moving(0.6).position),
+            ORTHOGRAPHIC @ renderer._load_model(load),
+        ])  # fmt: skip
+        with renderer._ctx:
+            levels, proxy = finder.find(object_to_clip, (server.warped, server.warped_id, server.warped_depth), max_level, {1, 2})
+            w, h = WIDTH, HEIGHT
+            colour, depth = server.read_warped()
+            ids = np.rint(np.frombuffer(server.warped_id.read(), dtype=np.uint16).reshape(h, w)).astype(np.int64)
+            front = np.frombuffer(finder.proxy_depth.read(), dtype=np.float32).reshape(h, w)
+            back = np.frombuffer(finder.proxy_back_depth.read(), dtype=np.float32).reshape(h, w)
+    finally:
+        renderer.close()
+    expected = hole_levels((colour, ids, depth), (proxy, front, back), max_level, {1, 2})
+    np.testing.assert_array_equal(levels, expected)
+    assert (levels == 2).sum() > 50
+    assert max_level == 1 or (levels == 3).sum() > 0
+
+
+def test_the_gl_low_pass_fill_agrees_with_the_numpy_reference():
+    renderer, image, _ = warp_once(fill="lowpass")
+    try:
+        with renderer._ctx:
+            colour, depth = renderer._server.read_warped()
+    finally:
+        renderer.close()
+    holes = colour[:, :, 3] == 0
+    assert holes.sum() > 30
+    expected = lowpass_fill(colour, depth, LOWPASS_SEARCH_LEVELS)[::-1]
+    np.testing.assert_allclose(image[holes[::-1]] / 255.0, expected[holes[::-1]], atol=1.5 / 255)
+
+
+def test_the_low_pass_fill_shows_what_lay_behind_not_the_sphere():
+    renderer, image, reference = warp_once(fill="lowpass")
+    try:
+        with renderer._ctx:
+            colour, _ = renderer._server.read_warped()
+    finally:
+        renderer.close()
+    holes = (colour[:, :, 3] == 0)[::-1]
+    assert image[holes].max() < 100  # the sphere is at least 150 bright
+
+
+# -- the adaptive grid's cells ------------------------------------------------------------------
+
+
+def surface(z: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """A client surface (NDC depth, slopes, id) with the slopes the client's surface pass computes."""
+    h, w = z.shape
+    slopes = np.zeros((h, w, 2))
+    for axis, pixels, channel in ((1, w, 0), (0, h, 1)):
+        best = np.full((h, w), np.inf)
+        for side in (-1, 1):
+            neighbour, neighbour_id = np.roll(z, -side, axis=axis), np.roll(ids, -side, axis=axis)
+            valid = neighbour_id == ids
+            edge = [slice(None), slice(None)]
+            edge[axis] = slice(-1, None) if side == 1 else slice(0, 1)
+            valid[tuple(edge)] = False
+            d = np.where(valid, side * (neighbour - z), np.inf)
+            best = np.where(np.abs(d) < np.abs(best), d, best)
+        slopes[:, :, channel] = np.where(np.isfinite(best), best, 0.0) * pixels / 2.0
+    return np.dstack([z, slopes, ids]).astype(np.float32)
+
+
+def coverage(cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    count = np.zeros(shape, dtype=np.int64)
+    for x, y, side in cells:
+        count[y : y + side, x : x + side] += 1
+    return count
+
+
+def test_a_flat_plane_of_one_object_is_all_largest_cells():
+    y, x = np.mgrid[0:64, 0:96]
+    cells = grid_cells(surface(0.1 + 0.001 * x + 0.002 * y, np.ones((64, 96))))
+    assert len(cells) == (64 // GRID_TILE) * (96 // GRID_TILE) and set(cells[:, 2]) == {GRID_TILE}
+
+
+def test_no_cell_spans_a_depth_step_or_two_objects():
+    z = np.full((40, 40), 0.2)
+    z[:, 20:] = 0.5  # a step between columns 19 and 20
+    ids = np.ones((40, 40))
+    ids[25:, :] = 2  # another object from row 25
+    cells = grid_cells(surface(z, ids))
+    for x, y, side in cells:
+        assert not (x < 20 < x + side) and not (y < 25 < y + side)
+    assert (coverage(cells, (40, 40)) == 1).all()
+    assert len(cells) < 40 * 40 / 8
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    shape=st.tuples(st.integers(1, 70), st.integers(1, 70)),
+    steps=st.lists(st.tuples(st.integers(0, 69), st.floats(-0.3, 0.3)), max_size=4),
+    seed=st.integers(0, 1000),
+)
+def test_the_cells_tile_any_surface_exactly_once(shape, steps, seed):
+    rng = np.random.default_rng(seed)
+    h, w = shape
+    z = np.full(shape, 0.3) + 0.001 * np.arange(w)
+    for column, height in steps:
+        z[:, min(column, w - 1) :] += height
+    ids = rng.integers(0, 3, size=shape) if seed % 2 else np.ones(shape)
+    cells = grid_cells(surface(z, ids))
+    assert (coverage(cells, shape) == 1).all()
+    assert all(len(np.unique(ids[y : y + s, x : x + s])) == 1 for x, y, s in cells)
+
+
+# -- the load's kd-tree ---------------------------------------------------------------------------
+
+
+def test_every_triangle_is_in_one_leaf_and_inside_its_box():
+    rng = np.random.default_rng(4)
+    triangles = rng.uniform(-1.0, 1.0, (5000, 3, 3)).astype(np.float32)
+    leaves = build_leaves(triangles, leaf_triangles=300)
+    assert sorted(leaves.order.tolist()) == list(range(5000))
+    assert leaves.count.max() <= 300 and leaves.count.sum() == 5000
+    np.testing.assert_array_equal(leaves.first, np.r_[0, np.cumsum(leaves.count)[:-1]])
+    for i in range(len(leaves.first)):
+        mine = triangles[leaves.order[leaves.first[i] : leaves.first[i] + leaves.count[i]]].reshape(-1, 3)
+        assert (mine >= leaves.box_min[i]).all() and (mine <= leaves.box_max[i]).all()
+
+
+def test_a_ray_meets_the_nearest_leaves_whose_boxes_it_passes_through():
+    """One triangle a leaf: two behind each other on the left (depths 0.9 and 0.5), one on the right."""
+    corners = np.array([[0.0, 0.0], [0.1, 0.0], [0.0, 0.1]])
+    triangles = np.array([np.column_stack([corners + [x, 0.0], np.full(3, z)]) for x, z in ((-0.5, 0.9), (-0.5, 0.5), (0.5, 0.3))])
+    leaves = build_leaves(triangles.astype(np.float32), leaf_triangles=1)
+    hit = leaves_hit(leaves, np.eye(4), np.array([[-0.45, 0.05]]), per_ray=1)
+    assert [leaves.box_min[i][2] for i in hit] == pytest.approx([0.5])
+    assert len(leaves_hit(leaves, np.eye(4), np.array([[0.0, 0.5]]))) == 0
+
+
+def test_hole_blocks_are_the_blocks_holding_an_objects_holes():
+    levels = np.zeros((8, 12), dtype=np.uint8)
+    proxy = np.full((8, 12), 2)
+    levels[1, 1] = levels[5, 9] = 1
+    proxy[5, 9] = 1
+    np.testing.assert_allclose(hole_blocks(levels, proxy, 2), [[2.0 / 12 * 2 - 1, 2.0 / 8 * 2 - 1]])
