@@ -69,6 +69,7 @@ def stream(
         on_event("no reader came; nothing sent")
         return counts
     on_event(f"reader connected; sending {total} records at {rate:g} Hz")
+    motion.pose(0)  # the first block of poses is worked out before the clock starts, not late
     start = time.monotonic()
     held: list[Emission] = []
     stalled = disconnected = False

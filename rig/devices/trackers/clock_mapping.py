@@ -34,6 +34,9 @@ class ClockMapping(Protocol):
 
     latency_known: bool
 
+    def observe(self, device_time: float | None, t_arrival: float) -> None:
+        """Learn from a record, before `sensor_time` is asked for it and the others that came with it."""
+
     def sensor_time(self, device_time: float | None, t_arrival: float) -> float: ...
 
     def restart(self) -> None:
@@ -60,6 +63,9 @@ class ArrivalTime:
 
     latency_known = False
 
+    def observe(self, device_time: float | None, t_arrival: float) -> None:
+        pass
+
     def sensor_time(self, device_time: float | None, t_arrival: float) -> float:
         return t_arrival
 
@@ -84,7 +90,7 @@ class OneWayMapping:
         self._best_at = 0.0
         self._fresh = True
 
-    def sensor_time(self, device_time: float | None, t_arrival: float) -> float:
+    def observe(self, device_time: float | None, t_arrival: float) -> None:
         assert device_time is not None
         bound = device_time - t_arrival
         if t_arrival >= self._window_end and self._best > -math.inf:
@@ -95,11 +101,14 @@ class OneWayMapping:
             self._best, self._second, self._best_at = bound, self._best, t_arrival
         elif bound > self._second:
             self._second = bound
+
+    def sensor_time(self, device_time: float | None, t_arrival: float) -> float:
+        assert device_time is not None
         offset = self._best
         if self.model.latest is not None:
             modelled = self.model.offset_at(t_arrival)
             if not (self._fresh and abs(self._best - modelled) > CLOCK_RESTART_S):
-                offset = max(modelled, bound)
+                offset = max(modelled, device_time - t_arrival)
         return min(device_time - offset, t_arrival)
 
     def _close_window(self) -> None:
@@ -142,6 +151,9 @@ class CorrectedMapping:
         self._last = (correction, uncertainty)
         offset = self.origin_s - correction
         self.model.add(OffsetInterval(offset - uncertainty, offset + uncertainty, at))
+
+    def observe(self, device_time: float | None, t_arrival: float) -> None:
+        pass
 
     def sensor_time(self, device_time: float | None, t_arrival: float) -> float:
         assert device_time is not None

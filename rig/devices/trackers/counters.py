@@ -51,33 +51,36 @@ class SequenceCheck:
         self._last_seq: int | None = None
         self._last_time: float | None = None
         self._discarded_since = 0
+        self._restored = False
 
     def discarded(self, count: int) -> None:
         """Records were discarded (corrupt or rejected) since the last one handed on."""
         self._discarded_since += count
 
     def link_restored(self) -> None:
-        """After a reconnection the counter may restart; nothing is counted across the gap."""
-        self._last_seq = None
-        self._last_time = None
-        if self._unwrap is not None:
-            self._unwrap.reset()
+        """After a reconnection, records missing from a counter that went on count as dropped; a
+        counter (or device clock) that starts again lower restarted, and counts nothing."""
+        self._restored = True
 
     def accept(self, seq: int | None, device_time: float | None) -> None:
         counters = self._counters
+        restored, self._restored = self._restored, False
         if self._unwrap is not None and seq is not None:
             full = self._unwrap.unwrap(seq)
             if self._last_seq is not None:
                 step = full - self._last_seq
-                if step <= 0:
+                if step <= 0 and restored:
+                    self._unwrap.reset()
+                    full = self._unwrap.unwrap(seq)
+                elif step <= 0:
                     counters.out_of_order += 1
                 else:
                     counters.dropped += max(0, step - 1 - self._discarded_since)
-            self._last_seq = full if self._last_seq is None else max(full, self._last_seq)
+            self._last_seq = full if self._last_seq is None or restored else max(full, self._last_seq)
         elif device_time is not None:
-            if self._last_time is not None and device_time <= self._last_time:
+            if self._last_time is not None and device_time <= self._last_time and not restored:
                 counters.out_of_order += 1
-            self._last_time = device_time if self._last_time is None else max(device_time, self._last_time)
+            self._last_time = device_time if self._last_time is None or restored else max(device_time, self._last_time)
         self._discarded_since = 0
 
 

@@ -197,8 +197,10 @@ class TrackerStream:
             self.reader_cpu_s += time.thread_time() - started
 
     def _accept(self, readings: list[Reading]) -> None:
-        records = []
+        """Checks, counts and queues the readings of one read; the clock mapping learns from all of
+        them before it maps any, so records read together keep their order in sensor time."""
         counters, mapping = self.counters, self.mapping
+        possible = []
         for reading in readings:
             problem = check_reading(reading, self._unit_tolerance)
             if problem is not None:
@@ -208,6 +210,10 @@ class TrackerStream:
                     log.warning("tracker %s: impossible record discarded: %s", self.name, problem)
                 continue
             self._sequence.accept(reading.seq, reading.device_time)
+            mapping.observe(reading.device_time, reading.t_arrival)
+            possible.append(reading)
+        records = []
+        for reading in possible:
             t_sensor = mapping.sensor_time(reading.device_time, reading.t_arrival)
             if mapping.latency_known:
                 self.latency.add(reading.t_arrival - t_sensor)
