@@ -8,7 +8,8 @@ records completed by them; what it could not decode it discards and counts in `c
   skipped. A run of bytes longer than MAX_LINE without a terminator is corrupt.
 * `BinaryDecoder`: records start with the sync bytes and have a fixed length. Where a checksum
   fails the decoder moves on by one byte and looks for the next sync, so a damaged record never
-  takes an intact neighbour with it; a damaged stretch counts as the records its length holds.
+  takes an intact neighbour with it; a damaged stretch counts as the records its length could
+  hold, rounded up (so garbage between records counts as one).
 * `HidReportDecoder`: one input report is one record, after its report id where the device uses
   them; reports of other ids are someone else's and ignored, short ones are corrupt.
 
@@ -81,13 +82,12 @@ class TextDecoder:
     def _line(self, line: bytes, t_arrival: float) -> Reading | None:
         parts = line.split(self._separator.encode("ascii")) if self._separator else line.split()
         if len(parts) != self._count:
-            if parts and [part.strip() for part in parts] != self._header:
-                self.corrupt += 1
+            self.corrupt += bool(line.strip())
             return None
         try:
             values = [float(part) for part in parts]
         except ValueError:
-            self.corrupt += 1
+            self.corrupt += [part.strip() for part in parts] != self._header
             return None
         return self._maker.make(values, t_arrival, self._time.seconds(values))
 
@@ -142,7 +142,7 @@ class BinaryDecoder:
 
     def _end_stretch(self) -> None:
         if self._discarded:
-            self.corrupt += max(1, math.floor(self._discarded / self.record_bytes + 0.5))
+            self.corrupt += math.ceil(self._discarded / self.record_bytes)
             self._discarded = 0
 
     def reset(self) -> None:

@@ -1,0 +1,123 @@
+"""Decoders resynchronise after damage: every intact record comes out, damage is counted, nothing is
+made up; and counters, impossible values and the clock mapping behave as documented."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rig.devices.trackers.clock_mapping import WINDOW_S, CorrectedMapping, OneWayMapping
+from rig.devices.trackers.counters import LatencyHistogram, SequenceCheck, TrackerCounters
+from rig.devices.trackers.decoders import decoder_for
+from rig.devices.trackers.profile import load_profile
+from rig.devices.trackers.readings import Reading, check_reading
+from rig.emulate.encode import Emission, RecordEncoder
+from rig.emulate.faults import ByteFaults, parse_faults
+
+
+def emissions(count: int) -> list[Emission]:
+    return [Emission(k, 10.0 + k * 1e-3, (0.001 * k, 0.0, 0.5), (math.cos(0.01 * k), 0.0, 0.0, math.sin(0.01 * k))) for k in range(count)]
+
+
+@pytest.mark.parametrize("faults", ["corrupt=0.02", "drop=0.02", "garbage=200", "corrupt=0.01,drop=0.01,garbage=100"])
+def test_binary_records_survive_damage_without_fabrication(faults: str) -> None:
+    profile = load_profile("binary-pose")
+    encoder, damage = RecordEncoder(profile), ByteFaults(parse_faults(faults), seed=1)
+    stream, intact, damaged = b"", [], 0
+    for emission in emissions(2000):
+        data, hurt = damage.apply(encoder.encode(emission), 1000.0)
+        stream += data
+        if hurt:
+            damaged += 1
+        else:
+            intact.append(emission.seq)
+    decoder = decoder_for(profile)
+    pieces = np.random.default_rng(2).integers(1, 97, 4000)
+    readings, at = [], 0
+    for size in pieces:
+        readings += decoder.feed(stream[at : at + size], 0.0)
+        at += size
+    readings += decoder.feed(stream[at:], 0.0)
+    decoder.reset()
+    assert [r.seq for r in readings] == intact
+    assert decoder.corrupt >= damaged
+    if "garbage" not in faults:
+        assert decoder.corrupt == damaged, "a damaged stretch counts as the records it held"
+
+
+def test_text_lines_skip_their_header_and_count_bad_lines() -> None:
+    decoder = decoder_for(load_profile("csv"))
+    text = b"t,px,py,pz,qw,qx,qy,qz\n1.0,0,0,0,1,0,0,0\n1.001,0,0,x,1,0,0,0\n1.002,0,0\n1.00"
+    readings = decoder.feed(text, 5.0) + decoder.feed(b"3,0,0,0,1,0,0,0\n", 6.0)
+    assert [(r.device_time, r.t_arrival) for r in readings] == [(1.0, 5.0), (1.003, 6.0)]
+    assert decoder.corrupt == 2
+
+
+def test_impossible_values_are_refused_and_possible_ones_normalised() -> None:
+    def reading(q: tuple, position: tuple = (0.0, 0.0, 0.0)) -> Reading:
+        return Reading(0.0, None, None, position, q)
+
+    assert "norm" in check_reading(reading((1.0, 0.1, 0.0, 0.0)), 1e-3)
+    assert "finite" in check_reading(reading((1.0, 0.0, 0.0, 0.0), (math.nan, 0.0, 0.0)), 1e-3)
+    assert "finite" in check_reading(reading((math.inf, 0.0, 0.0, 0.0)), 1e-3)
+    near = reading((1.0002, 0.0, 0.0, 0.0))
+    assert check_reading(near, 1e-3) is None and near.orientation == (1.0, 0.0, 0.0, 0.0)
+
+
+def test_a_16_bit_counter_wraps_and_gaps_count_as_dropped_less_the_damaged() -> None:
+    counters = TrackerCounters()
+    check = SequenceCheck(counters, 16)
+    for seq in (65534, 65535, 0, 3):
+        check.accept(seq, None)
+    check.discarded(2)
+    check.accept(7, None)
+    check.accept(6, None)
+    assert (counters.dropped, counters.out_of_order) == (2 + 1, 1)
+
+
+def test_one_way_mapping_removes_jitter_and_finds_drift() -> None:
+    rng = np.random.default_rng(4)
+    rate, drift, floor = 500.0, 80e-6, 0.004
+    sensed = np.arange(int(6.0 * rate)) / rate
+    device = 1000.0 + sensed * (1.0 + drift)
+    arrival = sensed + floor + rng.exponential(0.0005, sensed.size)
+    mapping = OneWayMapping(1e-6)
+    mapped = []
+    for d, a in zip(device, arrival):
+        mapping.observe(d, a)
+        mapped.append(mapping.sensor_time(d, a))
+    settled = arrival > 2 * WINDOW_S
+    error = np.array(mapped)[settled] - (sensed[settled] + floor)
+    assert np.all(np.array(mapped) <= arrival)
+    assert np.abs(error).max() < 2e-4, "the fastest transfer's floor, without the jitter (mean 0.5 ms)"
+    described = mapping.describe()
+    assert described["drift_ppm"] == pytest.approx(drift * 1e6, abs=max(5.0, 3 * described["drift_uncertainty_ppm"]))
+
+
+def test_one_way_mapping_follows_a_device_clock_that_restarts() -> None:
+    mapping = OneWayMapping(1e-6)
+    for k in range(1000):
+        mapping.observe(500.0 + k * 1e-3, k * 1e-3 + 0.002)
+    mapping.restart()
+    t = 1.5
+    mapping.observe(0.0, t)
+    assert mapping.sensor_time(0.0, t) == pytest.approx(t)
+
+
+def test_corrected_mapping_applies_the_round_trip_offset() -> None:
+    mapping = CorrectedMapping()
+    mapping.origin_s = 100.0
+    mapping.add_correction(0.25, 1e-4, at=1.0)
+    # The sender's time 50.75 is local time 51.0, which is rig time 51.0 - 100.0.
+    assert mapping.sensor_time(50.75, 0.0) == pytest.approx(-49.0)
+    assert mapping.describe()["offset_interval_s"] == pytest.approx([100.0 - 0.25 - 1e-4, 100.0 - 0.25 + 1e-4])
+
+
+def test_the_latency_histogram_gives_median_and_95th_percentile() -> None:
+    histogram = LatencyHistogram()
+    for latency in np.linspace(0.0, 0.01, 1001):
+        histogram.add(latency)
+    assert histogram.quantile_ms(0.5) == pytest.approx(5.0, abs=0.02)
+    assert histogram.quantile_ms(0.95) == pytest.approx(9.5, abs=0.02)
