@@ -6,11 +6,13 @@
     predictor.update(PoseSample(t_sensor=0.0, t_arrival=0.002, position=p, orientation=q))
     pose = predictor.predict(0.016)
 
-Predictors (`names()`): hold, slerp, kalman-cv, kalman-ca, desp, auto; each class documents its
-parameters and their units. `evaluate` scores one on a `Trace` (`read_trace` reads CSV files);
+Predictors (`names()`): hold, slerp, kalman-cv, kalman-ca, desp, auto, adaptive; each class documents
+its parameters and their units. `make(DEFAULT)` ("default") makes the one to use when none is named:
+`adaptive`, which learns on the stream it is fed which motion model to trust at each horizon. `evaluate` scores one on a `Trace` (`read_trace` reads CSV files);
 `SAMPLE_COLUMNS`, `sample_row` and `read_samples` are the one file format of tracker samples.
 `predictors.quaternion` holds the vectorised quaternion maths, (w, x, y, z) Hamilton;
-`predictors.synthetic` generates head motion. Tuning (`predictors.tuning`) and the JAX twins of the
+`predictors.synthetic` generates head motion and `predictors.stress` the stress streams (rates,
+noise, faults, sudden stops) a default predictor must survive. Tuning (`predictors.tuning`) and the JAX twins of the
 filters (`predictors.jax_filters`) import JAX, so they are imported only by name, never from here:
 the real-time path stays free of it.
 """
@@ -20,10 +22,11 @@ from predictors.errors import PredictorError
 from predictors.evaluation import Evaluation, HorizonScore, evaluate
 from predictors.params_file import read_params, write_params
 from predictors.pose import Pose, PoseSample
-from predictors.registry import Predictor, make, names
+from predictors.registry import DEFAULT, Predictor, make, names, resolve
 from predictors.trace import SAMPLE_COLUMNS, Trace, read_samples, read_trace, sample_row, write_trace
 
 __all__ = [
+    "DEFAULT",
     "SAMPLE_COLUMNS",
     "Evaluation",
     "HorizonScore",
@@ -39,6 +42,7 @@ __all__ = [
     "read_params",
     "read_samples",
     "read_trace",
+    "resolve",
     "sample_row",
     "write_params",
     "write_trace",

@@ -9,6 +9,9 @@ A predictor is a small stateful object driven once per tracker sample and once p
 A new predictor slots in by adding its class to `_PREDICTORS`, under its `name`, once it declares
 its parameters (`predictors.params.declare_params`): `make` passes keyword parameters to the
 constructor, which checks them against that declaration.
+
+`DEFAULT` ("default") is not a predictor of its own but another name for the one to use when none
+is named (`rig simulate`, `rig measure`): `make("default")` makes it, and `resolve` says which it is.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from __future__ import annotations
 from types import MappingProxyType
 from typing import Any, Mapping, Protocol, runtime_checkable
 
+from predictors.adaptive import Adaptive
 from predictors.auto import Auto
 from predictors.desp import DoubleExponentialSmoothing
 from predictors.errors import PredictorError
@@ -44,21 +48,31 @@ class Predictor(Protocol):
 _PREDICTORS: Mapping[str, Any] = MappingProxyType(
     {
         cls.name: cls
-        for cls in (HoldLast, SlerpExtrapolator, KalmanCV, KalmanCA, DoubleExponentialSmoothing, Auto)
+        for cls in (HoldLast, SlerpExtrapolator, KalmanCV, KalmanCA, DoubleExponentialSmoothing, Auto, Adaptive)
     }
 )
 
+DEFAULT = "default"
+_DEFAULT_IS = Adaptive.name
+
 
 def names() -> tuple[str, ...]:
-    """The names `make` accepts."""
+    """The predictors `make` makes, each once (`make` also takes `DEFAULT`)."""
     return tuple(_PREDICTORS)
+
+
+def resolve(name: str) -> str:
+    """The predictor a name stands for: `name` itself, or the default predictor's for `DEFAULT`."""
+    return _DEFAULT_IS if name == DEFAULT else name
 
 
 def _predictor_class(name: str) -> Any:
     try:
-        return _PREDICTORS[name]
+        return _PREDICTORS[resolve(name)]
     except (KeyError, TypeError):
-        raise PredictorError(f"unknown predictor {name!r}; known predictors: {', '.join(names())}") from None
+        raise PredictorError(
+            f"unknown predictor {name!r}; known predictors: {', '.join(names())} ({DEFAULT!r} is {_DEFAULT_IS})"
+        ) from None
 
 
 def params_of(name: str) -> ParamSet:

@@ -1,0 +1,307 @@
+"""`adaptive`: learns, on the stream it is fed, which motion model predicts best at each horizon.
+
+No parameter is tuned to a tracker or a person. The predictor runs several candidate estimates of
+the motion side by side (`predictors.smoothers`: the velocity through the last two samples, and
+Kalman smoothers of 25, 10 and 4 Hz bandwidth), and keeps scoring their predictions at horizons of
+10, 20, 40, 80 and 160 ms against the samples that arrive later (`predictors.horizon_scores`).
+At each horizon it learns a gain on every candidate's velocity and trusts the model whose realised
+errors there have been smallest, and constant velocity from the last two samples (slerp
+extrapolation) until another has beaten it by `margin`. So a clean tracker gets a model that
+follows it, a noisy one a smoother, jittery micro-movements a damped velocity, each horizon its
+own; and the answer changes as the stream does, with a memory of `memory` seconds.
+
+`predict(t)` answers any horizon h = t - (newest sample time): between two scored horizons it
+blends their predictions, weighted by where h lies between them on a log scale; below 10 ms it uses
+the 10 ms choice, above 160 ms the 160 ms one; before any horizon has been scored, constant
+velocity. Everything is driven by timestamps: the scores are per second of motion, a horizon is
+scored at most every half horizon (and at most `SCORES_PER_SAMPLE` horizons per sample, so the cost
+per sample stays bounded at 1000 Hz), and the smoothers' bandwidths are in Hz.
+
+Sample rules: samples are taken in sensor-time order; an older sample than the newest is dropped;
+one less than `min_interval` after the newest replaces it (a duplicate: the smoothers take it as a
+second measurement and the two-sample velocity is taken from the sample before); a gap longer than
+`max_gap` restarts the estimates from the next sample but keeps what was learnt about the stream.
+
+`state` reports what it trusts at each horizon, with the learnt gains, the errors scored, and the
+tracker noise it measured: from the second differences of the samples, whose lag-one covariance is
+-4/6 of their variance for white noise and close to their variance for smooth motion, so that
+sigma^2 = (<d_k.d_k> - <d_k.d_k-1>) / 10 per axis (only reported; the choice needs no noise level).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from math import exp, log, sqrt
+from typing import Any, ClassVar
+
+from predictors import scalar_quaternion as squat
+from predictors.checks import finite_time, no_sample_yet, read_sample
+from predictors.extrapolators import MIN_INTERVAL
+from predictors.horizon_scores import COLD_START, MODEL_NAMES, MODELS, Choice, HorizonScore
+from predictors.params import MAX_GAP, MAX_HORIZON, OPEN_UNIT, POSITIVE, Param, ParamSet, declare_params
+from predictors.pose import Pose, PoseSample
+from predictors.smoothers import Estimate, Smoothers, two_sample
+
+HORIZONS_S = (0.01, 0.02, 0.04, 0.08, 0.16)
+SCORES_PER_SAMPLE = 2
+SCORE_EVERY = 1.0  # a horizon is scored at most once per this many horizons
+# History kept beyond the oldest anchor still needed, before the list is trimmed (amortised).
+_TRIM_AFTER = 256
+
+MEMORY = Param(
+    "memory", 10.0, "seconds",
+    "Time constant of the scores, the learnt gains and the noise estimate: how long what the stream "
+    "showed counts.",
+    POSITIVE,
+)
+MARGIN = Param(
+    "margin", 0.05, "",
+    "A fraction: another model is trusted at a horizon only while its scored squared error there is "
+    "below (1 - margin) times constant velocity's.",
+    OPEN_UNIT,
+)
+GAIN_PRIOR = Param(
+    "gain_prior", 2.0, "seconds",
+    "The learnt velocity gains start at 1 and count as this many seconds of evidence for 1.",
+    POSITIVE,
+)
+
+# (t_sensor, position, orientation, the candidates' estimates) of a sample.
+_Anchor = tuple[float, tuple[float, float, float], squat.Quaternion, tuple[Estimate, ...]]
+
+
+@dataclass(frozen=True)
+class HorizonChoice:
+    """What `adaptive` trusts at one horizon: the model and its velocity gain for orientation and
+    for position, the seconds scored, and each model's RMS error there (deg, mm; `MODEL_NAMES` order)."""
+
+    horizon_ms: float
+    orientation_model: str
+    orientation_gain: float
+    position_model: str
+    position_gain: float
+    scored_s: float
+    orientation_rms_deg: tuple[float, ...]
+    position_rms_mm: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class AdaptiveState:
+    """`adaptive`'s state: its choice per horizon, the tracker noise it measured (per axis) and the
+    mean sample interval."""
+
+    horizons: tuple[HorizonChoice, ...]
+    orientation_noise_deg: float
+    position_noise_mm: float
+    sample_interval_ms: float
+
+
+@declare_params(MEMORY, MARGIN, GAIN_PRIOR, MIN_INTERVAL, MAX_GAP, MAX_HORIZON)
+class Adaptive:
+    """Trusts, per horizon, the candidate model whose realised errors on this stream have been
+    smallest (`adaptive`, the default predictor); see `predictors.adaptive`."""
+
+    name = "adaptive"
+    params: ClassVar[ParamSet]
+
+    def __init__(self, **values: Any) -> None:
+        """Parameters as keyword arguments, each then an attribute (the class docstring lists them)."""
+        self.params.assign(self, values)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every sample and everything learnt."""
+        self._scores = [HorizonScore(h) for h in HORIZONS_S]
+        self._noise = [0.0, 0.0, 0.0]  # EW weight (s), sums of d.d - d.d_prev: orientation, position
+        self._t: float | None = None
+        self._restart()
+
+    def _restart(self) -> None:
+        self._smoothers = Smoothers()
+        self._history: list[_Anchor] = []
+        self._anchors = [0] * len(HORIZONS_S)
+        self._older: tuple[float, tuple[float, float, float], squat.Quaternion] | None = None
+        self._steps: tuple[float, tuple[float, float, float], tuple[float, float, float]] | None = None
+        self._position_moved = False
+        self._second_differences: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
+
+    def update(self, sample: PoseSample) -> None:
+        """Take one tracker sample (the module docstring gives the order rules)."""
+        t, position, orientation = read_sample(sample, self.name)
+        last = self._t
+        if last is None or t - last > self.max_gap:
+            self._restart()
+            self._t, self._position, self._orientation = t, position, orientation
+            self._history.append((t, position, orientation, self._smoothers.estimates))
+            return
+        dt = t - last
+        if dt < 0.0:
+            return
+        r = squat.rotation_vector_between(self._orientation, orientation)
+        p = self._position
+        rp = (position[0] - p[0], position[1] - p[1], position[2] - p[2])
+        if rp != (0.0, 0.0, 0.0):
+            self._position_moved = True
+        if dt < self.min_interval:
+            self._replace_newest(t, position, orientation, r, rp)
+            return
+        self._older = (last, p, self._orientation)
+        self._smoothers.advance(dt, r, rp, two_sample(dt, r, rp))
+        self._note_noise(dt, r, rp)
+        self._t, self._position, self._orientation = t, position, orientation
+        self._history.append((t, position, orientation, self._smoothers.estimates))
+        self._score(t, r)
+
+    def _replace_newest(self, t: float, position: tuple[float, float, float], orientation: squat.Quaternion,
+                        r: tuple[float, float, float], rp: tuple[float, float, float]) -> None:
+        older = self._older
+        if older is None:
+            estimate = self._smoothers.estimates[0]
+        else:
+            t0, p0, q0 = older
+            dt = t - t0
+            w = squat.rotation_vector_between(q0, orientation)
+            estimate = two_sample(dt, w, (position[0] - p0[0], position[1] - p0[1], position[2] - p0[2]))
+        self._smoothers.remeasure(r, rp, estimate)
+        self._t, self._position, self._orientation = t, position, orientation
+        self._history[-1] = (t, position, orientation, self._smoothers.estimates)
+
+    def _note_noise(self, dt: float, r: tuple[float, float, float], rp: tuple[float, float, float]) -> None:
+        """Second differences of the steps (rescaled to this step's length), their squares and
+        lag-one products, as exponentially weighted sums."""
+        steps = self._steps
+        self._steps = (dt, r, rp)
+        if steps is None:
+            return
+        scale = dt / steps[0]
+        before, before_p = steps[1], steps[2]
+        d = (r[0] - scale * before[0], r[1] - scale * before[1], r[2] - scale * before[2])
+        dp = (rp[0] - scale * before_p[0], rp[1] - scale * before_p[1], rp[2] - scale * before_p[2])
+        decay = exp(-dt / self.memory)
+        noise = self._noise
+        previous = self._second_differences
+        self._second_differences = (d, dp)
+        if previous is None:
+            return
+        b, bp = previous
+        noise[0] = decay * noise[0] + dt
+        noise[1] = decay * noise[1] + dt * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - d[0] * b[0] - d[1] * b[1] - d[2] * b[2])
+        noise[2] = decay * noise[2] + dt * (
+            dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2] - dp[0] * bp[0] - dp[1] * bp[1] - dp[2] * bp[2]
+        )
+
+    def _score(self, t: float, r: tuple[float, float, float]) -> None:
+        """Score the (at most `SCORES_PER_SAMPLE`) horizons most overdue, each at most every half
+        horizon, whose predictions from an earlier sample the newest one (which turned by r from
+        the one before) has just overtaken."""
+        due: list[tuple[float, int]] = []
+        for k, score in enumerate(self._scores):
+            last = score.last
+            if last is None:
+                due.append((math.inf, k))
+            elif t - last >= SCORE_EVERY * score.horizon:
+                due.append(((t - last) / score.horizon, k))
+        if len(due) > SCORES_PER_SAMPLE:
+            due.sort(reverse=True)
+        history = self._history
+        newest = len(history) - 1
+        t_before, p_before, _, _ = history[newest - 1]
+        p_now, q_now = self._position, self._orientation
+        r0, r1, r2 = r
+        for _, k in due[:SCORES_PER_SAMPLE]:
+            score = self._scores[k]
+            horizon = score.horizon
+            i = self._anchors[k]
+            while i + 1 < newest and history[i + 1][0] + horizon <= t:
+                i += 1
+            self._anchors[k] = i
+            t_anchor, p_anchor, q_anchor, estimates = history[i]
+            target = t_anchor + horizon
+            if not t_before < target <= t:
+                continue
+            # The truth at the target, between the sample before and the newest: the turn from the
+            # anchor to the newest less the rest of the last step, r + r x turn / 2 to second order.
+            back = (t - target) / (t - t_before)
+            a0, a1, a2 = squat.rotation_vector_between(q_anchor, q_now)
+            turn = (
+                a0 - back * (r0 + 0.5 * (r1 * a2 - r2 * a1)),
+                a1 - back * (r1 + 0.5 * (r2 * a0 - r0 * a2)),
+                a2 - back * (r2 + 0.5 * (r0 * a1 - r1 * a0)),
+            )
+            moved = (
+                p_now[0] - back * (p_now[0] - p_before[0]) - p_anchor[0],
+                p_now[1] - back * (p_now[1] - p_before[1]) - p_anchor[1],
+                p_now[2] - back * (p_now[2] - p_before[2]) - p_anchor[2],
+            ) if self._position_moved else None
+            weight = min(t - score.last, 2.0 * SCORE_EVERY * horizon) if score.last is not None else min(t - t_before, horizon)
+            score.last = t
+            score.learn(turn, moved, estimates, weight, self.memory, self.gain_prior, self.margin)
+        oldest = min(self._anchors)
+        if oldest > _TRIM_AFTER:
+            del history[:oldest]
+            self._anchors = [i - oldest for i in self._anchors]
+
+    def _choice(self, k: int) -> Choice:
+        """Horizon k's choice, or the next shorter ready horizon's, or the cold-start choice."""
+        scores = self._scores
+        while k > 0 and not scores[k].ready:
+            k -= 1
+        return scores[k].choice if scores[k].ready else COLD_START
+
+    def predict(self, t: float) -> Pose:
+        """The pose at t (s): each part blended from the models trusted at the horizons either side
+        of t - (newest sample time), at most max_horizon seconds either way."""
+        last = self._t
+        if last is None:
+            raise no_sample_yet(self.name)
+        t = finite_time(t, self.name)
+        h = t - last
+        limit = self.max_horizon
+        h = limit if h > limit else -limit if h < -limit else h
+        if h <= HORIZONS_S[0]:
+            blend: tuple[tuple[int, float], ...] = ((0, 1.0),)
+        elif h >= HORIZONS_S[-1]:
+            blend = ((len(HORIZONS_S) - 1, 1.0),)
+        else:
+            k = 0
+            while HORIZONS_S[k + 1] < h:
+                k += 1
+            u = log(h / HORIZONS_S[k]) / log(HORIZONS_S[k + 1] / HORIZONS_S[k])
+            blend = ((k, 1.0 - u), (k + 1, u))
+        estimates = self._history[-1][3]
+        d0 = d1 = d2 = m0 = m1 = m2 = 0.0
+        for k, share in blend:
+            (model, gain), (position_model, position_gain) = self._choice(k)
+            a0, a1, a2, w0, w1, w2 = estimates[MODELS[model][0]][0]
+            reach = share * gain * h
+            d0 += share * a0 + reach * w0
+            d1 += share * a1 + reach * w1
+            d2 += share * a2 + reach * w2
+            a0, a1, a2, w0, w1, w2 = estimates[MODELS[position_model][0]][1]
+            reach = share * position_gain * h
+            m0 += share * a0 + reach * w0
+            m1 += share * a1 + reach * w1
+            m2 += share * a2 + reach * w2
+        p = self._position
+        return Pose(t, (p[0] + m0, p[1] + m1, p[2] + m2), squat.rotated_by(d0, d1, d2, self._orientation))
+
+    @property
+    def state(self) -> AdaptiveState:
+        """What it trusts per horizon, with the learnt gains and scored errors, and the noise measured."""
+        horizons = []
+        for k, score in enumerate(self._scores):
+            (model, gain), (position_model, position_gain) = self._choice(k)
+            orientation_rms, position_rms = score.rms_errors()
+            horizons.append(HorizonChoice(
+                1e3 * score.horizon, MODEL_NAMES[model], gain, MODEL_NAMES[position_model], position_gain,
+                score.scored, tuple(math.degrees(e) for e in orientation_rms), tuple(1e3 * e for e in position_rms),
+            ))
+        weight, turning, moving = self._noise
+        per_axis = 1.0 / (30.0 * weight) if weight > 0.0 else 0.0
+        return AdaptiveState(
+            tuple(horizons),
+            math.degrees(sqrt(max(0.0, turning * per_axis))),
+            1e3 * sqrt(max(0.0, moving * per_axis)),
+            1e3 * self._smoothers.interval,
+        )

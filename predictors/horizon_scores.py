@@ -1,0 +1,138 @@
+"""What `adaptive` has learnt at one prediction horizon: each model's realised error there, the gain
+on its velocity that would have made it smaller, and which model to trust.
+
+A *model* is a candidate estimate (`predictors.smoothers`) with a gain g on its velocity term: it
+predicts the displacement offset + g H velocity from the newest sample, H seconds ahead. The models
+are constant velocity from the last two samples with g = 1 (the baseline: slerp extrapolation), and
+every candidate with its gain learnt here.
+
+Each prediction's error becomes known once the tracker has passed the time it was made for:
+H seconds after an anchor sample, the truth there (the samples either side, interpolated) gives
+every model's error at once. Per model, separately for orientation (rad) and position (m), the
+scores keep exponentially weighted sums over `memory` seconds, each scored error weighted by the
+seconds since the horizon was last scored, so that statistics are per second of motion whatever
+the sample rate:
+
+* the learnt gain: least squares of the true displacement y (less the model's offset) on the
+  velocity term f = H velocity, shrunk towards 1 by `gain_prior` seconds of pseudo-data and kept
+  in [0, `GAIN_MAX`]: g = (n <f.y> + n0 <f.f>) / ((n + n0) <f.f>). A gain below 1 damps a
+  velocity that does not carry (micro-movements, noise), above 1 follows one that grows;
+* the error: the squared error of the model's prediction with the gain it had *before* this
+  error was known (so the score is out of sample);
+* the choice: the model of least error, if it beats the baseline's error by a fraction `margin`
+  or more, else the baseline. So a model is trusted only once it has shown an advantage at this
+  horizon on this stream, and a stream where nothing beats constant velocity gets constant
+  velocity.
+
+A horizon scored for less than `MIN_SCORED` horizons' worth of seconds is not `ready`: `adaptive`
+takes the next shorter ready horizon's choice, or, from a cold start, `COLD_START`: the least
+smoothing Kalman smoother, which follows a clean tracker almost as constant velocity does and
+spares a noisy fast one the velocity noise of two samples a millisecond apart.
+"""
+
+from __future__ import annotations
+
+from math import exp
+
+from predictors.smoothers import NAMES, Estimate, Vector
+
+GAIN_MAX = 1.5
+MIN_SCORED = 2.0  # horizons' worth of scored predictions before a horizon's own choice counts
+
+# Each model: (index of its estimate in `predictors.smoothers.NAMES`, whether it learns a gain): the
+# baseline first, then every estimate in order, each with a learnt gain.
+MODELS: tuple[tuple[int, bool], ...] = ((0, False), *((i, True) for i in range(len(NAMES))))
+MODEL_NAMES = ("constant-velocity", *(f"{name}, learnt gain" for name in NAMES))
+Choice = tuple[tuple[int, float], tuple[int, float]]  # (model, gain) for orientation, for position
+COLD_START: Choice = ((2, 1.0), (2, 1.0))
+
+# Per model and part: EW sums of |f|^2, f.y and the squared error (the weight, their common
+# denominator, is `scored`).
+_FF, _FY, _SSE = 0, 1, 2
+
+
+class HorizonScore:
+    """Scores, gains and choice at one horizon (s); `choice` is ((model, gain) for orientation,
+    (model, gain) for position)."""
+
+    __slots__ = ("horizon", "scored", "last", "choice", "_orientation", "_position")
+
+    def __init__(self, horizon: float) -> None:
+        self.horizon = horizon
+        self.scored = 0.0
+        self.last: float | None = None
+        self.choice: Choice = ((0, 1.0), (0, 1.0))
+        self._orientation = [[0.0, 0.0, 0.0] for _ in MODELS]
+        self._position = [[0.0, 0.0, 0.0] for _ in MODELS]
+
+    def learn(self, truth: Vector, truth_position: Vector | None, anchor: tuple[Estimate, ...], weight: float,
+              memory: float, gain_prior: float, margin: float) -> None:
+        """Score every model's prediction from the `anchor` estimates against the true turn (rad)
+        and displacement (m) from the anchor sample, `horizon` seconds later; `weight` is the
+        seconds this score stands for. A stream whose position has never moved passes None for the
+        displacement: its position scores stay zero and its choice constant velocity."""
+        decay = exp(-weight / memory)
+        self.scored = scored = self.scored * decay + weight
+        prior = gain_prior / scored
+        orientation = _learn(self._orientation, 0, self.horizon, truth, anchor, weight, decay, prior, margin)
+        position = self.choice[1]
+        if truth_position is not None:
+            position = _learn(self._position, 1, self.horizon, truth_position, anchor, weight, decay, prior, margin)
+        self.choice = (orientation, position)
+
+    @property
+    def ready(self) -> bool:
+        """Whether enough has been scored here for this horizon's own choice to count."""
+        return self.scored >= MIN_SCORED * self.horizon
+
+    def rms_errors(self) -> tuple[list[float], list[float]]:
+        """Each model's RMS error at this horizon (rad, m), as scored so far (NaN before any)."""
+        scored = self.scored if self.scored > 0.0 else float("nan")
+        return (
+            [(stats[_SSE] / scored) ** 0.5 for stats in self._orientation],
+            [(stats[_SSE] / scored) ** 0.5 for stats in self._position],
+        )
+
+
+def _gain(ff: float, fy: float, prior: float) -> float:
+    """The least-squares gain fy / ff shrunk towards 1 by `prior` (pseudo-weight over weight), in
+    [0, GAIN_MAX]."""
+    if ff <= 0.0:
+        return 1.0
+    gain = (fy + prior * ff) / ((1.0 + prior) * ff)
+    return 0.0 if gain < 0.0 else GAIN_MAX if gain > GAIN_MAX else gain
+
+
+def _learn(stats: list[list[float]], part: int, h: float, truth: Vector, anchor: tuple[Estimate, ...],
+           weight: float, decay: float, prior: float, margin: float) -> tuple[int, float]:
+    """Score and learn every model for one part (0 orientation, 1 position) and return its choice.
+    Written out for speed: this is most of `adaptive`'s cost."""
+    t0, t1, t2 = truth
+    # The baseline and the first learning model share the two-sample estimate.
+    a0, a1, a2, w0, w1, w2 = anchor[0][part]
+    y0, y1, y2 = t0 - a0, t1 - a1, t2 - a2
+    f0, f1, f2 = h * w0, h * w1, h * w2
+    e0, e1, e2 = y0 - f0, y1 - f1, y2 - f2
+    baseline = stats[0]
+    error = baseline[_SSE] = baseline[_SSE] * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
+    best, least = 0, (1.0 - margin) * error
+    for model in range(1, len(stats)):
+        if model > 1:
+            a0, a1, a2, w0, w1, w2 = anchor[model - 1][part]
+            y0, y1, y2 = t0 - a0, t1 - a1, t2 - a2
+            f0, f1, f2 = h * w0, h * w1, h * w2
+        learnt = stats[model]
+        ff, fy, sse = learnt
+        gain = (fy + prior * ff) / ((1.0 + prior) * ff) if ff > 0.0 else 1.0
+        gain = 0.0 if gain < 0.0 else GAIN_MAX if gain > GAIN_MAX else gain
+        e0, e1, e2 = y0 - gain * f0, y1 - gain * f1, y2 - gain * f2
+        error = sse * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
+        learnt[0] = ff * decay + weight * (f0 * f0 + f1 * f1 + f2 * f2)
+        learnt[1] = fy * decay + weight * (f0 * y0 + f1 * y1 + f2 * y2)
+        learnt[2] = error
+        if error < least:
+            best, least = model, error
+    if best == 0:
+        return 0, 1.0
+    learnt = stats[best]
+    return best, _gain(learnt[0], learnt[1], prior)
