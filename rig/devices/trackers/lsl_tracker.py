@@ -98,7 +98,7 @@ class LslLink:
             # The first correction takes a good fraction of a second: measured before the samples flow.
             correction, uncertainty = time_correction(inlet, CORRECTION_TIMEOUT_S)
             inlet.open_stream(timeout=OPEN_TIMEOUT_S)
-        except (lsl.TimeoutError, lsl.LostError) as error:
+        except (lsl.util.TimeoutError, lsl.util.LostError) as error:
             raise RigError(f"LSL stream {self.name!r} did not answer: {error}") from None
         if self.mapping.origin_s is None:
             self.mapping.origin_s = lsl_origin(clock)
@@ -118,9 +118,11 @@ class LslLink:
             rest, stamps = inlet.pull_chunk(timeout=0.0)
             t_arrival = clock.now()
             if t_arrival >= self._next_correction:
-                self.mapping.add_correction(*time_correction(inlet, 0.0), t_arrival)
                 self._next_correction = t_arrival + CORRECTION_INTERVAL_S
-        except lsl.LostError as error:
+                self.mapping.add_correction(*time_correction(inlet, 0.0), t_arrival)
+        except lsl.util.TimeoutError:
+            pass  # no fresh estimate yet (liblsl measures in the background): the mapping keeps the last
+        except lsl.util.LostError as error:
             raise LinkLost(f"the sender is gone ({error})") from None
         readings = []
         for values, device_time in zip([first, *rest], [stamp, *stamps]):
