@@ -1,21 +1,52 @@
-"""The `rig` command line. Every user error ends in one line on stderr and exit status 2."""
+"""The `rig` command line. Every user error ends in one line on stderr and exit status 2.
+
+This module imports only the standard library and the rig's error types, so that an interrupt or a
+signal at any moment, imports included, ends in the rig's own message and exit status: the command
+modules (and numpy, OpenCV, JAX behind them) are imported once the handlers are in place.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib
+import os
+import signal
 import sys
+from types import FrameType
 from typing import Sequence
 
-from analysis.errors import AnalysisError
-from predictors import PredictorError
-from rig.commands import analyse, bench, board, demo, report, simulate, sweep, tune
-from rig.commands import devices, emulate, record_tracker
 from rig.compile_cache import keep_compiled_fits
 from rig.errors import RigError
 
-USER_ERRORS = (RigError, PredictorError, AnalysisError)
+COMMANDS = (
+    "demo",
+    "simulate",
+    "analyse",
+    "sweep",
+    "report",
+    "bench",
+    "tune",
+    "board",
+    "record_tracker",
+    "devices",
+    "emulate",
+)
+"""The command modules in rig.commands, in the order `rig --help` lists them."""
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, handled as an interrupt: the command stops, keeping what it recorded."""
+
+
+def user_errors() -> tuple[type[Exception], ...]:
+    """The error types a user can cause: the rig's and its two libraries'."""
+    from analysis.errors import AnalysisError
+    from predictors import PredictorError
+
+    return (RigError, PredictorError, AnalysisError)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -24,8 +55,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Measure motion-to-photon latency with a pendulum, an LED and a camera; simulate the rig.",
     )
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for command in (demo, simulate, analyse, sweep, report, bench, tune, board, record_tracker, devices, emulate):
-        command.add_parser(subparsers)
+    for name in COMMANDS:
+        importlib.import_module(f"rig.commands.{name}").add_parser(subparsers)
     return parser
 
 
@@ -33,18 +64,43 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except USER_ERRORS as error:
+    except user_errors() as error:
         print(f"rig {args.command}: error: {error}", file=sys.stderr)
         return EXIT_USER_ERROR
-    except KeyboardInterrupt:
-        print(f"\nrig {args.command}: interrupted; everything recorded so far is on disk", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as interrupt:
+        print(f"\nrig {args.command}: {_stopped(interrupt)}; everything recorded so far is on disk", file=sys.stderr)
+        return EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
+
+
+def _stopped(interrupt: KeyboardInterrupt) -> str:
+    return "terminated" if isinstance(interrupt, Terminated) else "interrupted"
+
+
+def _terminate(signum: int, frame: FrameType | None) -> None:
+    raise Terminated()
 
 
 def run() -> None:
-    """Console-script entry point."""
-    keep_compiled_fits()
-    sys.exit(main())
+    """Console-script entry point.
+
+    Ends with os._exit once the command has closed its files: an interrupt that lands while native
+    code (XLA, OpenCV, OpenGL) runs its own exit handlers or threads could otherwise crash or hang
+    the interpreter's teardown after the work is safely on disk.
+    """
+    signal.signal(signal.SIGTERM, _terminate)
+    try:
+        keep_compiled_fits()
+        code = main()
+    except KeyboardInterrupt as interrupt:
+        print(f"\nrig: {_stopped(interrupt)} while starting; nothing was done", file=sys.stderr)
+        code = EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
+    except SystemExit as exit_:
+        code = exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else EXIT_USER_ERROR)
+        if exit_.code is not None and not isinstance(exit_.code, int):
+            print(exit_.code, file=sys.stderr)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
 
 
 if __name__ == "__main__":
