@@ -11,15 +11,15 @@ import math
 import os
 import sys
 import tempfile
-from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
 import predictors
 from predictors import read_trace
-from rig.bench import analyser, batch, renderer_report, renderers
+from rig.bench import analyser, batch
 from rig.bench import predictors as predictor_bench
 from rig.commands import options
+from rig.commands.bench_renderers import add_renderers
 from rig.errors import ConfigError, RigError
 from rig.progress import ProgressBar
 
@@ -136,88 +136,6 @@ def _add_predictors(benchmarks: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=_run_predictors)
 
 
-# -- renderers -----------------------------------------------------------------------------------
-
-
-def _int_list(text: str) -> tuple[int, ...]:
-    values = tuple(options.non_negative_int(part) for part in text.split(","))
-    if not values:
-        raise argparse.ArgumentTypeError(f"expected a comma-separated list of whole numbers, got {text!r}")
-    return values
-
-
-def _ratio_list(text: str) -> tuple[int, ...]:
-    values = _int_list(text)
-    if min(values) < 1:
-        raise argparse.ArgumentTypeError(f"rate ratios are display frames per client frame, at least 1, got {text!r}")
-    return values
-
-
-def _resolution_list(text: str) -> tuple[tuple[int, int], ...]:
-    sizes = []
-    for part in text.split(","):
-        w, sep, h = part.lower().partition("x")
-        try:
-            size = (int(w), int(h))
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT[,WIDTHxHEIGHT...], got {text!r}") from None
-        if not sep or min(size) < 16:
-            raise argparse.ArgumentTypeError(f"a resolution is WIDTHxHEIGHT, each at least 16, got {part!r}")
-        sizes.append(size)
-    return tuple(sizes)
-
-
-def _run_renderers(args: argparse.Namespace) -> int:
-    grid = renderers.QUICK_GRID if args.quick else renderers.BenchGrid()
-    grid = replace(grid, **{name: getattr(args, name) for name in ("triangles", "resolutions", "ratios") if getattr(args, name) is not None})
-    for path in (args.json, args.csv, args.plot):
-        if path is not None and not path.parent.exists():
-            raise ConfigError(f"cannot write {path}: folder {path.parent} does not exist")
-    bench_predictors = {"direct": args.direct_predictor, "warp": args.predictor}
-    if args.runs is not None:
-        args.runs.mkdir(parents=True, exist_ok=True)
-        rows = renderers.run_bench(grid, bench_predictors, args.runs, _log)
-    else:
-        with tempfile.TemporaryDirectory(prefix="rig-bench-") as runs:
-            rows = renderers.run_bench(grid, bench_predictors, Path(runs), _log)
-    if args.json is not None:
-        _write_json(args.json, rows)
-    if args.csv is not None:
-        renderer_report.write_csv(rows, args.csv)
-    if args.plot is not None:
-        renderer_report.plot_rows(rows, args.plot)
-    print(renderer_report.table(rows))
-    return 0
-
-
-def _add_renderers(benchmarks: argparse._SubParsersAction) -> None:
-    parser = benchmarks.add_parser(
-        "renderers",
-        help="frame cost, latency and image error of the direct and warp renderers against scene size",
-        description="Time the direct renderer and the warp renderer's client and server for load sizes and "
-        "display resolutions, measure the image error of warped frames against direct renders, and the latency "
-        "`rig analyse` finds in simulated videos (frame costs measured, then modelled). The default grid takes "
-        "several minutes; --quick runs a tiny one.",
-    )
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the rows as a JSON list")
-    parser.add_argument("--csv", type=Path, metavar="OUT", help="write the rows as CSV")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot latency against N and error against warp time")
-    parser.add_argument("--quick", action="store_true", help="a tiny grid (a smoke test, seconds not minutes)")
-    parser.add_argument("--triangles", type=_int_list, metavar="N,N,...", help="load sizes (default 10000,100000,1000000,5000000)")
-    parser.add_argument("--resolutions", type=_resolution_list, metavar="WxH,...", help="display sizes (default 640x480,1280x720)")
-    parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
-    parser.add_argument("--predictor", default="slerp", help="the warp renderer's predictor in the latency runs (default: %(default)s)")
-    parser.add_argument(
-        "--direct-predictor",
-        default="hold",
-        help="the direct renderer's predictor in the latency runs (default: %(default)s, as the seeds' reference "
-        "renderer, which sampled the tracker just before drawing: linear prediction across a frame of seconds "
-        "overshoots the swing)",
-    )
-    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the latency runs' videos here (default: a temporary folder)")
-    parser.set_defaults(func=_run_renderers)
-
-
 # -- batch ---------------------------------------------------------------------------------------
 
 
@@ -293,7 +211,7 @@ def _add_trackers(benchmarks: argparse._SubParsersAction) -> None:
 SUBJECTS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
     "analyser": _add_analyser,
     "predictors": _add_predictors,
-    "renderers": _add_renderers,
+    "renderers": add_renderers,
     "trackers": _add_trackers,
     "batch": _add_batch,
 }

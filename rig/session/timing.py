@@ -18,8 +18,10 @@ A **timing policy** says when the renderer works and when its images reach the d
 * `CompositeEveryRefresh` (a warp renderer): application frames run back to back at their own
   pace; a server composes images from the newest finished one. It aims each composition at a
   refresh and starts it that refresh's expected cost (plus `SWAP_MARGIN_S`) before its blank. A
-  modelled cost is known in advance; a measured one is expected to be the largest of the last
-  `EXPECTED_COST_WINDOW` measured. A composition that overruns its blank misses it, and one that
+  modelled cost is known in advance; a measured one is expected to be the EXPECTED_COST_QUANTILE
+  quantile of the last EXPECTED_COST_WINDOW measured (a lone stall of the machine does not push
+  the next compositions earlier, and so later in latency). A composition that overruns its blank
+  misses it, and one that
   costs more than a refresh cannot be aimed at every refresh: either way the display repeats the
   last image at the refreshes the server missed.
 
@@ -46,8 +48,9 @@ if TYPE_CHECKING:
     from rig.devices.protocols import Display
     from rig.session.session import Session
 
-EXPECTED_COST_WINDOW = 8
-"""A measured server cost is expected to be the largest of this many latest measurements."""
+EXPECTED_COST_WINDOW = 20
+EXPECTED_COST_QUANTILE = 90.0
+"""A measured server cost is expected to be this percentile of the EXPECTED_COST_WINDOW latest."""
 SWAP_MARGIN_S = 2e-4
 """A composition aims to be ready this long before its blank: a swap at the blank misses it."""
 PHOTON_TARGETS = ("photons", "scanout")
@@ -188,7 +191,8 @@ class CompositeEveryRefresh:
 
     def _expected_s(self, display: Display) -> float:
         recent = self._charged[-EXPECTED_COST_WINDOW:]
-        return self.server_cost.expected_s(max(recent) if recent else 1.0 / display.refresh_hz)
+        typical = float(np.percentile(recent, EXPECTED_COST_QUANTILE)) if recent else 1.0 / display.refresh_hz
+        return self.server_cost.expected_s(typical)
 
     def _plan(self, display: Display, k: int) -> float:
         if self._start is None:

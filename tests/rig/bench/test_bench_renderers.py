@@ -1,4 +1,4 @@
-"""`rig bench renderers --quick`: every row and figure is there, and the numbers are sane."""
+"""`rig bench renderers --quick` in each of its modes: every row and figure is there, and the numbers are sane."""
 
 from __future__ import annotations
 
@@ -8,8 +8,9 @@ import json
 
 import pytest
 
-from rig.commands import bench
 from rig.bench.renderers import QUICK_GRID, ROW_FIELDS
+from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
+from rig.commands import bench
 
 
 def bench_parser() -> argparse.ArgumentParser:
@@ -43,13 +44,15 @@ def test_the_figures_are_filled_in_where_they_apply(quick_run):
     for r in rows:
         assert r["frame_ms_median"] > 0 and r["frame_ms_p95"] >= r["frame_ms_median"] and r["frame_cpu_ms_median"] > 0
         if r["triangles"] in QUICK_GRID.latency_triangles:
-            assert r["latency_true_ms"] > 0 and "cost measured, then modelled" in r["latency_note"]
+            assert r["latency_true_ms"] > 0 and r["latency_note"].startswith("costs: application frame measured")
+            assert r["cost_source"] == "measured" and r["predictor"] == "hold" and 0 <= r["missed_pct"] <= 100
             assert abs(r["latency_measured_ms"] - r["latency_true_ms"]) < 1.5
         else:
             assert r["latency_measured_ms"] is None and r["latency_note"] is None
         if r["renderer"] == "warp":
-            assert r["client_ms_median"] > 0
+            assert r["client_ms_median"] > 0 and r["spec"] == "warp" and r["primitives"] > 0
             assert 0 <= r["lab_error_pct"] < 5 and 0 <= r["hole_pct"] < 5 and r["psnr_db"] > 20
+            assert 0.9 < r["ssim"] <= 1.0 and r["dssim"] == pytest.approx((1 - r["ssim"]) / 2)
         else:
             assert r["client_ms_median"] is None and r["lab_error_pct"] is None and r["hole_pct"] is None
 
@@ -74,3 +77,62 @@ def test_bad_grid_options_are_rejected(capsys: pytest.CaptureFixture[str]):
         with pytest.raises(SystemExit):
             bench_parser().parse_args(["bench", "renderers", *bad])
     assert "error" in capsys.readouterr().err
+
+
+def run_quick(out, mode: str, *extra: str) -> tuple[list[dict], str]:
+    args = bench_parser().parse_args(["bench", "renderers", "--quick", mode, "--json", str(out / "rows.json"), "--plot", str(out / "plot.png"), *extra])
+    assert args.func(args) == 0
+    return json.loads((out / "rows.json").read_text())
+
+
+@pytest.mark.slow
+def test_the_seed_table_films_both_renderers_alike_and_sets_the_seeds_figures_beside(tmp_path, capsys):
+    rows = run_quick(tmp_path, "--seed-table")
+    ours = [r for r in rows if r["source"] == "this machine"]
+    seed = [r for r in rows if r["source"] == SEED_SOURCE]
+    assert {(r["renderer"], r["triangles"]) for r in ours} == {(renderer, n) for renderer in ("direct", "warp") for n in (1_000, 4_000)}
+    for r in ours:
+        assert {"renderer", "triangles", "width", "latency_measured_ms", "latency_sd_ms", "frame_ms_median", "cost_source"} <= set(r)
+        assert r["cost_source"] == "measured" and r["predictor"] == "hold" and r["width"] == 160
+        assert abs(r["latency_measured_ms"] - r["latency_true_ms"]) < 1.5 and r["latency_sd_ms"] >= 0
+        assert r["latency_refreshes"] == pytest.approx(r["latency_measured_ms"] / (1e3 / 60))
+    assert len(seed) == 2 * len(SEED_TABLE_2)
+    printed = capsys.readouterr().out
+    assert "crossover, seed: 2.15M triangles" in printed and "780.0 (14.2)" in printed
+    assert (tmp_path / "plot.png").stat().st_size > 20_000
+
+
+@pytest.mark.slow
+def test_the_variants_plot_image_error_against_latency_saved(tmp_path):
+    rows = run_quick(tmp_path, "--variants")
+    assert [r["spec"] for r in rows] == ["warp", "warp:views=2,recon=grid,holes=1"]
+    for r in rows:
+        assert r["latency_saved_ms"] == pytest.approx(r["direct_latency_ms"] - r["latency_measured_ms"])
+        assert 0.9 < r["ssim"] <= 1.0 and r["primitives"] > 0 and r["server_ms_median"] > 0
+    assert rows[1]["hole_pct"] <= rows[0]["hole_pct"]
+    assert (tmp_path / "plot.png").stat().st_size > 20_000
+
+
+@pytest.mark.slow
+def test_aimed_at_the_photons_a_good_predictor_leaves_almost_no_latency(tmp_path, capsys):
+    """With a GPU-like 2 ms server (modelled), kalman-cv aimed at the middle of each frame's photons
+    brings the measured latency within 2 ms of zero; aimed at scan-out it leaves about half a refresh."""
+    rows = run_quick(tmp_path, "--photon-residual", "--residual-predictor", "kalman-cv")
+    by = {r["photon_target"]: r for r in rows}
+    assert {r["cost_source"] for r in rows} == {"modelled"}
+    assert abs(by["photons"]["latency_measured_ms"]) < 2.0
+    assert by["scanout"]["latency_measured_ms"] - by["photons"]["latency_measured_ms"] == pytest.approx(1e3 / 60 / 2, abs=2.0)
+    assert "best predictor kalman-cv" in capsys.readouterr().out
+
+
+def test_the_crossover_is_interpolated_in_log_size_with_the_direct_frame_time_there():
+    def row(renderer, n, latency, frame):
+        return {"renderer": renderer, "triangles": n, "latency_measured_ms": latency, "frame_ms_median": frame, "refresh_ms": 10.0}
+
+    rows = [row("direct", 1_000, 40.0, 2.0), row("warp", 1_000, 50.0, 5.0), row("direct", 4_000, 70.0, 8.0), row("warp", 4_000, 50.0, 5.0)]
+    found = crossover(rows)
+    assert found["triangles"] == pytest.approx(1_000 * 4 ** (1 / 3))
+    assert found["direct_frame_ms"] == pytest.approx(2.0 * 4 ** (1 / 3)) and found["direct_frame_refreshes"] == pytest.approx(found["direct_frame_ms"] / 10)
+    assert crossover(rows[:2]) is None
+    seed = crossover(seed_rows())
+    assert 2e6 < seed["triangles"] < 4e6 and 18.8 < seed["direct_frame_ms"] < 37.0

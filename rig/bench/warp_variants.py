@@ -1,0 +1,110 @@
+"""`rig bench renderers --variants`: image error against latency saved, for each warp variant and scene.
+
+For each load size, the direct renderer's latency is filmed once; then each warp variant (a spec,
+`warp:recon=grid`, ...) is measured three ways: its image error against a direct render at the same
+pose (client frames at several swing phases, each warped over a client:display rate ratio of 1:r,
+as the renderer bench does: Lab > 10 share, SSIM, DSSIM, holes left for the fill), its cost per
+display frame and primitives, and its latency, filmed with every cost measured (or the server's
+modelled, labelled). Latency saved is the direct renderer's latency less the variant's, both
+measured from video; a variant whose server misses refreshes saves less. One picture then shows
+what each variant costs in image quality for the latency it saves.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from rig.bench.renderer_latency import film_latency
+from rig.bench.renderers import (
+    QUALITY_FIGURES,
+    QUICK_GRID,
+    BenchGrid,
+    machine_name,
+    measure_warp_quality,
+    open_warp,
+    scene_setup,
+    time_direct,
+    time_warp_rounds,
+)
+
+DEFAULT_VARIANTS = (
+    "warp", "warp:recon=quad", "warp:recon=mesh", "warp:recon=grid", "warp:views=2", "warp:holes=1", "warp:holes=2",
+    "warp:fill=lowpass", "warp:views=2,recon=grid,holes=2,fill=lowpass", "warp:spin=30", "warp:spin=30,untracked=hold",
+)  # fmt: skip
+
+Log = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class VariantSpec:
+    """What `--variants` measures: load sizes, variants, the display, the rate ratio of the image
+    error, the latency runs' predictor and costs."""
+
+    triangles: tuple[int, ...] = (10_000, 1_000_000)
+    variants: tuple[str, ...] = DEFAULT_VARIANTS
+    grid: BenchGrid = BenchGrid(resolutions=((320, 240),), ratios=(5,), phases=2, warp_rounds=8, direct_frames=3, direct_budget_s=2.0)
+    predictor: str = "hold"
+
+
+QUICK_SPEC = VariantSpec(triangles=(1_000,), variants=("warp", "warp:views=2,recon=grid,holes=1"), grid=replace(QUICK_GRID, ratios=(3,)))
+
+
+def run_variants(spec: VariantSpec, runs_dir: Path, log: Log) -> list[dict[str, Any]]:
+    """A row per variant and load size (see the module docstring)."""
+    machine = machine_name()
+    log(f"machine: {machine}")
+    grid = spec.grid
+    size, ratio = grid.resolutions[0], grid.ratios[0]
+    rows: list[dict[str, Any]] = []
+    for triangles in spec.triangles:
+        setup, pendulum = scene_setup(*size, triangles, grid.refresh_hz)
+        direct_s = float(np.median(time_direct(setup, grid)[0]))
+        direct = film_latency(grid.latency_run("direct", triangles, spec.predictor), direct_s, 0.0, runs_dir / f"variants-direct-{triangles}")
+        log(f"{triangles:>9} triangles: direct latency {direct['latency_measured_ms'] or float('nan'):.1f} ms")
+        for variant in spec.variants:
+            started = time.perf_counter()
+            m = open_warp(variant, setup, pendulum, (ratio,))
+            try:
+                measure_warp_quality(m, grid)
+                time_warp_rounds([m], grid)
+            finally:
+                m.renderer.close()
+            client_s, server_s = float(np.median(m.client_s)), float(np.median(m.wall_s))
+            run = grid.latency_run(variant, triangles, spec.predictor)
+            figures = film_latency(run, client_s, server_s, runs_dir / f"variants-{variant.replace(':', '_').replace(',', '_')}-{triangles}")
+            warp_ms, direct_ms = figures["latency_measured_ms"], direct["latency_measured_ms"]
+            rows.append({
+                **figures, **m.quality(ratio), "spec": variant, "renderer": "warp", "rate_ratio": ratio,
+                "server_ms_median": server_s * 1e3, "client_ms_median": client_s * 1e3,
+                "direct_latency_ms": direct_ms,
+                "latency_saved_ms": direct_ms - warp_ms if warp_ms is not None and direct_ms is not None else None,
+                "machine": machine,
+            })  # fmt: skip
+            r = rows[-1]
+            log(f"{triangles:>9} triangles {variant:45}: Lab>10 {r['lab_error_pct']:.3f} %, SSIM {r['ssim']:.4f}, "
+                f"{r['primitives']:.0f} primitives, {server_s * 1e3:.1f} ms/frame, latency {warp_ms or float('nan'):.1f} ms "
+                f"({time.perf_counter() - started:.0f} s)")  # fmt: skip
+    return rows
+
+
+def variants_text(rows: list[dict[str, Any]]) -> str:
+    """The rows as a table."""
+    header = (f"{'N':>9} {'variant':45} {'Lab>10 %':>8} {'SSIM':>7} {'DSSIM':>7} {'holes %':>7} {'primitives':>10} "
+              f"{'ms/frame':>8} {'missed':>6} {'latency':>8} {'saved':>7}")  # fmt: skip
+    lines = [header]
+    for r in rows:
+        figures = [f"{r[name]:.3f}" if r[name] is not None else "-" for name in ("lab_error_pct", "ssim", "dssim", "hole_pct")]
+        latency = "-" if r["latency_measured_ms"] is None else f"{r['latency_measured_ms']:.1f}"
+        saved = "-" if r["latency_saved_ms"] is None else f"{r['latency_saved_ms']:.1f}"
+        lines.append(
+            f"{r['triangles']:>9} {r['spec']:45} {figures[0]:>8} {figures[1]:>7} {figures[2]:>7} {figures[3]:>7} {r['primitives']:>10.0f} "
+            f"{r['server_ms_median']:>8.1f} {r['missed_pct'] or 0:>5.0f}% {latency:>8} {saved:>7}"
+        )
+    lines.append(f"image figures: means over the warped frames (client:display 1:{rows[0]['rate_ratio']}); "
+                 f"{', '.join(QUALITY_FIGURES)}" if rows else "no rows")  # fmt: skip
+    return "\n".join(lines)
