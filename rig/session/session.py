@@ -108,10 +108,14 @@ class Session:
         t_end: float,
         record: RunRecord,
         progress: Progress | None = None,
+        from_connect: bool = False,
     ) -> None:
         self.parts = parts
         self.t_begin = t_begin
         self.t_end = t_end
+        self.from_connect = from_connect
+        """Count the run's span from when its devices are connected (a live run: opening a window
+        and finding a tracker take as long as they take) rather than from `t_begin` as given."""
         self.record = record
         self.progress = progress
         self.display = parts.display
@@ -133,6 +137,9 @@ class Session:
                 stack.callback(device.close)
             parts.renderer.open(parts.render_setup)
             stack.callback(parts.renderer.close)
+            if self.from_connect:
+                shift = parts.clock.now() - self.t_begin
+                self.t_begin, self.t_end = self.t_begin + shift, self.t_end + shift
             self._loop()
         return self.log
 
