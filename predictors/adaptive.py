@@ -38,13 +38,14 @@ from typing import Any, ClassVar
 from predictors import scalar_quaternion as squat
 from predictors.checks import finite_time, no_sample_yet, read_sample
 from predictors.extrapolators import MIN_INTERVAL
-from predictors.horizon_scores import COLD_START, MODEL_NAMES, MODELS, Choice, HorizonScore
+from predictors.horizon_scores import BASELINE, COLD_START, MODEL_NAMES, MODELS, Choice, HorizonScore
 from predictors.params import MAX_GAP, MAX_HORIZON, OPEN_UNIT, POSITIVE, Param, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
 from predictors.smoothers import Estimate, Smoothers, two_sample
 
 HORIZONS_S = (0.01, 0.02, 0.04, 0.08, 0.16)
 SCORES_PER_SAMPLE = 2
+_LOG_HORIZONS = tuple(log(h) for h in HORIZONS_S)
 SCORE_EVERY = 1.0  # a horizon is scored at most once per this many horizons
 # History kept beyond the oldest anchor still needed, before the list is trimmed (amortised).
 _TRIM_AFTER = 256
@@ -113,6 +114,7 @@ class Adaptive:
     def reset(self) -> None:
         """Forget every sample and everything learnt."""
         self._scores = [HorizonScore(h) for h in HORIZONS_S]
+        self._trusted: list[Choice] = [COLD_START] * len(HORIZONS_S)
         self._noise = [0.0, 0.0, 0.0]  # EW weight (s), sums of d.d - d.d_prev: orientation, position
         self._t: float | None = None
         self._restart()
@@ -163,7 +165,7 @@ class Adaptive:
             dt = t - t0
             w = squat.rotation_vector_between(q0, orientation)
             estimate = two_sample(dt, w, (position[0] - p0[0], position[1] - p0[1], position[2] - p0[2]))
-        self._smoothers.remeasure(r, rp, estimate)
+        self._smoothers.advance(0.0, r, rp, estimate)
         self._t, self._position, self._orientation = t, position, orientation
         self._history[-1] = (t, position, orientation, self._smoothers.estimates)
 
@@ -201,7 +203,7 @@ class Adaptive:
             if last is None:
                 due.append((math.inf, k))
             elif t - last >= SCORE_EVERY * score.horizon:
-                due.append(((t - last) / score.horizon, k))
+                due.append((t - last, k))
         if len(due) > SCORES_PER_SAMPLE:
             due.sort(reverse=True)
         history = self._history
@@ -209,6 +211,7 @@ class Adaptive:
         t_before, p_before, _, _ = history[newest - 1]
         p_now, q_now = self._position, self._orientation
         r0, r1, r2 = r
+        learnt = False
         for _, k in due[:SCORES_PER_SAMPLE]:
             score = self._scores[k]
             horizon = score.horizon
@@ -236,18 +239,26 @@ class Adaptive:
             ) if self._position_moved else None
             weight = min(t - score.last, 2.0 * SCORE_EVERY * horizon) if score.last is not None else min(t - t_before, horizon)
             score.last = t
-            score.learn(turn, moved, estimates, weight, self.memory, self.gain_prior, self.margin)
+            score.learn(turn, moved, estimates, weight, self.memory, self.gain_prior)
+            learnt = True
+        if learnt:
+            self._trust()
         oldest = min(self._anchors)
         if oldest > _TRIM_AFTER:
             del history[:oldest]
             self._anchors = [i - oldest for i in self._anchors]
 
-    def _choice(self, k: int) -> Choice:
-        """Horizon k's choice, or the next shorter ready horizon's, or the cold-start choice."""
-        scores = self._scores
-        while k > 0 and not scores[k].ready:
-            k -= 1
-        return scores[k].choice if scores[k].ready else COLD_START
+    def _trust(self) -> None:
+        """Each horizon's choice, shortest first: a ready horizon keeps the next shorter one's
+        model (constant velocity for the shortest) unless another beats it there by `margin`; a
+        horizon not yet ready takes the next shorter one's choice; before any is, `COLD_START`."""
+        trusted: list[Choice] = []
+        choice: Choice | None = None
+        for score in self._scores:
+            if score.ready:
+                choice = score.choose(choice or BASELINE, self.gain_prior, self.margin)
+            trusted.append(choice or COLD_START)
+        self._trusted = trusted
 
     def predict(self, t: float) -> Pose:
         """The pose at t (s): each part blended from the models trusted at the horizons either side
@@ -259,20 +270,20 @@ class Adaptive:
         h = t - last
         limit = self.max_horizon
         h = limit if h > limit else -limit if h < -limit else h
+        trusted = self._trusted
         if h <= HORIZONS_S[0]:
-            blend: tuple[tuple[int, float], ...] = ((0, 1.0),)
+            blend: tuple[tuple[Choice, float], ...] = ((trusted[0], 1.0),)
         elif h >= HORIZONS_S[-1]:
-            blend = ((len(HORIZONS_S) - 1, 1.0),)
+            blend = ((trusted[-1], 1.0),)
         else:
             k = 0
             while HORIZONS_S[k + 1] < h:
                 k += 1
-            u = log(h / HORIZONS_S[k]) / log(HORIZONS_S[k + 1] / HORIZONS_S[k])
-            blend = ((k, 1.0 - u), (k + 1, u))
+            u = (log(h) - _LOG_HORIZONS[k]) / (_LOG_HORIZONS[k + 1] - _LOG_HORIZONS[k])
+            blend = ((trusted[k], 1.0 - u), (trusted[k + 1], u))
         estimates = self._history[-1][3]
         d0 = d1 = d2 = m0 = m1 = m2 = 0.0
-        for k, share in blend:
-            (model, gain), (position_model, position_gain) = self._choice(k)
+        for ((model, gain), (position_model, position_gain)), share in blend:
             a0, a1, a2, w0, w1, w2 = estimates[MODELS[model][0]][0]
             reach = share * gain * h
             d0 += share * a0 + reach * w0
@@ -290,8 +301,8 @@ class Adaptive:
     def state(self) -> AdaptiveState:
         """What it trusts per horizon, with the learnt gains and scored errors, and the noise measured."""
         horizons = []
-        for k, score in enumerate(self._scores):
-            (model, gain), (position_model, position_gain) = self._choice(k)
+        for score, trusted in zip(self._scores, self._trusted):
+            (model, gain), (position_model, position_gain) = trusted
             orientation_rms, position_rms = score.rms_errors()
             horizons.append(HorizonChoice(
                 1e3 * score.horizon, MODEL_NAMES[model], gain, MODEL_NAMES[position_model], position_gain,

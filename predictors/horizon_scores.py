@@ -24,10 +24,12 @@ the sample rate:
   horizon on this stream, and a stream where nothing beats constant velocity gets constant
   velocity.
 
-A horizon scored for less than `MIN_SCORED` horizons' worth of seconds is not `ready`: `adaptive`
-takes the next shorter ready horizon's choice, or, from a cold start, `COLD_START`: the least
-smoothing Kalman smoother, which follows a clean tracker almost as constant velocity does and
-spares a noisy fast one the velocity noise of two samples a millisecond apart.
+A horizon scored for less than `MIN_SCORED` seconds is not `ready`: `adaptive` takes the next
+shorter ready horizon's choice, or, from a cold start, `COLD_START`: the least smoothing Kalman
+smoother, which follows a clean tracker almost as constant velocity does and spares a noisy fast
+one the velocity noise of two samples a millisecond apart. A second of evidence, not a few
+samples: a stream that starts at rest shows every smoother to advantage until the head first
+moves, and the first turn would find a lagging one trusted.
 """
 
 from __future__ import annotations
@@ -37,13 +39,14 @@ from math import exp
 from predictors.smoothers import NAMES, Estimate, Vector
 
 GAIN_MAX = 1.5
-MIN_SCORED = 2.0  # horizons' worth of scored predictions before a horizon's own choice counts
+MIN_SCORED = 1.0  # seconds of scored predictions before a horizon's own choice counts
 
 # Each model: (index of its estimate in `predictors.smoothers.NAMES`, whether it learns a gain): the
 # baseline first, then every estimate in order, each with a learnt gain.
 MODELS: tuple[tuple[int, bool], ...] = ((0, False), *((i, True) for i in range(len(NAMES))))
 MODEL_NAMES = ("constant-velocity", *(f"{name}, learnt gain" for name in NAMES))
 Choice = tuple[tuple[int, float], tuple[int, float]]  # (model, gain) for orientation, for position
+BASELINE: Choice = ((0, 1.0), (0, 1.0))
 COLD_START: Choice = ((2, 1.0), (2, 1.0))
 
 # Per model and part: EW sums of |f|^2, f.y and the squared error (the weight, their common
@@ -52,38 +55,40 @@ _FF, _FY, _SSE = 0, 1, 2
 
 
 class HorizonScore:
-    """Scores, gains and choice at one horizon (s); `choice` is ((model, gain) for orientation,
-    (model, gain) for position)."""
+    """Scores and learnt gains at one horizon (s), and the choice they make."""
 
-    __slots__ = ("horizon", "scored", "last", "choice", "_orientation", "_position")
+    __slots__ = ("horizon", "scored", "last", "_orientation", "_position")
 
     def __init__(self, horizon: float) -> None:
         self.horizon = horizon
         self.scored = 0.0
         self.last: float | None = None
-        self.choice: Choice = ((0, 1.0), (0, 1.0))
         self._orientation = [[0.0, 0.0, 0.0] for _ in MODELS]
         self._position = [[0.0, 0.0, 0.0] for _ in MODELS]
 
     def learn(self, truth: Vector, truth_position: Vector | None, anchor: tuple[Estimate, ...], weight: float,
-              memory: float, gain_prior: float, margin: float) -> None:
+              memory: float, gain_prior: float) -> None:
         """Score every model's prediction from the `anchor` estimates against the true turn (rad)
         and displacement (m) from the anchor sample, `horizon` seconds later; `weight` is the
         seconds this score stands for. A stream whose position has never moved passes None for the
-        displacement: its position scores stay zero and its choice constant velocity."""
+        displacement: its position scores stay zero."""
         decay = exp(-weight / memory)
         self.scored = scored = self.scored * decay + weight
         prior = gain_prior / scored
-        orientation = _learn(self._orientation, 0, self.horizon, truth, anchor, weight, decay, prior, margin)
-        position = self.choice[1]
+        _learn(self._orientation, 0, self.horizon, truth, anchor, weight, decay, prior)
         if truth_position is not None:
-            position = _learn(self._position, 1, self.horizon, truth_position, anchor, weight, decay, prior, margin)
-        self.choice = (orientation, position)
+            _learn(self._position, 1, self.horizon, truth_position, anchor, weight, decay, prior)
+
+    def choose(self, default: Choice, gain_prior: float, margin: float) -> Choice:
+        """The model to trust here for each part: `default`'s unless another's scored squared error
+        is below (1 - margin) times its, then the one of least error; with its gain learnt here."""
+        prior = gain_prior / self.scored
+        return _choose(self._orientation, default[0][0], prior, margin), _choose(self._position, default[1][0], prior, margin)
 
     @property
     def ready(self) -> bool:
         """Whether enough has been scored here for this horizon's own choice to count."""
-        return self.scored >= MIN_SCORED * self.horizon
+        return self.scored >= MIN_SCORED
 
     def rms_errors(self) -> tuple[list[float], list[float]]:
         """Each model's RMS error at this horizon (rad, m), as scored so far (NaN before any)."""
@@ -104,9 +109,9 @@ def _gain(ff: float, fy: float, prior: float) -> float:
 
 
 def _learn(stats: list[list[float]], part: int, h: float, truth: Vector, anchor: tuple[Estimate, ...],
-           weight: float, decay: float, prior: float, margin: float) -> tuple[int, float]:
-    """Score and learn every model for one part (0 orientation, 1 position) and return its choice.
-    Written out for speed: this is most of `adaptive`'s cost."""
+           weight: float, decay: float, prior: float) -> None:
+    """Score and learn every model for one part (0 orientation, 1 position). Written out for
+    speed: this is most of `adaptive`'s cost."""
     t0, t1, t2 = truth
     # The baseline and the first learning model share the two-sample estimate.
     a0, a1, a2, w0, w1, w2 = anchor[0][part]
@@ -114,8 +119,7 @@ def _learn(stats: list[list[float]], part: int, h: float, truth: Vector, anchor:
     f0, f1, f2 = h * w0, h * w1, h * w2
     e0, e1, e2 = y0 - f0, y1 - f1, y2 - f2
     baseline = stats[0]
-    error = baseline[_SSE] = baseline[_SSE] * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
-    best, least = 0, (1.0 - margin) * error
+    baseline[_SSE] = baseline[_SSE] * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
     for model in range(1, len(stats)):
         if model > 1:
             a0, a1, a2, w0, w1, w2 = anchor[model - 1][part]
@@ -126,13 +130,17 @@ def _learn(stats: list[list[float]], part: int, h: float, truth: Vector, anchor:
         gain = (fy + prior * ff) / ((1.0 + prior) * ff) if ff > 0.0 else 1.0
         gain = 0.0 if gain < 0.0 else GAIN_MAX if gain > GAIN_MAX else gain
         e0, e1, e2 = y0 - gain * f0, y1 - gain * f1, y2 - gain * f2
-        error = sse * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
         learnt[0] = ff * decay + weight * (f0 * f0 + f1 * f1 + f2 * f2)
         learnt[1] = fy * decay + weight * (f0 * y0 + f1 * y1 + f2 * y2)
-        learnt[2] = error
-        if error < least:
-            best, least = model, error
+        learnt[2] = sse * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
+
+
+def _choose(stats: list[list[float]], default: int, prior: float, margin: float) -> tuple[int, float]:
+    best, least = default, (1.0 - margin) * stats[default][_SSE]
+    for model, learnt in enumerate(stats):
+        if learnt[_SSE] < least:
+            best, least = model, learnt[_SSE]
     if best == 0:
         return 0, 1.0
     learnt = stats[best]
-    return best, _gain(learnt[0], learnt[1], prior)
+    return best, _gain(learnt[_FF], learnt[_FY], prior)

@@ -12,6 +12,7 @@ real-time budget, and numpy's per-call overhead on 3- and 4-vectors would be mos
 from __future__ import annotations
 
 import math
+import struct
 from math import isfinite
 from dataclasses import dataclass
 from typing import Sequence, Union
@@ -25,6 +26,10 @@ FloatVector = Union[np.ndarray, Sequence[float]]
 _UNIT_TOLERANCE = 1e-6
 
 
+_PACK3 = struct.Struct("3d").pack
+_PACK4 = struct.Struct("4d").pack
+
+
 def _float_array(value: FloatVector, what: str) -> np.ndarray:
     """A float64 copy of value, owned by the pose."""
     try:
@@ -33,7 +38,21 @@ def _float_array(value: FloatVector, what: str) -> np.ndarray:
         raise PredictorError(f"{what} must be numbers, got {value!r}") from None
 
 
+def _finite(values: tuple[float, ...], what: str, part: str) -> bool:
+    """Whether every value is finite; PredictorError if one is not a number."""
+    try:
+        return all(map(isfinite, values))
+    except TypeError:
+        raise PredictorError(f"{what}: {part} must be numbers, got {values!r}") from None
+
+
 def _position(value: FloatVector, what: str) -> np.ndarray:
+    if type(value) is tuple and len(value) == 3:
+        # What the predictors return once per display frame: packed straight into an immutable
+        # buffer, two numpy calls fewer than the general path.
+        if not _finite(value, what, "position"):
+            raise PredictorError(f"{what}: position must be finite, got {list(value)}")
+        return np.frombuffer(_PACK3(*value))
     p = _float_array(value, f"{what}: position")
     if p.shape != (3,):
         raise PredictorError(f"{what}: position must have shape (3,), got {p.shape}")
@@ -45,21 +64,25 @@ def _position(value: FloatVector, what: str) -> np.ndarray:
 
 
 def _orientation(value: FloatVector, what: str) -> np.ndarray:
-    q = _float_array(value, f"{what}: orientation")
-    if q.shape != (4,):
-        raise PredictorError(f"{what}: orientation must be a (w, x, y, z) quaternion, got shape {q.shape}")
-    w, x, y, z = q.tolist()
-    if not (isfinite(w) and isfinite(x) and isfinite(y) and isfinite(z)):
-        raise PredictorError(f"{what}: orientation must be finite, got {[w, x, y, z]}")
+    if type(value) is tuple and len(value) == 4:
+        if not _finite(value, what, "orientation"):
+            raise PredictorError(f"{what}: orientation must be finite, got {list(value)}")
+        w, x, y, z = value
+    else:
+        q = _float_array(value, f"{what}: orientation")
+        if q.shape != (4,):
+            raise PredictorError(f"{what}: orientation must be a (w, x, y, z) quaternion, got shape {q.shape}")
+        w, x, y, z = q.tolist()
+        if not (isfinite(w) and isfinite(x) and isfinite(y) and isfinite(z)):
+            raise PredictorError(f"{what}: orientation must be finite, got {[w, x, y, z]}")
     norm = math.sqrt(w * w + x * x + y * y + z * z)
     if abs(norm - 1.0) > _UNIT_TOLERANCE:
         raise PredictorError(
             f"{what}: orientation must be a unit quaternion, got norm {norm:.9g}; normalise it first"
         )
     if norm != 1.0:
-        q /= norm
-    q.flags.writeable = False
-    return q
+        w, x, y, z = w / norm, x / norm, y / norm, z / norm
+    return np.frombuffer(_PACK4(w, x, y, z))
 
 
 def _time(value: float, what: str) -> float:

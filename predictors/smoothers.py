@@ -71,54 +71,48 @@ class Smoothers:
     def __init__(self) -> None:
         self.estimates: tuple[Estimate, ...] = (STILL,) * len(NAMES)
         self.interval = 0.0
-        # Per filter: [orientation offset, angular velocity] and [position offset, velocity].
-        self._filters = [([0.0] * 6, [0.0] * 6) for _ in BANDWIDTHS_HZ]
+        # Per filter: [(orientation offset, angular velocity), (position offset, velocity)].
+        self._filters: list[list[Motion]] = [[STILL[0], STILL[1]] for _ in BANDWIDTHS_HZ]
         self._covariances: list[KinematicCovariance] = []
         self._densities = tuple((2.0 * pi * f) ** 4 for f in BANDWIDTHS_HZ)
 
     def advance(self, dt: float, r: Vector, rp: Vector, two_sample: Estimate) -> None:
-        """A new newest sample dt > 0 s after the last: it turned by r (rad) and moved by rp (m) from
-        it; `two_sample` is the two-sample estimate through it."""
+        """A new newest sample dt >= 0 s after the last: it turned by r (rad) and moved by rp (m) from
+        it; `two_sample` is the two-sample estimate through it. dt = 0 is a duplicate that replaces
+        the newest sample: a second measurement, no time update."""
         if not self._covariances:
+            if dt == 0.0:
+                self.estimates = (two_sample, *self.estimates[1:])
+                return
             self.interval = dt
             self._covariances = [KinematicCovariance(2, 1.0, 1.0, (1.0, _DIFFUSE / (dt * dt))) for _ in BANDWIDTHS_HZ]
-        else:
+        elif dt > 0.0:
             self.interval += INTERVAL_RATE * (dt - self.interval)
         interval = self.interval
-        for covariance, density, (turning, moving) in zip(self._covariances, self._densities, self._filters):
-            covariance.density = density * interval
-            covariance.predict(dt)
+        r0, r1, r2 = r
+        s0, s1, s2 = rp
+        estimates: list[Estimate] = [two_sample]
+        for covariance, density, state in zip(self._covariances, self._densities, self._filters):
+            if dt > 0.0:
+                covariance.density = density * interval
+                covariance.predict(dt)
             k0, k1 = covariance.update()
-            _measure(turning, dt, k0, k1, r, True)
-            _measure(moving, dt, k0, k1, rp, False)
-        self._publish(two_sample)
-
-    def remeasure(self, r: Vector, rp: Vector, two_sample: Estimate) -> None:
-        """The newest sample replaced by one at the same time (a duplicate), r and rp from the one
-        it replaces: a second measurement, no time update."""
-        for covariance, (turning, moving) in zip(self._covariances, self._filters):
-            k0, k1 = covariance.update()
-            _measure(turning, 0.0, k0, k1, r, True)
-            _measure(moving, 0.0, k0, k1, rp, False)
-        self._publish(two_sample)
-
-    def _publish(self, two_sample: Estimate) -> None:
-        self.estimates = (two_sample, *[(tuple(turning), tuple(moving)) for turning, moving in self._filters])  # type: ignore[list-item]
-
-
-def _measure(state: list[float], dt: float, k0: float, k1: float, step: Vector, rotation: bool) -> None:
-    """Time update over dt, move the origin to the new sample (by `step`, a rotation vector or a
-    displacement) and take it as a measurement at offset zero with Kalman gain (k0, k1)."""
-    a0, a1, a2, w0, w1, w2 = state
-    a0, a1, a2 = a0 + dt * w0, a1 + dt * w1, a2 + dt * w2
-    r0, r1, r2 = step
-    if rotation:
-        c0, c1, c2 = a1 * r2 - a2 * r1, a2 * r0 - a0 * r2, a0 * r1 - a1 * r0
-        a0, a1, a2 = a0 - r0 - 0.5 * c0, a1 - r1 - 0.5 * c1, a2 - r2 - 0.5 * c2
-    else:
-        a0, a1, a2 = a0 - r0, a1 - r1, a2 - r2
-    g = 1.0 - k0
-    state[:] = (g * a0, g * a1, g * a2, w0 - k1 * a0, w1 - k1 * a1, w2 - k1 * a2)
+            g = 1.0 - k0
+            (a0, a1, a2, w0, w1, w2), (b0, b1, b2, v0, v1, v2) = state
+            # Time update, then the origin moved to the new sample (rotation vectors composed to
+            # second order), then the measurement update at offset zero.
+            a0, a1, a2 = a0 + dt * w0, a1 + dt * w1, a2 + dt * w2
+            a0, a1, a2 = (
+                a0 - r0 - 0.5 * (a1 * r2 - a2 * r1),
+                a1 - r1 - 0.5 * (a2 * r0 - a0 * r2),
+                a2 - r2 - 0.5 * (a0 * r1 - a1 * r0),
+            )
+            b0, b1, b2 = b0 + dt * v0 - s0, b1 + dt * v1 - s1, b2 + dt * v2 - s2
+            turning = (g * a0, g * a1, g * a2, w0 - k1 * a0, w1 - k1 * a1, w2 - k1 * a2)
+            moving = (g * b0, g * b1, g * b2, v0 - k1 * b0, v1 - k1 * b1, v2 - k1 * b2)
+            state[0], state[1] = turning, moving
+            estimates.append((turning, moving))
+        self.estimates = tuple(estimates)
 
 
 def two_sample(dt: float, r: Vector, rp: Vector) -> Estimate:
