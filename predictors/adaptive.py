@@ -120,6 +120,8 @@ class Adaptive:
         self._restart()
 
     def _restart(self) -> None:
+        for score in self._scores:
+            score.last = None
         self._smoothers = Smoothers()
         self._history: list[_Anchor] = []
         self._anchors = [0] * len(HORIZONS_S)
@@ -194,9 +196,10 @@ class Adaptive:
         )
 
     def _score(self, t: float, r: tuple[float, float, float]) -> None:
-        """Score the (at most `SCORES_PER_SAMPLE`) horizons most overdue, each at most every half
-        horizon, whose predictions from an earlier sample the newest one (which turned by r from
-        the one before) has just overtaken."""
+        """Score the (at most `SCORES_PER_SAMPLE`) horizons longest unscored, each at most once per
+        `SCORE_EVERY` horizons, whose predictions from an earlier sample the newest one (which
+        turned by r from the one before) has just overtaken. Each score weighs the seconds since
+        its horizon was last scored."""
         due: list[tuple[float, int]] = []
         for k, score in enumerate(self._scores):
             last = score.last
@@ -211,7 +214,7 @@ class Adaptive:
         t_before, p_before, _, _ = history[newest - 1]
         p_now, q_now = self._position, self._orientation
         r0, r1, r2 = r
-        learnt = False
+        shortest = len(self._scores)
         for _, k in due[:SCORES_PER_SAMPLE]:
             score = self._scores[k]
             horizon = score.horizon
@@ -237,28 +240,30 @@ class Adaptive:
                 p_now[1] - back * (p_now[1] - p_before[1]) - p_anchor[1],
                 p_now[2] - back * (p_now[2] - p_before[2]) - p_anchor[2],
             ) if self._position_moved else None
-            weight = min(t - score.last, 2.0 * SCORE_EVERY * horizon) if score.last is not None else min(t - t_before, horizon)
+            weight = min(t - score.last, self.max_gap) if score.last is not None else min(t - t_before, horizon)
             score.last = t
             score.learn(turn, moved, estimates, weight, self.memory, self.gain_prior)
-            learnt = True
-        if learnt:
-            self._trust()
+            shortest = min(shortest, k)
+        self._trust(shortest)
         oldest = min(self._anchors)
         if oldest > _TRIM_AFTER:
             del history[:oldest]
             self._anchors = [i - oldest for i in self._anchors]
 
-    def _trust(self) -> None:
-        """Each horizon's choice, shortest first: a ready horizon keeps the next shorter one's
-        model (constant velocity for the shortest) unless another beats it there by `margin`; a
-        horizon not yet ready takes the next shorter one's choice; before any is, `COLD_START`."""
-        trusted: list[Choice] = []
+    def _trust(self, start: int = 0) -> None:
+        """Each horizon's choice from `start` on (the shorter ones' are as they were), shortest
+        first: a ready horizon keeps the next shorter one's model (constant velocity for the
+        shortest) unless another beats it there by `margin`; a horizon not yet ready takes the next
+        shorter one's choice; before any is ready, `COLD_START`."""
+        trusted = self._trusted
         choice: Choice | None = None
-        for score in self._scores:
+        if start > 0 and trusted[start - 1] is not COLD_START:
+            choice = trusted[start - 1]
+        for k in range(start, len(trusted)):
+            score = self._scores[k]
             if score.ready:
                 choice = score.choose(choice or BASELINE, self.gain_prior, self.margin)
-            trusted.append(choice or COLD_START)
-        self._trusted = trusted
+            trusted[k] = choice or COLD_START
 
     def predict(self, t: float) -> Pose:
         """The pose at t (s): each part blended from the models trusted at the horizons either side
@@ -284,12 +289,12 @@ class Adaptive:
         estimates = self._history[-1][3]
         d0 = d1 = d2 = m0 = m1 = m2 = 0.0
         for ((model, gain), (position_model, position_gain)), share in blend:
-            a0, a1, a2, w0, w1, w2 = estimates[MODELS[model][0]][0]
+            a0, a1, a2, w0, w1, w2 = estimates[MODELS[model]][0]
             reach = share * gain * h
             d0 += share * a0 + reach * w0
             d1 += share * a1 + reach * w1
             d2 += share * a2 + reach * w2
-            a0, a1, a2, w0, w1, w2 = estimates[MODELS[position_model][0]][1]
+            a0, a1, a2, w0, w1, w2 = estimates[MODELS[position_model]][1]
             reach = share * position_gain * h
             m0 += share * a0 + reach * w0
             m1 += share * a1 + reach * w1

@@ -1,10 +1,10 @@
 """What `adaptive` has learnt at one prediction horizon: each model's realised error there, the gain
-on its velocity that would have made it smaller, and which model to trust.
+on the two-sample velocity that would have made it smaller, and which model to trust.
 
-A *model* is a candidate estimate (`predictors.smoothers`) with a gain g on its velocity term: it
-predicts the displacement offset + g H velocity from the newest sample, H seconds ahead. The models
-are constant velocity from the last two samples with g = 1 (the baseline: slerp extrapolation), and
-every candidate with its gain learnt here.
+A *model* predicts the displacement offset + g H velocity from the newest sample, H seconds ahead,
+from one candidate estimate (`predictors.smoothers`) and a gain g on its velocity term. The models
+(`MODEL_NAMES`): constant velocity from the last two samples with g = 1 (the baseline: slerp
+extrapolation); the same velocity with its gain learnt here; and each Kalman smoother with g = 1.
 
 Each prediction's error becomes known once the tracker has passed the time it was made for:
 H seconds after an anchor sample, the truth there (the samples either side, interpolated) gives
@@ -13,16 +13,19 @@ scores keep exponentially weighted sums over `memory` seconds, each scored error
 seconds since the horizon was last scored, so that statistics are per second of motion whatever
 the sample rate:
 
-* the learnt gain: least squares of the true displacement y (less the model's offset) on the
-  velocity term f = H velocity, shrunk towards 1 by `gain_prior` seconds of pseudo-data and kept
-  in [0, `GAIN_MAX`]: g = (n <f.y> + n0 <f.f>) / ((n + n0) <f.f>). A gain below 1 damps a
-  velocity that does not carry (micro-movements, noise), above 1 follows one that grows;
+* the learnt gain: least squares of the true displacement y on the velocity term f = H velocity,
+  shrunk towards 1 by `gain_prior` seconds of pseudo-data and kept in [0, `GAIN_MAX`]:
+  g = (n <f.y> + n0 <f.f>) / ((n + n0) <f.f>). A gain below 1 damps a velocity that does not
+  carry (micro-movements, a tracker that repeats samples), above 1 follows one that grows. Learnt
+  on the two-sample velocity only: the smoothers' velocities are smooth already, and learning
+  theirs too changed nothing on the stress streams but the cost;
 * the error: the squared error of the model's prediction with the gain it had *before* this
   error was known (so the score is out of sample);
-* the choice: the model of least error, if it beats the baseline's error by a fraction `margin`
-  or more, else the baseline. So a model is trusted only once it has shown an advantage at this
-  horizon on this stream, and a stream where nothing beats constant velocity gets constant
-  velocity.
+* the choice (`choose`): a default model, kept unless another's error is below (1 - `margin`)
+  times its, then the one of least error. `adaptive` makes constant velocity the default at the
+  shortest horizon and each horizon's choice the default of the next longer one, so a model is
+  trusted only once it has shown an advantage on this stream, and a long horizon, whose errors
+  come slowly and in bursts, follows the shorter ones unless its own errors disagree.
 
 A horizon scored for less than `MIN_SCORED` seconds is not `ready`: `adaptive` takes the next
 shorter ready horizon's choice, or, from a cold start, `COLD_START`: the least smoothing Kalman
@@ -41,10 +44,11 @@ from predictors.smoothers import NAMES, Estimate, Vector
 GAIN_MAX = 1.5
 MIN_SCORED = 1.0  # seconds of scored predictions before a horizon's own choice counts
 
-# Each model: (index of its estimate in `predictors.smoothers.NAMES`, whether it learns a gain): the
-# baseline first, then every estimate in order, each with a learnt gain.
-MODELS: tuple[tuple[int, bool], ...] = ((0, False), *((i, True) for i in range(len(NAMES))))
-MODEL_NAMES = ("constant-velocity", *(f"{name}, learnt gain" for name in NAMES))
+# Each model: the index of its estimate in `predictors.smoothers.NAMES`. The baseline, then the
+# two-sample velocity with a learnt gain (`LEARNT`), then every smoother as it is.
+MODELS: tuple[int, ...] = (0, 0, *range(1, len(NAMES)))
+MODEL_NAMES = ("constant-velocity", "two-sample, learnt gain", *NAMES[1:])
+LEARNT = 1
 Choice = tuple[tuple[int, float], tuple[int, float]]  # (model, gain) for orientation, for position
 BASELINE: Choice = ((0, 1.0), (0, 1.0))
 COLD_START: Choice = ((2, 1.0), (2, 1.0))
@@ -110,29 +114,28 @@ def _gain(ff: float, fy: float, prior: float) -> float:
 
 def _learn(stats: list[list[float]], part: int, h: float, truth: Vector, anchor: tuple[Estimate, ...],
            weight: float, decay: float, prior: float) -> None:
-    """Score and learn every model for one part (0 orientation, 1 position). Written out for
-    speed: this is most of `adaptive`'s cost."""
+    """Score every model for one part (0 orientation, 1 position) and learn the two-sample gain.
+    Written out for speed: this is most of `adaptive`'s cost."""
     t0, t1, t2 = truth
-    # The baseline and the first learning model share the two-sample estimate.
+    # The baseline and the learnt-gain model share the two-sample estimate.
     a0, a1, a2, w0, w1, w2 = anchor[0][part]
     y0, y1, y2 = t0 - a0, t1 - a1, t2 - a2
     f0, f1, f2 = h * w0, h * w1, h * w2
     e0, e1, e2 = y0 - f0, y1 - f1, y2 - f2
     baseline = stats[0]
     baseline[_SSE] = baseline[_SSE] * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
-    for model in range(1, len(stats)):
-        if model > 1:
-            a0, a1, a2, w0, w1, w2 = anchor[model - 1][part]
-            y0, y1, y2 = t0 - a0, t1 - a1, t2 - a2
-            f0, f1, f2 = h * w0, h * w1, h * w2
-        learnt = stats[model]
-        ff, fy, sse = learnt
-        gain = (fy + prior * ff) / ((1.0 + prior) * ff) if ff > 0.0 else 1.0
-        gain = 0.0 if gain < 0.0 else GAIN_MAX if gain > GAIN_MAX else gain
-        e0, e1, e2 = y0 - gain * f0, y1 - gain * f1, y2 - gain * f2
-        learnt[0] = ff * decay + weight * (f0 * f0 + f1 * f1 + f2 * f2)
-        learnt[1] = fy * decay + weight * (f0 * y0 + f1 * y1 + f2 * y2)
-        learnt[2] = sse * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
+    learnt = stats[1]
+    ff, fy, sse = learnt
+    gain = _gain(ff, fy, prior)
+    e0, e1, e2 = y0 - gain * f0, y1 - gain * f1, y2 - gain * f2
+    learnt[_FF] = ff * decay + weight * (f0 * f0 + f1 * f1 + f2 * f2)
+    learnt[_FY] = fy * decay + weight * (f0 * y0 + f1 * y1 + f2 * y2)
+    learnt[_SSE] = sse * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
+    for model in range(2, len(stats)):
+        a0, a1, a2, w0, w1, w2 = anchor[model - 1][part]
+        e0, e1, e2 = t0 - a0 - h * w0, t1 - a1 - h * w1, t2 - a2 - h * w2
+        smoothed = stats[model]
+        smoothed[_SSE] = smoothed[_SSE] * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
 
 
 def _choose(stats: list[list[float]], default: int, prior: float, margin: float) -> tuple[int, float]:
@@ -140,7 +143,7 @@ def _choose(stats: list[list[float]], default: int, prior: float, margin: float)
     for model, learnt in enumerate(stats):
         if learnt[_SSE] < least:
             best, least = model, learnt[_SSE]
-    if best == 0:
-        return 0, 1.0
+    if best != LEARNT:
+        return best, 1.0
     learnt = stats[best]
     return best, _gain(learnt[_FF], learnt[_FY], prior)
