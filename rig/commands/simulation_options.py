@@ -25,7 +25,9 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--renderer",
         default=defaults.renderer,
-        help=f"renderer under test: {', '.join(renderer_names())} (default: %(default)s)",
+        metavar="NAME[:key=value,...]",
+        help=f"renderer under test ({', '.join(renderer_names())}) and its options, e.g. warp:views=2,recon=grid,holes=1 "
+        "(default: %(default)s)",
     )
     group.add_argument(
         "--predictor",

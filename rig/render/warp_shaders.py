@@ -98,6 +98,13 @@ void main() {
 }
 """
 
+_SPLAT = """Splat {
+    vec4 colour;  // rgb, and the object id in alpha
+    vec2 half_x;  // clip-space offset of half a client pixel along client x, after the warp
+    vec2 half_y;
+}"""
+"""The interface block a splat carries from the vertex to the fragment shader."""
+
 _WARP_HEADER = """
 #version 330
 // P' = M_id (x, y, z, 1): client pixel (i, j) in OpenGL rows (j = 0 at the bottom), at NDC (x, y)
@@ -117,6 +124,11 @@ vec2 pixel_ndc(vec2 pixel) {
     return pixel / vec2(client_size) * 2.0 - 1.0;
 }
 
+// The client pixel of this vertex, one vertex per pixel in row order.
+ivec2 vertex_texel() {
+    return ivec2(gl_VertexID % client_size.x, gl_VertexID / client_size.x);
+}
+
 // The warped clip position of a client surface point at `ndc` (depth z) of object `id`.
 vec4 warped(int id, vec2 ndc, float z) {
     vec4 p = warp_matrices[id] * vec4(ndc, z, 1.0);
@@ -130,20 +142,16 @@ vec4 warped(int id, vec2 ndc, float z) {
 }
 """
 
-_SPLAT_VERTEX_MAIN = """
+_SPLAT_VERTEX_MAIN = f"""
 // One vertex per client pixel, from gl_VertexID; the splat covers the warped pixel.
 uniform vec2 server_size;
 uniform float max_splat;
 uniform float splat_rounding;
 
-out Splat {
-    vec4 colour;  // rgb, and the object id in alpha
-    vec2 half_x;  // clip-space offset of half a client pixel along client x, after the warp
-    vec2 half_y;
-} splat;
-
+out {_SPLAT} splat;
+""" + """
 void main() {
-    ivec2 texel = ivec2(gl_VertexID % client_size.x, gl_VertexID / client_size.x);
+    ivec2 texel = vertex_texel();
     vec4 surface = texelFetch(client_surface, texel, 0);
     int id = object_of(surface);
     mat4 m = warp_matrices[id];
@@ -172,7 +180,7 @@ out Vertex {
 } vertex;
 
 void main() {
-    ivec2 texel = ivec2(gl_VertexID % client_size.x, gl_VertexID / client_size.x);
+    ivec2 texel = vertex_texel();
     vec4 surface = texelFetch(client_surface, texel, 0);
     int id = object_of(surface);
     gl_Position = warped(id, pixel_ndc(vec2(texel) + 0.5), surface.x);
@@ -204,21 +212,14 @@ void main() {
 }
 """
 
-WARP_QUAD_GEOMETRY_SHADER = """
+WARP_QUAD_GEOMETRY_SHADER = f"""
 #version 330
 // Quad splat: the warped pixel's parallelogram, corners at P' +- half_x +- half_y (section 4.1).
 layout(points) in;
 layout(triangle_strip, max_vertices = 4) out;
-in Splat {
-    vec4 colour;
-    vec2 half_x;
-    vec2 half_y;
-} splat_in[];
-out Splat {
-    vec4 colour;
-    vec2 half_x;
-    vec2 half_y;
-} splat;
+in {_SPLAT} splat_in[];
+out {_SPLAT} splat;
+""" + """
 void main() {
     vec4 p = gl_in[0].gl_Position;
     for (int corner = 0; corner < 4; ++corner) {
@@ -247,11 +248,7 @@ in Vertex {
     vec4 colour;
     float client_depth;
 } vertex[];
-out Splat {
-    vec4 colour;
-    vec2 half_x;
-    vec2 half_y;
-} splat;
+out %SPLAT% splat;
 void main() {
     float id = vertex[0].colour.a;
     if (vertex[1].colour.a != id || vertex[2].colour.a != id) {
@@ -271,7 +268,7 @@ void main() {
     }
     EndPrimitive();
 }
-"""
+""".replace("%SPLAT%", _SPLAT)
 
 _COVERAGE_TEST = """
 uniform float id_scale;
@@ -290,13 +287,9 @@ void write(vec3 colour, float id) {
 """
 
 WARP_FRAGMENT_SHADER = (
-    """
+    f"""
 #version 330
-in Splat {
-    vec4 colour;
-    vec2 half_x;
-    vec2 half_y;
-} splat;
+in {_SPLAT} splat;
 """
     + _COVERAGE_TEST
     + """

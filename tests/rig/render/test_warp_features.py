@@ -18,7 +18,7 @@ from rig.render.warp import WarpRenderer
 from rig.render.warp_grid import GRID_TILE, grid_cells
 from rig.render.warp_holes import build_leaves, hole_blocks, leaves_hit
 from rig.render.warp_matrices import translation
-from rig.render.warp_reference import arbitrate_views, hole_levels, lowpass_fill, reference_warp
+from rig.render.warp_reference import arbitrate_views, depth_slopes, hole_levels, lowpass_fill, reference_warp
 from rig.render.warp_server import BACKGROUND_NDC_Z
 
 WIDTH, HEIGHT = 96, 72
@@ -135,28 +135,30 @@ def test_the_gl_hole_levels_agree_with_the_numpy_reference(max_level):
     assert max_level == 1 or (levels == 3).sum() > 0
 
 
-def test_the_gl_low_pass_fill_agrees_with_the_numpy_reference():
+@pytest.fixture(scope="module")
+def lowpass_filled() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The moving scene filled by the low-pass pyramid: (image, warp before filling: colour and
+    depth in OpenGL rows)."""
     renderer, image, _ = warp_once(fill="lowpass")
     try:
         with renderer._ctx:
             colour, depth = renderer._server.read_warped()
     finally:
         renderer.close()
+    return image, colour, depth
+
+
+def test_the_gl_low_pass_fill_agrees_with_the_numpy_reference(lowpass_filled):
+    image, colour, depth = lowpass_filled
     holes = colour[:, :, 3] == 0
     assert holes.sum() > 30
     expected = lowpass_fill(colour, depth, LOWPASS_SEARCH_LEVELS)[::-1]
     np.testing.assert_allclose(image[holes[::-1]] / 255.0, expected[holes[::-1]], atol=1.5 / 255)
 
 
-def test_the_low_pass_fill_shows_what_lay_behind_not_the_sphere():
-    renderer, image, reference = warp_once(fill="lowpass")
-    try:
-        with renderer._ctx:
-            colour, _ = renderer._server.read_warped()
-    finally:
-        renderer.close()
-    holes = (colour[:, :, 3] == 0)[::-1]
-    assert image[holes].max() < 100  # the sphere is at least 150 bright
+def test_the_low_pass_fill_shows_what_lay_behind_not_the_sphere(lowpass_filled):
+    image, colour, _ = lowpass_filled
+    assert image[(colour[:, :, 3] == 0)[::-1]].max() < 100  # the sphere is at least 150 bright
 
 
 # -- the adaptive grid's cells ------------------------------------------------------------------
@@ -164,20 +166,7 @@ def test_the_low_pass_fill_shows_what_lay_behind_not_the_sphere():
 
 def surface(z: np.ndarray, ids: np.ndarray) -> np.ndarray:
     """A client surface (NDC depth, slopes, id) with the slopes the client's surface pass computes."""
-    h, w = z.shape
-    slopes = np.zeros((h, w, 2))
-    for axis, pixels, channel in ((1, w, 0), (0, h, 1)):
-        best = np.full((h, w), np.inf)
-        for side in (-1, 1):
-            neighbour, neighbour_id = np.roll(z, -side, axis=axis), np.roll(ids, -side, axis=axis)
-            valid = neighbour_id == ids
-            edge = [slice(None), slice(None)]
-            edge[axis] = slice(-1, None) if side == 1 else slice(0, 1)
-            valid[tuple(edge)] = False
-            d = np.where(valid, side * (neighbour - z), np.inf)
-            best = np.where(np.abs(d) < np.abs(best), d, best)
-        slopes[:, :, channel] = np.where(np.isfinite(best), best, 0.0) * pixels / 2.0
-    return np.dstack([z, slopes, ids]).astype(np.float32)
+    return np.dstack([z, depth_slopes(z, ids), ids]).astype(np.float32)
 
 
 def coverage(cells: np.ndarray, shape: tuple[int, int]) -> np.ndarray:

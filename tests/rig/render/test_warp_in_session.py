@@ -91,3 +91,26 @@ def test_demo_compare_prints_both_latencies_and_the_warp_is_faster(tmp_path: Pat
         assert report[name]["agrees"]
         assert (tmp_path / name / "truth.json").exists()
     assert report["direct"]["latency_measured_ms"] > report["warp"]["latency_measured_ms"] + 50.0
+
+
+def test_a_measured_server_cost_drives_the_clock_and_its_misses_are_on_record(tmp_path: Path):
+    """Whatever this machine's GL costs: each composed image is charged what it took, appears no
+    earlier than the refresh it was aimed at (its id), and a refresh without a new image is logged
+    as missed, in display_frames.csv and in the truth."""
+    run = warp_run(tmp_path, 20.0, warp_ms=None)
+    truth = run.truth
+    assert truth.display_frame_cost["source"] == "measured" and truth.display_frame_cost["median_ms"] > 0.0
+    assert truth.app_frame_cost == {"ms": 20.0, "source": "modelled"}
+    shown = rows(run.out_dir / "display_frames.csv")
+    assert {r["cost_source"] for r in shown} == {"measured"}
+    for before, row in zip(shown, shown[1:]):
+        assert (row["missed"] == "1") == (row["image"] == before["image"])
+    fresh = [r for r in shown if r["missed"] == "0"]
+    assert all(int(r["refresh"]) >= int(r["image"]) for r in fresh)
+    costs_ms = {int(r["image"]): float(r["image_cost_s"]) * 1e3 for r in fresh}
+    assert 0.0 < min(costs_ms.values()) and max(costs_ms.values()) <= truth.display_frame_cost["max_ms"] + 1e-9
+    if truth.display_frame_cost["median_ms"] > REFRESH_MS:
+        assert truth.refreshes.missed > truth.refreshes.shown / 3  # a server slower than a refresh cannot make them all
+    summary = run.summary()
+    assert summary["refreshes"] == {"shown": truth.refreshes.shown, "missed": truth.refreshes.missed}
+    assert summary["display_frame_cost"] == truth.display_frame_cost and "measured, median" in run.cost_line()
