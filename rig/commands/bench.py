@@ -95,43 +95,87 @@ def _run_predictors(args: argparse.Namespace) -> int:
     horizons = args.horizons_ms
     if args.plot_horizon_ms not in horizons:
         raise ConfigError(f"--plot-horizon-ms {args.plot_horizon_ms:g} must be one of --horizons-ms {','.join(f'{h:g}' for h in horizons)}")
-    traces = [read_trace(path) for path in args.trace] if args.trace else predictor_bench.default_traces(args.duration, args.seed)
+    traces = [read_trace(path) for path in args.trace or []]
+    if args.stress:
+        traces += predictor_bench.stress_traces(args.duration, args.seed)
+    if not traces:
+        traces = predictor_bench.default_traces(args.duration, args.seed)
     specs = args.predictor or [(name, {}) for name in predictors.names()]
+    if (predictor_bench.BASELINE, {}) not in specs:
+        specs = [*specs, (predictor_bench.BASELINE, {})]
     results = predictor_bench.run_bench(traces, specs, horizons, args.timing_repeats, ProgressBar("benchmarking predictors"))
     print(predictor_bench.table(results, horizons))
-    ratios = predictor_bench.cost_ratios(results)
-    for trace, ratio in ratios.items():
+    ratios = predictor_bench.ratios(results, horizons)
+    shown = [h for h in horizons if h > 0.0] or list(horizons)
+    print(f"\nangular RMS error / constant velocity ({predictor_bench.BASELINE}) at {' / '.join(f'{h:g}' for h in shown)} ms:")
+    print(predictor_bench.ratio_table(ratios, "angular", shown))
+    if any(math.isfinite(v) for entry in ratios for by_horizon in entry.position.values() for v in by_horizon.values()):
+        print(f"\nposition RMS error / constant velocity at {' / '.join(f'{h:g}' for h in shown)} ms (traces with position):")
+        print(predictor_bench.ratio_table(ratios, "position", shown))
+    costs = predictor_bench.cost_ratios(results)
+    for trace, ratio in costs.items():
         print(f"kalman-cv / desp cost on {trace}: {ratio:.2f}")
+    held = []
+    for name in args.leave_one_out or []:
+        if len(traces) < 2:
+            raise ConfigError("--leave-one-out needs at least two traces: it tunes on all but one")
+        held += predictor_bench.leave_one_out(
+            name, traces, args.plot_horizon_ms, args.tune_iterations, ProgressBar(f"tuning {name}, each trace held out in turn")
+        )
+    if held:
+        print(f"\nleave one trace out: tuned at {args.plot_horizon_ms:g} ms on the others, RMS error / constant velocity on the one held out:")
+        print(predictor_bench.held_out_table(held))
     if args.json:
-        _write_json(args.json, {"horizons_ms": list(horizons), "kalman_cv_over_desp_cost": ratios, "results": [r.to_dict() for r in results]})
+        _write_json(args.json, {
+            "horizons_ms": list(horizons),
+            "baseline": predictor_bench.BASELINE,
+            "kalman_cv_over_desp_cost": costs,
+            "ratios": [entry.to_dict(horizons) for entry in ratios],
+            "leave_one_out": [h.to_dict() for h in held],
+            "results": [r.to_dict() for r in results],
+        })
     if args.plot:
         _plot(lambda: predictor_bench.plot(results, args.plot_horizon_ms, args.plot), args.plot)
     return 0
 
 
+def _tunable(name: str) -> str:
+    from predictors.tuning import TUNABLE  # imports JAX: only when the option is given
+
+    if name not in TUNABLE:
+        raise argparse.ArgumentTypeError(f"cannot tune {name!r}; tunable predictors: {', '.join(TUNABLE)}")
+    return name
+
+
 def _add_predictors(benchmarks: argparse._SubParsersAction) -> None:
     parser = benchmarks.add_parser(
         "predictors",
-        help="score every predictor on traces: error at several horizons against cost per update",
-        description=predictor_bench.__doc__.split("\n\n")[0] + " With no --trace, runs the simulated pendulum, the "
-        "synthetic head and the real head-motion trace.",
+        help="score every predictor on traces: error against constant velocity at several horizons, and cost per update",
+        description=predictor_bench.__doc__.split("\n\n")[0] + " With no --trace or --stress, runs the simulated "
+        "pendulum, the synthetic head and the two recordings in data/traces.",
     )
     parser.add_argument("--trace", type=Path, action="append", metavar="FILE",
                         help="trace CSV (t_sensor,t_arrival,px,py,pz,qw,qx,qy,qz, or t instead of t_sensor); repeat "
-                        "for several (default: the built-in three)")  # fmt: skip
+                        "for several (default: the built-in four)")  # fmt: skip
+    parser.add_argument("--stress", action="store_true",
+                        help="run the synthetic stress streams (30-1000 Hz, noise, jitter, repeats, sudden stops) too")  # fmt: skip
     parser.add_argument("--predictor", type=options.predictor_spec, action="append", metavar="NAME[:key=value,...]",
                         help="predictor and parameters, or NAME:FILE.json; repeat for several (default: every predictor: "
-                        f"{', '.join(predictors.names())})")  # fmt: skip
+                        f"{', '.join(predictors.names())}); {predictor_bench.BASELINE}, the baseline, is always run")  # fmt: skip
     parser.add_argument("--horizons-ms", type=_horizons_ms, default=predictor_bench.DEFAULT_HORIZONS_MS, metavar="H,H,...",
                         help="prediction horizons after each sample's arrival (default: 0,10,20,50,100)")  # fmt: skip
     parser.add_argument("--plot-horizon-ms", type=options.non_negative_float, default=50.0,
-                        help="the horizon the plot shows (default: %(default)s)")  # fmt: skip
+                        help="the horizon the plot shows and --leave-one-out tunes for (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--leave-one-out", type=_tunable, action="append", metavar="NAME",
+                        help="tune NAME on all traces but one and score it on that one, for each trace; repeat for several")  # fmt: skip
+    parser.add_argument("--tune-iterations", type=options.non_negative_int, default=40,
+                        help="optimiser iterations per --leave-one-out fit (default: %(default)s)")  # fmt: skip
     parser.add_argument("--duration", type=options.positive_float, default=30.0,
-                        help="seconds of simulated pendulum and synthetic head (default: %(default)s)")  # fmt: skip
+                        help="seconds of simulated pendulum, synthetic head and stress streams (default: %(default)s)")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="seed of the simulated traces (default: %(default)s)")
     parser.add_argument("--timing-repeats", type=options.non_negative_int, default=3,
                         help="timed replays per predictor and trace; the best counts (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write every score as JSON")
+    parser.add_argument("--json", type=Path, metavar="OUT", help="write every score, ratio and held-out result as JSON")
     parser.add_argument("--plot", type=Path, metavar="OUT.png", help="draw speed against error")
     parser.set_defaults(func=_run_predictors)
 
