@@ -172,7 +172,7 @@ class Session:
             while next_app_start <= t_refresh:
                 next_app_start = self._app_frame(next_app_start)
             clock.wait_until(t_refresh)
-            timing.at_refresh(self, k, t_refresh)
+            timing.at_refresh(self, k, max(t_refresh, clock.now()))
             self._log_refresh(k)
             self._record_camera()
             for instrument in self.parts.instruments:
@@ -189,6 +189,7 @@ class Session:
         """Render application frame at `start`; when the next one starts."""
         index = self._app_frames
         self.parts.clock.wait_until(start)
+        start = max(start, self.parts.clock.now())  # on a live clock work may start late
         self.feed.deliver()
         display = self.display
         t_photon = self.photon_target(display.refresh_after(start + self._last_cost))

@@ -1,0 +1,144 @@
+"""`measure`: a live run filmed by a camera, then three answers side by side (see `MeasureReport`).
+
+1. the video's: the analyser (`rig.service.analyse`) on the camera's video, with its 95 % interval;
+2. the rig's own log's: the latency its logged swaps and tracker samples imply (`rig.live.log_latency`);
+3. with a rig board recording (`--board DIR`, from `rig board record` during the run), the
+   photodiode's (`analysis.board.photodiode_latency`).
+
+All three go into `measure.json` and `measure.png`, beside the run's files.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from analysis.board.photodiode_latency import estimate_from_recording
+from rig.devices.camera.opencv_camera import OpenCvCamera, opencv_camera
+from rig.errors import RigError
+from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
+from rig.live.run import EXTERNAL, LiveConfig, run_live
+from rig.live.view import View
+from rig.render.protocol import RenderSetup
+from rig.service.analyse import AnalysisRequest, analyse
+
+MEASURE_FILE = "measure.json"
+PLOT_FILE = "measure.png"
+
+
+@dataclass(frozen=True)
+class VideoOptions:
+    """How to read the run's video: its regions of interest (None: found), which side the LED is on."""
+
+    led_roi: tuple[int, int, int, int] | None = None
+    sphere_roi: tuple[int, int, int, int] | None = None
+    led_side: str | None = None
+
+
+@dataclass
+class MeasureReport:
+    out_dir: Path
+    video: dict[str, Any]
+    log: dict[str, Any]
+    board: dict[str, Any] | None
+    run: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "latency_ms": self.video["latency_ms"],
+            "ci95_ms": self.video["ci95_ms"],
+            "log_latency_ms": self.log["latency_ms"],
+            "board_latency_ms": self.board["latency_ms"] if self.board else None,
+            "video": self.video,
+            "log": self.log,
+            "board": self.board,
+            "run": self.run,
+            "out_dir": str(self.out_dir),
+        }
+
+
+def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[str, Any]:
+    """The log's answer for a run folder (`rig.live.log_latency`)."""
+    if not external:
+        return log_latency(out_dir, shown_by_window(out_dir)).to_dict()
+    shown = shown_by_markers(out_dir)
+    view, display = run["view"], run["display"]
+    setup = RenderSetup(1, 1, np.array(view["world_to_clip"]), view["sphere_radius_m"])
+    rows = np.array([setup.row_fraction(p) for p in np.column_stack([shown["px"], shown["py"], shown["pz"]])])
+    return log_latency(out_dir, shown, rows * display["scanout_fraction"] / display["refresh_hz"]).to_dict()
+
+
+def analyse_run(out_dir: Path, fps: float | None, options: VideoOptions, board: Path | None, run: dict[str, Any],
+                progress: Callable[[int, int], object] | None = None) -> MeasureReport:  # fmt: skip
+    """The three answers for a filmed live run in `out_dir`; written to measure.json and measure.png."""
+    request = AnalysisRequest(out_dir / "video.avi", fps=fps, led_roi=options.led_roi, sphere_roi=options.sphere_roi,
+                              led_side=options.led_side, tracks_csv=out_dir / "tracks.csv")  # fmt: skip
+    video = analyse(request, progress).to_dict()
+    log = logged_latency(out_dir, run["renderer"] == EXTERNAL, run)
+    board_result = None
+    if board is not None:
+        latency = estimate_from_recording(board)
+        board_result = {"latency_ms": latency.latency_s * 1e3, "sd_ms": latency.uncertainty_s * 1e3, "folder": str(board)}
+    report = MeasureReport(out_dir, video, log, board_result, run)
+    write_report(report)
+    plot_measurement(report, out_dir / PLOT_FILE)
+    return report
+
+
+def write_report(report: MeasureReport) -> Path:
+    path = report.out_dir / MEASURE_FILE
+    path.write_text(json.dumps(report.to_dict(), indent=1, default=str) + "\n", encoding="utf-8")
+    return path
+
+
+def plot_measurement(report: MeasureReport, path: Path) -> Path:
+    """The answers side by side: each latency with its interval (the log's: the frame-by-frame
+    sensor-to-photon spread)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = [("video", report.video["latency_ms"], report.video["ci95_ms"])]
+    spread = report.log["sensor_to_photon_ms"]["sd"]
+    rows.append(("rig log", report.log["latency_ms"], [report.log["latency_ms"] - spread, report.log["latency_ms"] + spread]))
+    if report.board:
+        value, sd = report.board["latency_ms"], report.board["sd_ms"]
+        rows.append(("photodiode", value, [value - 1.96 * sd, value + 1.96 * sd]))
+    figure, axes = plt.subplots(figsize=(6.0, 0.8 + 0.6 * len(rows)))
+    for i, (name, value, interval) in enumerate(rows):
+        low, high = interval if interval else (value, value)
+        axes.errorbar([value], [i], xerr=[[value - low], [high - value]], fmt="o", capsize=4)
+        axes.annotate(f"{value:.1f} ms", (value, i), textcoords="offset points", xytext=(0, 8), ha="center")
+    axes.set_yticks(range(len(rows)), [name for name, _, _ in rows])
+    axes.set_ylim(-0.7, len(rows) - 0.3)
+    axes.set_xlabel("latency (ms): video 95 % interval, log +- 1 sd of frame delays, photodiode 95 %")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+    return path
+
+
+def measure(
+    config: LiveConfig,
+    camera_spec: str,
+    out_dir: Path,
+    *,
+    view: View | None = None,
+    options: VideoOptions = VideoOptions(),
+    board: Path | None = None,
+    accept_camera_settings: bool = False,
+    overwrite: bool = False,
+    progress: Callable[[float, float], None] | None = None,
+) -> MeasureReport:
+    """Run `config` live while `camera_spec` films it, then analyse (see the module docstring)."""
+    camera: OpenCvCamera = opencv_camera(camera_spec, out_dir, accept_refused=accept_camera_settings, overwrite=overwrite)
+    result = run_live(config, out_dir, view=view, camera=camera, overwrite=overwrite, progress=progress)
+    fps = camera.writer.measured_fps() if camera.writer else None
+    if camera.writer is None or camera.writer.frames < 2:
+        raise RigError(f"the camera {camera_spec} recorded no video; check it films while the run goes")
+    return analyse_run(out_dir, fps, options, board, result.summary)

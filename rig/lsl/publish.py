@@ -1,0 +1,137 @@
+"""The rig's LSL outlets (`rig.lsl.streams`): the predicted pose per display frame and the raw
+tracker stream, and the wrappers that feed them from a session without the session knowing.
+
+`PublishingTracker` wraps a tracker source: every sample the session takes is pushed on
+`RigTracker`. `PublishingRenderer` wraps a renderer: every pose it draws a display frame with (an
+application frame of a renderer that shows one image per frame, each composed frame of one that
+composes at every refresh) is pushed on `RigPose` with the photon time it was predicted for and
+the newest sample behind it. Pushing never blocks.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from predictors import Pose, PoseSample
+from rig.clock import Clock
+from rig.devices.trackers.lsl_tracker import CHANNELS, lsl_origin, pylsl
+from rig.lsl.streams import POSE_CHANNELS, POSE_UNITS, StreamNames, describe_channels
+from rig.render.protocol import AppFrameRequest, AppFrameResult, DisplayFrameRequest, DisplayFrameResult, Renderer, RenderSetup
+from rig.records import CsvRecord
+
+PUBLISHED_COLUMNS = ("frame", "t_published", *POSE_CHANNELS[1:])
+
+
+class LslPublisher:
+    """The outlets of one run (none where `names` is None: the poses are only recorded); `record`
+    (optional) gets every pose published, on the rig clock."""
+
+    def __init__(self, names: StreamNames | None, refresh_hz: float, record: CsvRecord | None = None) -> None:
+        self.names = names
+        self.refresh_hz = refresh_hz
+        self.newest_sensor_time = -math.inf
+        self._record = record
+        self._clock: Clock | None = None
+        self._origin = 0.0
+        self._pose: Any = None
+        self._tracker: Any = None
+
+    def open(self, clock: Clock, setup: RenderSetup) -> None:
+        self._clock = clock
+        if self.names is None:
+            return
+        lsl = pylsl()
+        self._origin = lsl_origin(clock)
+        source = f"latency-rig-{self.names.pose}"
+        pose = lsl.StreamInfo(self.names.pose, "Pose", len(POSE_CHANNELS), self.refresh_hz, lsl.cf_double64, source)
+        describe_channels(pose, POSE_CHANNELS, POSE_UNITS)
+        view = pose.desc().append_child("view")
+        view.append_child_value("world_to_clip", " ".join(repr(float(v)) for v in np.asarray(setup.world_to_clip).ravel()))
+        view.append_child_value("sphere_radius_m", repr(float(setup.sphere_radius_m)))
+        pose.desc().append_child_value("refresh_hz", repr(float(self.refresh_hz)))
+        tracker = lsl.StreamInfo(self.names.tracker, "MoCap", len(CHANNELS), 0.0, lsl.cf_double64, f"latency-rig-{self.names.tracker}")
+        describe_channels(tracker, CHANNELS, ("metres",) * 3 + ("normalised",) * 4)
+        self._pose = lsl.StreamOutlet(pose)
+        self._tracker = lsl.StreamOutlet(tracker)
+
+    def lsl_time(self, t: float) -> float:
+        """A rig time on the LSL clock."""
+        return t + self._origin
+
+    def samples(self, samples: list[PoseSample]) -> None:
+        for sample in samples:
+            if self._tracker is not None:
+                self._tracker.push_sample([*sample.position.tolist(), *sample.orientation.tolist()], self.lsl_time(sample.t_sensor))
+            self.newest_sensor_time = max(self.newest_sensor_time, sample.t_sensor)
+
+    def pose(self, frame: int, t_photon: float, pose: Pose) -> None:
+        now = self._clock.now()
+        values = [float(frame), self.lsl_time(t_photon), self.lsl_time(self.newest_sensor_time), *pose.position.tolist(),
+                  *pose.orientation.tolist()]  # fmt: skip
+        if self._pose is not None:
+            self._pose.push_sample(values, self.lsl_time(now))
+        if self._record is not None:
+            self._record.write([frame, now, t_photon, self.newest_sensor_time, *values[3:]])
+
+    def close(self) -> None:
+        self._pose = self._tracker = None
+
+
+class PublishingTracker:
+    """A tracker source whose samples are also pushed on the rig's tracker outlet."""
+
+    def __init__(self, tracker: Any, publisher: LslPublisher) -> None:
+        self.tracker = tracker
+        self.publisher = publisher
+
+    def connect(self, clock: Clock) -> None:
+        self.tracker.connect(clock)
+
+    def poll(self) -> list[PoseSample]:
+        samples = self.tracker.poll()
+        self.publisher.samples(samples)
+        return samples
+
+    def wait(self, timeout_s: float) -> list[PoseSample]:
+        samples = self.tracker.wait(timeout_s)
+        self.publisher.samples(samples)
+        return samples
+
+    def close(self) -> None:
+        self.tracker.close()
+
+
+class PublishingRenderer:
+    """A renderer whose display-frame poses are also pushed on the rig's pose outlet; the outlets
+    open with the renderer (they need its view) and close with it."""
+
+    def __init__(self, renderer: Renderer, publisher: LslPublisher, clock: Clock) -> None:
+        self.renderer = renderer
+        self.publisher = publisher
+        self.name = renderer.name
+        self.per_display_frame = renderer.per_display_frame
+        self._clock = clock
+
+    def open(self, setup: RenderSetup) -> None:
+        self.publisher.open(self._clock, setup)
+        self.renderer.open(setup)
+
+    def render_app_frame(self, request: AppFrameRequest) -> AppFrameResult:
+        result = self.renderer.render_app_frame(request)
+        if not self.per_display_frame:
+            self.publisher.pose(request.index, request.t_photon, result.pose)
+        return result
+
+    def render_display_frame(self, request: DisplayFrameRequest) -> DisplayFrameResult:
+        result = self.renderer.render_display_frame(request)
+        self.publisher.pose(request.index, request.t_photon, result.pose)
+        return result
+
+    def close(self) -> None:
+        try:
+            self.renderer.close()
+        finally:
+            self.publisher.close()
