@@ -102,6 +102,21 @@ class Trace:
             raise PredictorError(f"trace {self.name!r}: t_arrival must be {t.size} finite times")
         return replace(self, t=t, t_arrival=t_arrival, position=position, orientation=orientation)
 
+    def order_faults(self) -> tuple[int, int]:
+        """(samples earlier than the one before them, samples at the time of the one before them),
+        by sensor time in file order: a recording's clock went back, or it logged a time twice."""
+        steps = np.diff(self.t)
+        return int(np.count_nonzero(steps < 0.0)), int(np.count_nonzero(steps == 0.0))
+
+    def in_time_order(self) -> Trace:
+        """The samples sorted by sensor time, each repeated time kept once (the last one in the
+        file, as the truth keeps it); arrival times travel with their samples."""
+        order = np.argsort(self.t, kind="stable")
+        t = self.t[order]
+        keep = order[np.append(t[1:] != t[:-1], True)]
+        return replace(self, t=self.t[keep], t_arrival=self.t_arrival[keep], position=self.position[keep],
+                       orientation=self.orientation[keep])
+
     def covers(self, times: np.ndarray) -> np.ndarray:
         """Which times lie within the truth's time span."""
         return (times >= self.truth_t[0]) & (times <= self.truth_t[-1])

@@ -149,8 +149,11 @@ class _Fit:
     angular_scale: float
 
 
+Progress = Callable[[float, float], object]  # called as progress(done, total)
+
+
 def _fit(predictor: str, traces: Sequence[Trace], horizon_s: float, params: Mapping[str, Any],
-         max_iterations: int) -> _Fit:
+         max_iterations: int, progress: Callable[[int], object] | None = None) -> _Fit:
     """Fit a JAX-twinned predictor's parameters (see the module docstring) by gradient."""
     model = _Parameterisation(predictor, params)
     arrays, true_p, true_q, scored = _stacked(traces, horizon_s)
@@ -174,7 +177,7 @@ def _fit(predictor: str, traces: Sequence[Trace], horizon_s: float, params: Mapp
         position, angular = errors(x)
         return position_scale * position + angular_scale * angular
 
-    best = minimise(loss, x0, max_iterations=max_iterations)
+    best = minimise(loss, x0, max_iterations=max_iterations, progress=progress)
     fitted = model.natural(best.x)
     scales = {"position": position_scale, "orientation": angular_scale, "pose": max(position_scale, angular_scale)}
     informed = tuple(param.name for param in model.trained if scales[param.acts_on] > 0.0)
@@ -202,22 +205,33 @@ def _replayed_loss(predictor: str, params: Mapping[str, Any], traces: Sequence[T
     return (position_scale * position + angular_scale * angular) / max(count, 1)
 
 
-def _tune_auto(traces: Sequence[Trace], horizon_s: float, params: Mapping[str, Any], max_iterations: int) -> TuneResult:
+def _tune_auto(traces: Sequence[Trace], horizon_s: float, params: Mapping[str, Any], max_iterations: int,
+               progress: Progress | None) -> TuneResult:
     """auto's filters as kalman-cv's by gradient, then memory and margin on a grid (module docstring)."""
     start = params_of("auto").resolve(params)
+    axes = [sorted({*grid, start[name]}) for name, grid in AUTO_GRIDS.items()]
+    total = max_iterations + math.prod(len(axis) for axis in axes)
     filter_names = params_of("kalman-cv").names
     shared = {name: value for name, value in params.items() if name in filter_names}
-    filters = _fit("kalman-cv", traces, horizon_s, shared, max_iterations)
+    filters = _fit("kalman-cv", traces, horizon_s, shared, max_iterations, _iterations(progress, total))
     scales = (filters.position_scale, filters.angular_scale)
     fitted = {name: filters.result.params[name] for name in filters.result.fitted}
-    axes = [sorted({*grid, start[name]}) for name, grid in AUTO_GRIDS.items()]
     candidates = [{**params, **fitted, **dict(zip(AUTO_GRIDS, point))} for point in itertools.product(*axes)]
-    losses = [_replayed_loss("auto", candidate, traces, horizon_s, *scales) for candidate in candidates]
+    losses = []
+    for k, candidate in enumerate(candidates):
+        losses.append(_replayed_loss("auto", candidate, traces, horizon_s, *scales))
+        if progress is not None:
+            progress(max_iterations + k + 1, total)
     best = int(np.argmin(losses))
     return TuneResult(
         "auto", candidates[best], (*filters.result.fitted, *AUTO_GRIDS), float(horizon_s),
         _replayed_loss("auto", params, traces, horizon_s, *scales), losses[best], filters.result.iterations,
     )
+
+
+def _iterations(progress: Progress | None, total: int) -> Callable[[int], object] | None:
+    """The optimiser's per-iteration callback reporting to `progress` out of `total` steps."""
+    return None if progress is None else lambda done: progress(done, total)
 
 
 def tune(
@@ -226,9 +240,11 @@ def tune(
     horizon_s: float,
     params: Mapping[str, Any] | None = None,
     max_iterations: int = 40,
+    progress: Progress | None = None,
 ) -> TuneResult:
     """Fit `predictor`'s parameters (starting from `params`, else its defaults) to predict the
-    training `traces` `horizon_s` seconds ahead, in float64 whatever the caller's JAX setting."""
+    training `traces` `horizon_s` seconds ahead, in float64 whatever the caller's JAX setting.
+    `progress(done, total)` is told of each optimiser iteration (and, for auto, grid point)."""
     if predictor not in TUNABLE:
         raise PredictorError(f"cannot tune {predictor!r}; tunable predictors: {', '.join(TUNABLE)}")
     if not traces:
@@ -237,5 +253,5 @@ def tune(
         raise PredictorError(f"the horizon must be zero or a positive number of seconds, got {horizon_s!r}")
     with jax.enable_x64(True):
         if predictor == "auto":
-            return _tune_auto(traces, horizon_s, params or {}, max_iterations)
-        return _fit(predictor, traces, horizon_s, params or {}, max_iterations).result
+            return _tune_auto(traces, horizon_s, params or {}, max_iterations, progress)
+        return _fit(predictor, traces, horizon_s, params or {}, max_iterations, _iterations(progress, max_iterations)).result

@@ -1,36 +1,77 @@
-"""`rig tune`: fit a predictor's parameters to recorded motion and report held-out error.
+"""`rig tune`: fit a predictor's parameters to recorded motion, check them on motion held out, and
+write them only if they beat the defaults there.
 
-Training traces are the --trace files; held-out traces are the --held-out files, or, without any,
-the last part of each training trace (--split says how much is kept for training). The fitted
-parameters go to --out (see `rig.service.tune`).
+Each --trace is split in time: its first --split to train on, the rest to validate on (or the
+--held-out files are the validation). Prints training and validation RMS errors of the tuned
+parameters, the defaults, constant velocity and the default predictor (see `rig.service.tune`).
+Exit status 0 when the parameters were written, 1 when they lost to the defaults on validation and
+were not (--force writes them anyway), 2 for a usage error, such as a trace out of time order
+(--repair sorts it).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import sys
 from pathlib import Path
 
-from predictors import read_trace
+from predictors import Trace, read_trace
 from rig.commands import options
-from rig.service import split_traces, tune
+from rig.progress import ProgressBar
+from rig.service import TuneReport, split_traces, tune
+from rig.service.tune import PARTS, in_time_order
+
+EXIT_NOT_WRITTEN = 1
+
+
+def _read(paths: list[Path], repair: bool) -> tuple[list[Trace], list[str]]:
+    traces, repaired = [], []
+    for path in paths:
+        trace, note = in_time_order(read_trace(path), repair)
+        traces.append(trace)
+        if note is not None:
+            repaired.append(note)
+    return traces, repaired
+
+
+def _table(report: TuneReport) -> str:
+    rows = [f"RMS error at {report.horizon_ms:g} ms         training (deg, mm)    validation (deg, mm)"]
+    for key, label in report.labels.items():
+        cells = "   ".join(
+            f"{report.errors[part][key]['angular_rms_deg']:8.4f} {report.errors[part][key]['position_rms_mm']:9.4f}" for part in PARTS
+        )
+        rows.append(f"  {label:28s} {cells}")
+    return "\n".join(rows)
 
 
 def _run(args: argparse.Namespace) -> int:
-    traces = [read_trace(path) for path in args.trace]
-    held_out = [read_trace(path) for path in args.held_out or []]
-    train, held_out = split_traces(traces, held_out, args.split)
+    traces, repaired = _read(args.trace, args.repair)
+    held_out, repaired_held_out = _read(args.held_out or [], args.repair)
+    train, validation = split_traces(traces, held_out, args.split)
     name, start = args.predictor
-    print(f"tuning {name} at {args.horizon_ms:g} ms on {sum(len(t) for t in train)} samples ...", flush=True)
-    report = tune(name, start, train, held_out, args.horizon_ms / 1e3, args.max_iterations)
+    say = (lambda line: print(line, file=sys.stderr)) if args.json else print
+    for note in repaired + repaired_held_out:
+        say(f"repaired {note}")
+    say(f"tuning {name} at {args.horizon_ms:g} ms on {sum(len(t) for t in train)} samples, validating on "
+        f"{sum(len(t) for t in validation)} ...")
+    report = tune(name, start, train, validation, args.horizon_ms / 1e3, args.max_iterations,
+                  ProgressBar(f"tuning {name}"), repaired + repaired_held_out)
     fit = report.fit
     fitted = ", ".join(f"{k}={fit.params[k]:.6g}" for k in fit.fitted) or "nothing (no motion to fit)"
-    print(f"fitted {fitted}; training loss {fit.loss_before:.4g} -> {fit.loss_after:.4g} in {fit.iterations} iterations")
-    print(f"held-out RMS error at {args.horizon_ms:g} ms ({report.held_out_samples} samples):")
-    for label, rms in report.comparison.items():
-        print(f"  {label:24s} {rms['angular_rms_deg']:.4f} deg  {rms['position_rms_mm']:.4f} mm")
-    report.write(args.out, args.horizon_ms)
-    print(f"wrote {args.out}")
-    return 0
+    say(f"fitted {fitted}; training loss {fit.loss_before:.4g} -> {fit.loss_after:.4g} in {fit.iterations} iterations")
+    say(_table(report))
+    say(f"validation error of the tuned parameters over the defaults': {report.validation_loss:.4f} (the tuning loss; below 1 is better)")
+    written = report.beats_defaults or args.force
+    if written:
+        report.write(args.out)
+        say(f"wrote {args.out}" + ("" if report.beats_defaults else " (--force: they lose to the defaults on validation)"))
+    else:
+        say(f"not written: the tuned parameters predict the validation part worse than {name}'s defaults; "
+            "keep the defaults, tune on more motion, or pass --force to write them anyway")
+    if args.json:
+        print(json.dumps({**report.to_dict(), "out": str(args.out), "written": written}))
+    return 0 if written else EXIT_NOT_WRITTEN
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -38,15 +79,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "tune",
         help="fit a predictor's parameters (Kalman noise ratios and damping, DESP's smoothing, auto's "
-        "choice) to recorded motion",
+        "choice) to recorded motion; keep them only if they beat the defaults on motion held out",
         description=__doc__.split("\n\n")[0] + " Tunable: kalman-cv, kalman-ca, desp, auto.",
     )
     parser.add_argument("predictor", type=options.predictor_spec, metavar="PREDICTOR[:key=value,...]",
                         help="predictor to tune, with starting or fixed parameters (e.g. the tracker's noise)")
     parser.add_argument("--trace", type=Path, action="append", required=True, metavar="FILE",
-                        help="training trace CSV; repeat for several")
+                        help="trace CSV; repeat for several")
     parser.add_argument("--held-out", type=Path, action="append", metavar="FILE",
-                        help="held-out trace CSV; repeat for several (default: the end of each training trace)")
+                        help="validation trace CSV; repeat for several (default: the end of each --trace)")
     parser.add_argument("--split", type=options.positive_float, default=0.6,
                         help="fraction of each trace's duration to train on when no --held-out is given (default: %(default)s)")
     parser.add_argument("--horizon-ms", type=options.non_negative_float, required=True,
@@ -54,4 +95,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--max-iterations", type=options.non_negative_int, default=40,
                         help="optimiser iterations at most (default: %(default)s)")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE.json", help="parameter file to write")
+    parser.add_argument("--force", action="store_true", help="write the parameters even if they lose to the defaults on validation")
+    parser.add_argument("--repair", action="store_true",
+                        help="sort a trace that is out of time order and drop repeated times, instead of refusing it")
+    parser.add_argument("--json", action="store_true", help="print the report as one JSON object (the rest goes to stderr)")
     parser.set_defaults(func=_run)

@@ -1,87 +1,176 @@
-"""Fit a predictor's parameters to recorded motion, and report its error on motion held out.
+"""Fit a predictor's parameters to recorded motion, check them on motion held out, and keep them only
+if they do better there than the defaults.
 
-Training traces are given; held-out traces are given too, or, without any, the last part of each
-training trace (`split` says how much is kept for training). The fitted parameters are written as
-a file that `rig simulate --predictor NAME:FILE.json`, `rig bench predictors --predictor
-NAME:FILE.json` and `predictors.make(name, **predictors.read_params(FILE)[1])` accept.
+Each trace is split in time: its first part (`split` of its duration) to train on, the rest to
+validate on; or the validation traces are given. The fitted parameters, the predictor's defaults
+(with any parameter the user fixed), constant velocity (`slerp`) and the default predictor are
+each scored on both parts. The tuned parameters *lose* when their validation error, relative to
+the defaults' (the mean over orientation and, where the traces move, position of the ratio of
+mean squared errors: the tuning loss), is above 1; the command then writes nothing unless forced.
+
+The parameter file is what `rig simulate --predictor NAME:FILE.json`, `rig bench predictors
+--predictor NAME:FILE.json` and `predictors.make(name, **predictors.read_params(FILE)[1])` accept.
+
+Traces must be in time order without a repeated time: a recording whose clock went back or logged
+a time twice is refused with the first place it happened, or put in order (`repair`): sorted by
+time, a repeated time kept once (its last sample).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
-from predictors import Trace, evaluate, write_params
+import numpy as np
+
+from predictors import DEFAULT, Trace, evaluate, resolve, write_params
+from rig.errors import ConfigError
 
 if TYPE_CHECKING:
     from predictors.tuning import TuneResult
 
 COMPARED_WITH = "slerp"
-"""The baseline the tuned predictor is compared with on the held-out traces."""
+"""The baseline: constant velocity from the last two samples."""
+
+PARTS = ("training", "validation")
 
 
-@dataclass(frozen=True)
-class TuneReport:
-    """The fit (`predictors.tuning.TuneResult`) and the held-out RMS errors of the tuned predictor,
-    its starting parameters and the baseline, each {"angular_rms_deg", "position_rms_mm"}."""
-
-    fit: TuneResult
-    train: list[str]
-    held_out: list[str]
-    held_out_samples: int
-    comparison: dict[str, dict[str, float]]
-
-    def write(self, path: Path, horizon_ms: float) -> None:
-        write_params(
-            path,
-            self.fit.predictor,
-            self.fit.params,
-            horizon_ms=horizon_ms,
-            fitted=list(self.fit.fitted),
-            train=self.train,
-            held_out={"traces": self.held_out, **self.comparison},
+def in_time_order(trace: Trace, repair: bool) -> tuple[Trace, str | None]:
+    """The trace, or with `repair` its samples in time order (and what was repaired); ConfigError
+    naming the first fault otherwise."""
+    backward, repeated = trace.order_faults()
+    if not backward and not repeated:
+        return trace, None
+    steps = np.diff(trace.t)
+    first = int(np.argmax(steps <= 0.0)) + 1
+    what = f"{backward} sample(s) earlier than the one before and {repeated} at the same time as the one before"
+    if not repair:
+        raise ConfigError(
+            f"trace {trace.name!r} is not in time order: {what} (first: sample {first}, t={trace.t[first]!r} s after "
+            f"{trace.t[first - 1]!r} s); sort it by time and drop repeated times, or pass --repair"
         )
-
-
-def held_out_rms(name: str, params: dict[str, Any], traces: Sequence[Trace], horizon_s: float) -> dict[str, float]:
-    """Angular (deg) and position (mm) RMS error over the traces, weighted by count."""
-    scores = [evaluate(name, trace, [horizon_s], params, timing_repeats=1).scores[0] for trace in traces]
-    count = sum(s.count for s in scores)
-    angular = (sum(s.count * s.angular_rms_deg**2 for s in scores) / count) ** 0.5
-    position = (sum(s.count * s.position_rms_mm**2 for s in scores) / count) ** 0.5
-    return {"angular_rms_deg": angular, "position_rms_mm": position}
+    repaired = trace.in_time_order()
+    return repaired, f"{trace.name}: {what}; sorted by time, {len(trace) - len(repaired)} repeated time(s) dropped"
 
 
 def split_traces(traces: Sequence[Trace], held_out: Sequence[Trace], split: float) -> tuple[list[Trace], list[Trace]]:
-    """(training, held-out): the given held-out traces, else the end of each training trace."""
+    """(training, validation): the given held-out traces, else the end of each training trace."""
     if held_out:
         return list(traces), list(held_out)
     halves = [trace.split(split) for trace in traces]
     return [h[0] for h in halves], [h[1] for h in halves]
 
 
+def rms_errors(name: str, params: dict[str, Any], traces: Sequence[Trace], horizon_s: float) -> dict[str, float]:
+    """Angular (deg) and position (mm) RMS error over the traces, weighted by count."""
+    scores = [evaluate(name, trace, [horizon_s], params, timing_repeats=0).scores[0] for trace in traces]
+    count = sum(s.count for s in scores)
+    angular = (sum(s.count * s.angular_rms_deg**2 for s in scores) / count) ** 0.5
+    position = (sum(s.count * s.position_rms_mm**2 for s in scores) / count) ** 0.5
+    return {"angular_rms_deg": angular, "position_rms_mm": position}
+
+
+def relative_loss(errors: dict[str, float], reference: dict[str, float]) -> float:
+    """The tuning loss of `errors` over `reference`'s: the mean ratio of mean squared errors over the
+    parts the reference has any error in (1 where it has none)."""
+    ratios = [(errors[k] / reference[k]) ** 2 for k in ("angular_rms_deg", "position_rms_mm") if reference[k] > 0.0]
+    return sum(ratios) / len(ratios) if ratios else 1.0
+
+
+@dataclass(frozen=True)
+class TuneReport:
+    """The fit, and the RMS errors on training and validation of the tuned parameters, the
+    defaults, constant velocity and the default predictor: errors[part][label] =
+    {"angular_rms_deg", "position_rms_mm"}; `validation_loss` is the tuned parameters' relative to
+    the defaults' on validation (below 1 is better)."""
+
+    fit: TuneResult
+    horizon_ms: float
+    labels: dict[str, str]
+    samples: dict[str, int]
+    traces: dict[str, list[str]]
+    errors: dict[str, dict[str, dict[str, float]]]
+    validation_loss: float
+    repaired: list[str] = field(default_factory=list)
+
+    @property
+    def beats_defaults(self) -> bool:
+        """Whether the tuned parameters predict the validation part at least as well as the defaults."""
+        return self.validation_loss <= 1.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-ready values."""
+        fit = self.fit
+        return {
+            "predictor": fit.predictor,
+            "horizon_ms": self.horizon_ms,
+            "labels": self.labels,
+            "params": fit.params,
+            "fitted": list(fit.fitted),
+            "training_loss": {"before": fit.loss_before, "after": fit.loss_after, "iterations": fit.iterations},
+            "samples": self.samples,
+            "traces": self.traces,
+            "errors": self.errors,
+            "validation_loss_over_defaults": self.validation_loss,
+            "beats_defaults": self.beats_defaults,
+            "repaired": self.repaired,
+        }
+
+    def write(self, path: Path) -> None:
+        """The parameter file, with what it was fitted on and how well it did."""
+        fit = self.fit
+        write_params(
+            path, fit.predictor, fit.params, horizon_ms=self.horizon_ms, fitted=list(fit.fitted),
+            traces=self.traces, errors=self.errors, validation_loss_over_defaults=self.validation_loss,
+        )
+
+
 def tune(
     name: str,
     start: dict[str, Any],
     train: Sequence[Trace],
-    held_out: Sequence[Trace],
+    validation: Sequence[Trace],
     horizon_s: float,
     max_iterations: int,
+    progress: Callable[[float, float], object] | None = None,
+    repaired: Sequence[str] = (),
 ) -> TuneReport:
-    """Fit `name` from `start` on `train` at `horizon_s`; score it on `held_out`."""
+    """Fit `name` from `start` on `train` at `horizon_s` and score it, its starting parameters, the
+    baseline and the default predictor on both parts; `progress(done, total)` follows the fit and
+    the scoring."""
     from predictors.tuning import tune as fit  # imports JAX: only when tuning
 
-    result = fit(name, list(train), horizon_s, start, max_iterations=max_iterations)
-    comparison = {
-        f"{name} tuned": held_out_rms(name, result.params, held_out, horizon_s),
-        f"{name} start": held_out_rms(name, start, held_out, horizon_s),
-        COMPARED_WITH: held_out_rms(COMPARED_WITH, {}, held_out, horizon_s),
+    scoring_steps = len(PARTS) * 4
+    fit_steps = [max_iterations]
+
+    def fitting(done: float, total: float) -> None:
+        fit_steps[0] = int(total)
+        if progress is not None:
+            progress(done, total + scoring_steps)
+
+    result = fit(name, list(train), horizon_s, start, max_iterations=max_iterations, progress=fitting)
+    labels = {
+        "tuned": f"{name} tuned",
+        "defaults": f"{name} defaults",
+        "baseline": f"{COMPARED_WITH} (constant velocity)",
+        "default": f"{DEFAULT} ({resolve(DEFAULT)})",
     }
+    specs = {"tuned": (name, result.params), "defaults": (name, start), "baseline": (COMPARED_WITH, {}), "default": (DEFAULT, {})}
+    errors: dict[str, dict[str, dict[str, float]]] = {}
+    for part, traces in zip(PARTS, (train, validation)):
+        errors[part] = {}
+        for key, (predictor, params) in specs.items():
+            errors[part][key] = rms_errors(predictor, params, traces, horizon_s)
+            if progress is not None:
+                progress(fit_steps[0] + len(errors) * len(specs) - len(specs) + len(errors[part]), fit_steps[0] + scoring_steps)
     return TuneReport(
         fit=result,
-        train=[t.name for t in train],
-        held_out=[t.name for t in held_out],
-        held_out_samples=sum(len(t) for t in held_out),
-        comparison=comparison,
+        horizon_ms=1e3 * horizon_s,
+        labels=labels,
+        samples={"training": sum(len(t) for t in train), "validation": sum(len(t) for t in validation)},
+        traces={"training": [t.name for t in train], "validation": [t.name for t in validation]},
+        errors=errors,
+        validation_loss=relative_loss(errors["validation"]["tuned"], errors["validation"]["defaults"]),
+        repaired=list(repaired),
     )

@@ -124,3 +124,15 @@ def test_parameter_files_round_trip_and_reject_other_json(tmp_path):
     (tmp_path / "other.json").write_text("[1, 2]")
     with pytest.raises(PredictorError, match="not a predictor parameter file"):
         read_params(tmp_path / "other.json")
+
+
+def test_order_faults_count_backward_steps_and_repeated_times_and_in_time_order_mends_them():
+    t = np.array([0.0, 0.02, 0.01, 0.03, 0.03, 0.04])
+    position = np.outer(np.arange(6.0), [1.0, 0.0, 0.0])
+    trace = Trace.from_samples("faulty", t, position, np.tile([1.0, 0.0, 0.0, 0.0], (6, 1)), t_arrival=t + 0.5)
+    assert trace.order_faults() == (1, 1)
+    mended = trace.in_time_order()
+    assert mended.order_faults() == (0, 0)
+    np.testing.assert_array_equal(mended.t, [0.0, 0.01, 0.02, 0.03, 0.04])
+    np.testing.assert_array_equal(mended.position[:, 0], [0.0, 2.0, 1.0, 4.0, 5.0])  # the later of the repeated time
+    np.testing.assert_array_equal(mended.t_arrival, mended.t + 0.5)
