@@ -30,6 +30,8 @@ COMMANDS = (
     "record_tracker",
     "devices",
     "emulate",
+    "record",
+    "measure",
 )
 """The command modules in rig.commands, in the order `rig --help` lists them."""
 EXIT_USER_ERROR = 2

@@ -6,7 +6,10 @@
 The scheme names a factory registered for the kind (tracker, display, camera); the address, the
 rest of the spec, goes to it. Built in: `sim` for every kind, the simulated twins of `rig.sim`,
 which exist only inside a simulated run; for trackers also `serial:URL`, `hid:VID:PID[:PROFILE]`
-and `lsl:NAME`, the real trackers of `rig.devices.trackers`. Third-party devices are entry points
+and `lsl:NAME`, the real trackers of `rig.devices.trackers`; for displays `window[:MONITOR][?...]`, an
+on-screen window (`rig.devices.window`); for cameras `camera:SOURCE[?...]`, a device, file or stream
+read with OpenCV (`rig.devices.camera`), which writes its frames into the context's `out_dir`.
+Third-party devices are entry points
 in the groups `rig.trackers`, `rig.displays` and `rig.cameras` (see `rig.plugins`): a callable
 taking `(address, context)` and returning an unconnected device that satisfies the kind's protocol
 in `rig.devices.protocols`.
@@ -15,13 +18,16 @@ in `rig.devices.protocols`.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
+from rig.devices.camera.opencv_camera import OpenCvCamera, opencv_camera
 from rig.devices.protocols import Camera, Display, TrackerSource
 from rig.devices.trackers.hid_tracker import hid_tracker
 from rig.devices.trackers.lsl_tracker import lsl_tracker
 from rig.devices.trackers.serial_tracker import serial_tracker
 from rig.devices.trackers.stream import TrackerStream
+from rig.devices.window.spec import window_display
 from rig.errors import ConfigError, RigError
 from rig.plugins import load_plugin, plugin_names
 
@@ -32,9 +38,10 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class DeviceContext:
     """What a device factory may need beyond its address: the simulated world a `sim` twin lives in
-    (None in a live run)."""
+    (None in a live run), and the folder a device that records its own data writes into."""
 
     simulation: SimulatedWorld | None = None
+    out_dir: Path | None = None
 
 
 DeviceFactory = Callable[[str, DeviceContext], Any]
@@ -52,6 +59,12 @@ class DeviceKind:
 
 def _real_tracker(make: Callable[[str], TrackerStream]) -> DeviceFactory:
     return lambda address, context: make(address)
+
+
+def _camera(address: str, context: DeviceContext) -> OpenCvCamera:
+    if context.out_dir is None:
+        raise ConfigError("a camera writes its frames as they come: it needs an output folder")
+    return opencv_camera(address, context.out_dir)
 
 
 def _simulated(kind: str) -> DeviceFactory:
@@ -79,8 +92,10 @@ KINDS: dict[str, DeviceKind] = {
                 "lsl": _real_tracker(lsl_tracker),
             },
         ),
-        DeviceKind("display", "rig.displays", Display, {"sim": _simulated("display")}),
-        DeviceKind("camera", "rig.cameras", Camera, {"sim": _simulated("camera")}),
+        DeviceKind(
+            "display", "rig.displays", Display, {"sim": _simulated("display"), "window": lambda a, c: window_display(a)}
+        ),
+        DeviceKind("camera", "rig.cameras", Camera, {"sim": _simulated("camera"), "camera": _camera}),
     )
 }
 

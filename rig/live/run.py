@@ -8,7 +8,8 @@ photon time it was predicted for and the newest sample behind it, also pushed on
 LSL outlet), the display's own log (`display_swaps.csv` for a window, `renderer_markers.csv` for an
 external renderer) and at the end `live.json` (devices, timing sources, counts, why it ended).
 Every row is written as it happens. A `Watchdog` instrument ends the run with a clear message when
-the tracker or the camera goes away (what was recorded stays); so does closing the window.
+the tracker or the camera goes away (what was recorded stays); so does closing the window. With
+`until_still` the run also ends, normally, once the pendulum has stopped swinging.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from rig.devices.registry import DeviceContext, make_device
 from rig.devices.trackers.stream import TrackerStream
 from rig.devices.window import SWAP_COLUMNS, FrameClock, WindowDisplay, WindowSettings
 from rig.errors import ConfigError, RigError
+from rig.live.still import RunEnded, SwingWatch
 from rig.live.view import View, view_from_positions
 from rig.lsl import MARKER_COLUMNS, PUBLISHED_COLUMNS, ExternalRenderer, LslPublisher, MarkerDisplay, PublishingRenderer
 from rig.lsl import PublishingTracker, StreamNames
@@ -63,6 +65,8 @@ class LiveConfig:
     scene_triangles: int = 0
     streams: StreamNames | None = StreamNames()
     mirror: bool = False
+    until_still: bool = False
+    """End when the pendulum has stopped swinging (`rig.live.still`), if before the duration."""
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.duration_s) and self.duration_s > 0):
@@ -82,8 +86,12 @@ class Watchdog:
     is open (and tells `on_connected`), and ends the run when a device has gone: a tracker whose link
     was lost and has stayed silent, a camera that stopped delivering."""
 
-    def __init__(self, tracker: Any, camera: Camera | None, display: Display, on_connected: Callable[[Display], None]) -> None:
+    def __init__(
+        self, tracker: Any, camera: Camera | None, display: Display, on_connected: Callable[[Display], None],
+        swing: SwingWatch | None = None,
+    ) -> None:  # fmt: skip
         self._tracker = tracker
+        self._swing = swing
         self._camera = camera
         self._display = display
         self._on_connected = on_connected
@@ -96,6 +104,8 @@ class Watchdog:
             self._camera.connect(clock)
 
     def poll(self) -> None:
+        if self._swing is not None and self._swing.stopped:
+            raise RunEnded("the pendulum stopped swinging")
         stream = self._tracker
         if isinstance(stream, TrackerStream) and stream.events and stream.events[-1].what == "lost":
             if self._clock.now() - stream.events[-1].t > TRACKER_SILENCE_S:
@@ -169,25 +179,28 @@ def run_live(
                                     swap_log=lambda swap: swaps.write(swap.row()))  # fmt: skip
         publisher = LslPublisher(config.streams, display.refresh_hz, published)
         tracker = make_device("tracker", config.tracker, DeviceContext())
+        swing = SwingWatch(tracker) if config.until_still else None
         renderer = ExternalRenderer() if external else make_renderer(config.renderer)
         setup = RenderSetup(width=display.width, height=display.height, world_to_clip=view.world_to_clip,
                             sphere_radius_m=view.sphere_radius_m, scene_triangles=config.scene_triangles, wait_for_gpu=True)  # fmt: skip
         parts = SessionParts(
             clock=clock,
-            tracker=PublishingTracker(tracker, publisher),
+            tracker=PublishingTracker(swing or tracker, publisher),
             predictor=predictors.make(config.predictor),
             renderer=PublishingRenderer(renderer, publisher, clock),
             render_setup=setup,
             timing=timing_for(renderer, cost_model(None)),
             app_cost=cost_model(None),
             display=display,
-            instruments=[Watchdog(tracker, camera, display, on_connected)],
+            instruments=[Watchdog(tracker, camera, display, on_connected, swing)],
             target=PhotonTarget(config.photon_target, config.persistence),
         )
         try:
             with RunRecord(out_dir, None, overwrite=overwrite) as record:
                 Session(parts, clock.now(), clock.now() + config.duration_s, record, progress, from_connect=True).run()
             ended = "completed"
+        except RunEnded as reason:
+            ended = str(reason)
         except RigError as error:
             ended = str(error)
             raise

@@ -1,0 +1,158 @@
+"""`rig measure`: measure a real system's latency: the live rig and a camera together, then the video.
+
+    rig measure --tracker SPEC --camera SPEC [--renderer warp|direct|external] [--duration S] --out DIR
+    rig measure --self-test [--external] [--json]
+
+The rig runs live (tracker, predictor, renderer, an on-screen window; or an external renderer over
+LSL) while the camera films the pendulum's LED and the screen; then the video is analysed and the
+latency printed with its 95 % interval beside the rig's own log's answer (and, with --board DIR,
+the photodiode's). Everything is in DIR: the run's logs as they were written, the video, and
+measure.json and measure.png with all three answers. --guided says what to do and checks the first
+seconds of video before the long run. --self-test runs the whole chain with stand-ins (an emulated
+tracker, a frame clock, a camera twin reading the window back) under an X display such as xvfb-run,
+and checks that the video and the log agree.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from rig.commands import options
+from rig.commands.record import CAMERA_SPECS, add_camera_options
+from rig.devices.window.spec import parse_window_address
+from rig.errors import ConfigError
+from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, VideoOptions, measure
+from rig.live.record import check_first_seconds, record_camera
+from rig.live.run import EXTERNAL, LiveConfig
+from rig.lsl import StreamNames
+from rig.progress import ProgressBar
+
+CHECK_SECONDS = 3.0
+EXIT_DISAGREE = 1
+GUIDE = (
+    "1. Set the pendulum swinging (a hand's width to each side) with the tracker and the LED on it.",
+    "2. Point the camera at the LED and at the monitor the rig draws on; both in view, nothing else bright.",
+    "3. The rig will film a few seconds and check them before the long run.",
+)
+
+
+def _interval(ci: Any) -> str:
+    return f", 95% CI [{ci[0]:.1f}, {ci[1]:.1f}] ms" if ci else ", no interval"
+
+
+def _lines(report: MeasureReport) -> list[str]:
+    video, log = report.video, report.log
+    lines = [
+        f"latency (video): {video['latency_ms']:.1f} ms{_interval(video['ci95_ms'])} by {video['method']}",
+        f"latency (rig log): {log['latency_ms']:.1f} ms (sensor to photon per frame: mean {log['sensor_to_photon_ms']['mean']:.1f} ms, "
+        f"sd {log['sensor_to_photon_ms']['sd']:.1f} ms, {log['frames']} frames)",
+    ]
+    if report.board:
+        lines.append(f"latency (photodiode): {report.board['latency_ms']:.1f} +- {report.board['sd_ms']:.1f} ms")
+    lines += [f"warning: {warning}" for warning in video.get("warnings", [])]
+    check = report.run.get("self_test")
+    if check:
+        verdict = "agree" if check["agree"] else "DISAGREE"
+        lines.append(f"self-test: video and log differ by {check['difference_ms']:+.2f} ms (tolerance {check['tolerance_ms']:g} ms): {verdict}")
+    lines.append(f"wrote {report.out_dir / MEASURE_FILE} and {report.out_dir / PLOT_FILE}")
+    return lines
+
+
+def _print(report: MeasureReport, as_json: bool) -> int:
+    print(json.dumps(report.to_dict(), default=str) if as_json else "\n".join(_lines(report)))
+    check = report.run.get("self_test")
+    return EXIT_DISAGREE if check and not check["agree"] else 0
+
+
+def _self_test(args: argparse.Namespace) -> int:
+    from rig.live.selftest.run import self_test
+
+    duration = args.duration or 20.0
+    bar = ProgressBar("self-test")
+    if args.out is not None:
+        return _print(self_test(args.out, duration, external=args.external, overwrite=args.overwrite, progress=bar), args.json)
+    with tempfile.TemporaryDirectory(prefix="rig-measure-self-test-") as scratch:
+        return _print(self_test(Path(scratch), duration, external=args.external, progress=bar), args.json)
+
+
+def _guided_check(args: argparse.Namespace) -> None:
+    for step in GUIDE:
+        print(step, file=sys.stderr)
+    while True:
+        folder = args.out / "check"
+        record_camera(args.camera.removeprefix("camera:"), CHECK_SECONDS, folder, overwrite=True,
+                      accept_refused=args.accept_camera_settings)  # fmt: skip
+        problems = check_first_seconds(folder / "video.avi", args.led_side)
+        if not problems:
+            print(f"the first {CHECK_SECONDS:g} s look right: both blobs found, exposure not saturated", file=sys.stderr)
+            return
+        for problem in problems:
+            print(f"check: {problem}", file=sys.stderr)
+        if not sys.stdin.isatty():
+            raise ConfigError("the guided check of the first seconds failed (see above); fix the bench and run again")
+        input("fix it, then press Enter to check again (Ctrl-C to stop) ")
+
+
+def _run(args: argparse.Namespace) -> int:
+    if args.self_test:
+        return _self_test(args)
+    missing = [name for name in ("tracker", "camera", "out") if getattr(args, name) is None]
+    if missing:
+        raise ConfigError(f"rig measure needs --{', --'.join(missing)} (or --self-test)")
+    settings, scanout = parse_window_address(args.display.removeprefix("window").removeprefix(":"))
+    config = LiveConfig(
+        tracker=args.tracker, renderer=EXTERNAL if args.external else args.renderer, predictor=args.predictor,
+        duration_s=args.duration or 60.0, window=settings, scanout_fraction=scanout, photon_target=args.photon_target,
+        streams=None if args.no_lsl else StreamNames(args.pose_stream, args.tracker_stream, args.marker_stream),
+        mirror=args.mirror, until_still=args.until_still,
+    )  # fmt: skip
+    if args.guided:
+        _guided_check(args)
+        print("4. Filming: keep the pendulum swinging and the camera still.", file=sys.stderr)
+    report = measure(
+        config, args.camera.removeprefix("camera:"), args.out, board=args.board,
+        options=VideoOptions(args.led_roi, args.sphere_roi, args.led_side),
+        accept_camera_settings=args.accept_camera_settings, overwrite=args.overwrite, progress=ProgressBar("measuring"),
+    )  # fmt: skip
+    return _print(report, args.json)
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Register `measure`."""
+    parser = subparsers.add_parser(
+        "measure",
+        help="measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
+        description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[2].replace("\n", " "),
+    )
+    parser.add_argument("--tracker", metavar="SPEC", help="the tracker on the pendulum (as rig record-tracker takes it)")
+    parser.add_argument("--camera", metavar="SPEC", help=f"the camera filming the LED and the screen: {CAMERA_SPECS}")
+    parser.add_argument("--renderer", default="warp", metavar="NAME",
+                        help="the rig's renderer (warp, direct, warp:options, a plug-in) (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--external", action="store_true", help="measure an external renderer over LSL instead (see README)")
+    parser.add_argument("--predictor", default="default", help="the pose predictor (default: %(default)s)")
+    parser.add_argument("--display", default="window", metavar="SPEC",
+                        help="the window: window[:MONITOR][?fullscreen=1&size=WxH&pos=X,Y&scanout=F] (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--duration", type=options.positive_float, metavar="S", help="seconds to run (default: 60; self-test 20)")
+    parser.add_argument("--until-still", action="store_true", help="end sooner once the pendulum has stopped swinging")
+    parser.add_argument("--photon-target", choices=("photons", "scanout"), default="photons",
+                        help="what each frame's pose is predicted for (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--mirror", action="store_true", help="mirror the screen's x (when the camera sees the sphere move against the LED)")
+    parser.add_argument("--led-side", choices=("left", "right"), help="which side of the video the LED is on")
+    parser.add_argument("--board", type=Path, metavar="DIR", help="a `rig board record` folder of the same run: the photodiode's latency too")
+    parser.add_argument("--pose-stream", default=StreamNames.pose, help="LSL name of the rig's pose stream (default: %(default)s)")
+    parser.add_argument("--tracker-stream", default=StreamNames.tracker, help="LSL name of the rig's tracker stream (default: %(default)s)")
+    parser.add_argument("--marker-stream", default=StreamNames.markers,
+                        help="LSL name of an external renderer's marker stream (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--no-lsl", action="store_true", help="publish nothing on LSL (the rig's own renderer only)")
+    parser.add_argument("--guided", action="store_true", help="say what to do and check the first seconds of video first")
+    parser.add_argument("--self-test", action="store_true", help="run the whole chain with stand-ins under an X display (xvfb-run)")
+    parser.add_argument("--out", type=Path, metavar="DIR", help="folder for the run, the video and the results")
+    parser.add_argument("--overwrite", action="store_true", help="replace a run already in DIR")
+    parser.add_argument("--json", action="store_true", help="print the results as one JSON object")
+    add_camera_options(parser)
+    parser.set_defaults(func=_run)
