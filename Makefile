@@ -1,7 +1,8 @@
 # Two entry points for a newcomer: `make demo` and `make test`. Both first install what is missing:
 # Debian packages (as root; otherwise the command to run is printed) and a virtual environment
 # with the pinned Python packages of constraints.txt. Only the tests need the firmware's toolchain
-# and its emulator (firmware/system-packages.txt): `make demo` leaves them out.
+# and its emulator (firmware/system-packages.txt) and a virtual X server for the live runs
+# (tests/system-packages.txt): `make demo` leaves them out.
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -14,7 +15,7 @@ system:
 	@scripts/install-system-packages.sh system-packages.txt
 
 test-system:
-	@scripts/install-system-packages.sh system-packages.txt firmware/system-packages.txt
+	@scripts/install-system-packages.sh system-packages.txt firmware/system-packages.txt tests/system-packages.txt
 
 venv: $(STAMP)
 
