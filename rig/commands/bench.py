@@ -19,6 +19,7 @@ from predictors import read_trace
 from rig.bench import analyser, batch
 from rig.bench import predictors as predictor_bench
 from rig.commands import options
+from rig.commands.bench_live import add_live
 from rig.commands.bench_renderers import add_renderers
 from rig.errors import ConfigError, RigError
 from rig.progress import ProgressBar
@@ -258,6 +259,7 @@ SUBJECTS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
     "renderers": add_renderers,
     "trackers": _add_trackers,
     "batch": _add_batch,
+    "live": add_live,
 }
 
 

@@ -4,13 +4,14 @@ tracker stream, and the wrappers that feed them from a session without the sessi
 `PublishingTracker` wraps a tracker source: every sample the session takes is pushed on
 `RigTracker`. `PublishingRenderer` wraps a renderer: every pose it draws a display frame with (an
 application frame of a renderer that shows one image per frame, each composed frame of one that
-composes at every refresh) is pushed on `RigPose` with the photon time it was predicted for and
-the newest sample behind it. Pushing never blocks.
+composes at every refresh) is pushed on `RigPose` with the photon time it was predicted for, the
+newest sample behind it and, as its stamp, when the renderer was handed it. Pushing never blocks.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -19,10 +20,19 @@ from predictors import Pose, PoseSample
 from rig.clock import Clock
 from rig.devices.trackers.lsl_tracker import CHANNELS, lsl_origin, pylsl
 from rig.lsl.streams import POSE_CHANNELS, POSE_UNITS, StreamNames, describe_channels
-from rig.render.protocol import AppFrameRequest, AppFrameResult, DisplayFrameRequest, DisplayFrameResult, Renderer, RenderSetup
+from rig.render.protocol import (
+    AppFrameRequest,
+    AppFrameResult,
+    DisplayFrameRequest,
+    DisplayFrameResult,
+    PredictFn,
+    Renderer,
+    RenderSetup,
+)
 from rig.records import CsvRecord
 
-PUBLISHED_COLUMNS = ("frame", "t_published", *POSE_CHANNELS[1:])
+PUBLISHED_COLUMNS = ("frame", "t_pose", *POSE_CHANNELS[1:])
+"""`t_pose`: when the renderer was handed the pose (rig clock); the others as `RigPose`'s channels."""
 
 
 class LslPublisher:
@@ -67,14 +77,14 @@ class LslPublisher:
                 self._tracker.push_sample([*sample.position.tolist(), *sample.orientation.tolist()], self.lsl_time(sample.t_sensor))
             self.newest_sensor_time = max(self.newest_sensor_time, sample.t_sensor)
 
-    def pose(self, frame: int, t_photon: float, pose: Pose) -> None:
-        now = self._clock.now()
+    def pose(self, frame: int, t_photon: float, pose: Pose, t_pose: float) -> None:
+        """Publish display frame `frame`'s pose, predicted for `t_photon` and handed over at `t_pose`."""
         values = [float(frame), self.lsl_time(t_photon), self.lsl_time(self.newest_sensor_time), *pose.position.tolist(),
                   *pose.orientation.tolist()]  # fmt: skip
         if self._pose is not None:
-            self._pose.push_sample(values, self.lsl_time(now))
+            self._pose.push_sample(values, self.lsl_time(t_pose))
         if self._record is not None:
-            self._record.write([frame, now, t_photon, self.newest_sensor_time, *values[3:]])
+            self._record.write([frame, t_pose, t_photon, self.newest_sensor_time, *values[3:]])
 
     def close(self) -> None:
         self._pose = self._tracker = None
@@ -114,20 +124,29 @@ class PublishingRenderer:
         self.name = renderer.name
         self.per_display_frame = renderer.per_display_frame
         self._clock = clock
+        self._t_pose = math.nan
 
     def open(self, setup: RenderSetup) -> None:
         self.publisher.open(self._clock, setup)
         self.renderer.open(setup)
 
+    def _timed(self, predict: PredictFn) -> PredictFn:
+        def timed(t: float) -> Pose:
+            pose = predict(t)
+            self._t_pose = self._clock.now()
+            return pose
+
+        return timed
+
     def render_app_frame(self, request: AppFrameRequest) -> AppFrameResult:
-        result = self.renderer.render_app_frame(request)
+        result = self.renderer.render_app_frame(replace(request, predict=self._timed(request.predict)))
         if not self.per_display_frame:
-            self.publisher.pose(request.index, request.t_photon, result.pose)
+            self.publisher.pose(request.index, request.t_photon, result.pose, self._t_pose)
         return result
 
     def render_display_frame(self, request: DisplayFrameRequest) -> DisplayFrameResult:
-        result = self.renderer.render_display_frame(request)
-        self.publisher.pose(request.index, request.t_photon, result.pose)
+        result = self.renderer.render_display_frame(replace(request, predict=self._timed(request.predict)))
+        self.publisher.pose(request.index, request.t_photon, result.pose, self._t_pose)
         return result
 
     def close(self) -> None:

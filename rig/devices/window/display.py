@@ -14,7 +14,7 @@ given a `FrameClock`, from that clock: virtual X servers draw and read back corr
 pace swaps, so tests pace the window with one). A swap that lands at a later refresh than it was
 aimed at is late: the display repeated its previous image meanwhile (a missed refresh).
 `vblank_time(k)` is the time refresh k was measured at where an image was swapped for it, and the
-model's otherwise. Rows are lit top to bottom over `scanout_fraction` of the period after the blank
+model's otherwise. The window is opened by `open_window` (tests give a fake). Rows are lit top to bottom over `scanout_fraction` of the period after the blank
 (the modelled scan-out; a monitor's own is not measured here).
 """
 
@@ -88,6 +88,7 @@ class WindowDisplay:
         nominal_refresh_hz: float = 60.0,
         frame_clock: FrameClock | None = None,
         swap_log: Callable[[SwapRecord], None] | None = None,
+        open_window: Callable[[WindowSettings], GlWindow] = GlWindow,
     ) -> None:
         if not 0.0 < scanout_fraction <= 1.0:
             raise ConfigError(f"the scan-out fraction is a share of a refresh in (0, 1], got {scanout_fraction!r}")
@@ -99,6 +100,7 @@ class WindowDisplay:
         self.window: GlWindow | None = None
         self._frame_clock = frame_clock
         self._swap_log = swap_log
+        self._open_window = open_window
         self._clock: Clock | None = None
         self._model: RefreshModel | None = None
         self._base = 0
@@ -116,7 +118,7 @@ class WindowDisplay:
     def connect(self, clock: Clock) -> None:
         """Open the window and measure its refresh (or start the frame clock)."""
         self._clock = clock
-        window = self.window = GlWindow(self.settings)
+        window = self.window = self._open_window(self.settings)
         try:
             self.width, self.height = window.width, window.height
             with window.current():
@@ -182,7 +184,7 @@ class WindowDisplay:
     def present(self, image: np.ndarray, t_ready: float, image_id: int) -> int:
         """Draw `image` and swap it in at the next refresh it can make (at most one new image a
         refresh); returns once the swap is done, with the refresh it reached."""
-        window, clock = self._open_window(), self._clock
+        window, clock = self._window(), self._clock
         if window.closing():
             raise RigError("the display window was closed; the run ended there (everything recorded so far is kept)")
         aimed = max(self.refresh_after(max(t_ready, clock.now())), self._last_present + 1)
@@ -228,7 +230,7 @@ class WindowDisplay:
             self._current = self._presents.pop(0)[1]
         return self._current
 
-    def _open_window(self) -> GlWindow:
+    def _window(self) -> GlWindow:
         if self.window is None:
             raise RigError("the window display is not connected")
         return self.window

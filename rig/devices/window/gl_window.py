@@ -10,6 +10,7 @@ RigError saying so.
 from __future__ import annotations
 
 import contextlib
+import re
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, Iterator
@@ -52,11 +53,19 @@ class WindowSettings:
 
 
 def _glfw() -> ModuleType:
+    """GLFW, its errors raised as exceptions (not the package's default warnings)."""
     try:
         import glfw
     except ImportError as error:  # the library loads libglfw itself and may fail here
         raise RigError(f"cannot load GLFW for an on-screen window: {error}") from None
+    glfw.ERROR_REPORTING = "raise"
     return glfw
+
+
+def _no_window(error: Exception) -> RigError:
+    # GLFW's message reads "(CODE) b'what happened'"
+    text = re.sub(r"^\(\d+\) b'(.*)'$", r"\1", str(error))
+    return RigError(f"cannot open a window ({text}): run on a desktop, set DISPLAY, or use xvfb-run for a virtual display")
 
 
 class GlWindow:
@@ -64,13 +73,16 @@ class GlWindow:
 
     def __init__(self, settings: WindowSettings) -> None:
         glfw = self.glfw = _glfw()
-        if not glfw.init():
-            raise RigError(
-                "no display to open a window on (no X server or Wayland compositor answered): run on a desktop, "
-                "set DISPLAY, or use xvfb-run for a virtual one"
-            )
+        try:
+            if not glfw.init():
+                raise RigError("no display to open a window on: run on a desktop, set DISPLAY, or use xvfb-run")
+        except glfw.GLFWError as error:
+            raise _no_window(error) from None
         try:
             self.handle = self._create(settings)
+        except glfw.GLFWError as error:
+            glfw.terminate()
+            raise _no_window(error) from None
         except BaseException:
             glfw.terminate()
             raise

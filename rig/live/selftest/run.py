@@ -14,21 +14,16 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import threading
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any, Callable
 
 from rig.clock import MonotonicClock
 from rig.devices.protocols import Display
 from rig.devices.window import WindowSettings
-from rig.emulate.encode import Emission
-from rig.emulate.faults import FaultPlan
-from rig.emulate.motion import Motion
-from rig.emulate.sinks import LslSink
-from rig.emulate.streamer import stream
 from rig.errors import RigError
 from rig.live.measure import MeasureReport, VideoOptions, analyse_run, write_report
 from rig.live.run import EXTERNAL, LiveConfig, run_live
+from rig.live.selftest.emulator import EmulatedPendulum
 from rig.live.selftest.frame_clock import FixedRateFrameClock
 from rig.live.selftest.twin import ScreenCamera, TwinSetup
 from rig.live.view import View
@@ -42,7 +37,6 @@ AGREEMENT_MS = 2.0
 REFRESH_HZ = 60.0
 CAMERA_FPS = 97.0
 """Incommensurate with the refresh (see rig.live.selftest.twin)."""
-TRACKER_HZ = 500.0
 DISPLAY_SIZE = (160, 120)
 """Small: software OpenGL's per-pixel warp costs about a refresh at this size."""
 CAMERA_SIZE = (480, 360)
@@ -50,50 +44,6 @@ WINDOW_POSITION = (0, 0)
 EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "external_renderer.py"
 # The emulator outlasts the run: connecting, framing and the end take their time.
 EMULATOR_MARGIN_S = 30.0
-
-
-class _Stopped(Exception):
-    """The run is over: the emulator stops sending."""
-
-
-class _StoppableSink(LslSink):
-    """The emulator's LSL outlet, which ends the sending loop once the run is over."""
-
-    stopped = False
-
-    def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
-        if self.stopped:
-            raise _Stopped
-        return super().send(emissions, rate_hz)
-
-
-class _Emulator:
-    """The emulated tracker on a thread; `start` is when its motion's time 0 was, on the rig clock."""
-
-    def __init__(self, name: str, duration_s: float, origin_s: float) -> None:
-        self.start: float | None = None
-        self.events: list[str] = []
-        self._origin = origin_s
-        self._sink = _StoppableSink(name, TRACKER_HZ, source_id=name)
-        self._motion = Motion(TRACKER_HZ, duration_s)
-        self._thread = threading.Thread(target=self._run, args=(duration_s,), name="emulated tracker", daemon=True)
-        self._thread.start()
-
-    def _device_clock(self, t: float) -> float:
-        if self.start is None:
-            self.start = t - self._origin
-        return t
-
-    def _run(self, duration_s: float) -> None:
-        try:
-            stream(self._motion, self._sink, duration_s, FaultPlan(), self._device_clock, None, self.events.append)
-        except _Stopped:
-            pass
-
-    def close(self) -> None:
-        self._sink.stopped = True
-        self._thread.join()
-        self._sink.close()
 
 
 def self_test(
@@ -130,7 +80,7 @@ def self_test(
         if window is not None:
             window_rect[0] = window.rect
 
-    emulator = _Emulator(name, duration_s + EMULATOR_MARGIN_S, clock.origin_ns / 1e9)
+    emulator = EmulatedPendulum(name, duration_s + EMULATOR_MARGIN_S, clock)
     renderer = _start_example(streams) if external else None
     try:
         twin = TwinSetup(camera_config, layout, PendulumConfig(), pendulum_end, 1.0 / REFRESH_HZ, out_dir, seed=1)
