@@ -35,7 +35,7 @@ class SimulationConfig:
     display: DisplayConfig = field(default_factory=DisplayConfig)
     camera: CameraConfig = field(default_factory=CameraConfig)
     renderer: str = "direct"
-    predictor: str = "hold"
+    predictor: str = "default"
     predictor_params: dict[str, Any] = field(default_factory=dict)
     scene_triangles: int = 0
     app_frame_ms: float | None = 5.0

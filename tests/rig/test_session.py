@@ -26,7 +26,8 @@ SMALL_CAMERA = CameraConfig(fps=120.0, width=320, height=240, subsamples=4)
 
 
 def small_config(**overrides) -> SimulationConfig:
-    settings = dict(duration_s=1.5, camera=SMALL_CAMERA, display=DisplayConfig(width=160, height=120))
+    # Without prediction (hold), so that the true latency is the frame delay plus half a refresh.
+    settings = dict(duration_s=1.5, camera=SMALL_CAMERA, display=DisplayConfig(width=160, height=120), predictor="hold")
     settings.update(overrides)
     return SimulationConfig(**settings)
 
