@@ -34,7 +34,7 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
         type=options.predictor_spec,
         default=(defaults.predictor, {}),
         metavar="NAME[:key=value,...]",
-        help=f"pose predictor ({', '.join(predictors.names())}) and its parameters, or NAME:FILE.json (default: hold)",
+        help=f"pose predictor ({', '.join(predictors.names())}) and its parameters, or NAME:FILE.json (default: default, the adaptive predictor)",
     )
     group.add_argument("--display-hz", type=options.positive_float, default=DisplayConfig().refresh_hz, help="display refresh rate (default: %(default)s)")
     group.add_argument("--tracker-hz", type=options.positive_float, default=TrackerConfig().rate_hz, help="tracker sample rate (default: %(default)s)")
