@@ -7,7 +7,8 @@ The run's folder gets what a simulated run writes (`tracker.csv`, `app_frames.cs
 photon time it was predicted for and the newest sample behind it, also pushed on the `RigPose`
 LSL outlet), the display's own log (`display_swaps.csv` for a window, `renderer_markers.csv` for an
 external renderer) and at the end `live.json` (devices, timing sources, counts, why it ended).
-Every row is written as it happens. A `Watchdog` instrument ends the run with a clear message when
+Every row is written as it happens; samples that arrive after the session last took any are
+written when it ends. A `Watchdog` instrument ends the run with a clear message when
 the tracker or the camera goes away (what was recorded stays); so does closing the window. With
 `until_still` the run also ends, normally, once the pendulum has stopped swinging.
 """
@@ -24,6 +25,7 @@ from typing import Any, Callable
 import numpy as np
 
 import predictors
+from predictors import sample_row
 from rig.clock import MonotonicClock
 from rig.devices.protocols import Camera, Display
 from rig.devices.registry import DeviceContext, make_device
@@ -125,6 +127,13 @@ class Watchdog:
             self._camera.close()
 
 
+def _record_left_over(tracker: Any, record: RunRecord) -> None:
+    """Samples that arrived after the session last took any (it has closed the tracker): recorded too."""
+    if isinstance(tracker, TrackerStream):
+        for left in tracker.take_queued():
+            record.tracker.write(sample_row(left.sample))
+
+
 def frame_view(tracker_spec: str, clock: MonotonicClock, width: int, height: int, mirror: bool, seconds: float = FRAMING_S) -> View:
     """The view framing the swing the tracker sees for `seconds` (`rig.live.view`)."""
     tracker = make_device("tracker", tracker_spec, DeviceContext())
@@ -197,7 +206,10 @@ def run_live(
         )
         try:
             with RunRecord(out_dir, None, overwrite=overwrite) as record:
-                Session(parts, clock.now(), clock.now() + config.duration_s, record, progress, from_connect=True).run()
+                try:
+                    Session(parts, clock.now(), clock.now() + config.duration_s, record, progress, from_connect=True).run()
+                finally:
+                    _record_left_over(tracker, record)
             ended = "completed"
         except RunEnded as reason:
             ended = str(reason)

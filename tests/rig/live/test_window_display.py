@@ -1,0 +1,129 @@
+"""The window display against a fake window on a virtual clock: images reach the refresh they were
+aimed at, swaps that overrun are late (the display repeated its image), every swap is logged, and a
+closed window ends the run. Measured refreshes come from the swaps' own times."""
+
+from __future__ import annotations
+
+import contextlib
+from typing import Iterator
+
+import numpy as np
+import pytest
+
+from rig.clock import VirtualClock
+from rig.devices.protocols import NO_IMAGE
+from rig.devices.window import SwapRecord, WindowDisplay, WindowSettings
+from rig.errors import RigError
+from rig.live.selftest.frame_clock import FixedRateFrameClock
+
+PERIOD = 1.0 / 60.0
+
+
+class FakeWindow:
+    """A window whose swap takes `swap_s` on the clock; with `vsync`, it returns at the next blank."""
+
+    def __init__(self, clock: VirtualClock, swap_s: float = 1e-3, vsync: bool = False) -> None:
+        self.clock = clock
+        self.swap_s = swap_s
+        self.vsync = vsync
+        self.width, self.height = 64, 48
+        self.drawn: list[int] = []
+        self.closed = False
+        self.ask_close = False
+
+        class Context:
+            extensions: set[str] = set()
+
+        self.ctx = Context()
+
+    @contextlib.contextmanager
+    def current(self) -> Iterator[None]:
+        yield
+
+    def native_glx(self) -> None:
+        return None
+
+    def proc_address(self, name: str) -> int:
+        return 0
+
+    def extension_supported(self, name: str) -> bool:
+        return False
+
+    def draw(self, image: np.ndarray) -> None:
+        self.drawn.append(int(image[0, 0, 0]))
+
+    def swap(self) -> None:
+        t = self.clock.now() + self.swap_s
+        if self.vsync:
+            t = (np.floor(t / PERIOD) + 1) * PERIOD
+        self.clock.wait_until(t)
+
+    def closing(self) -> bool:
+        return self.ask_close
+
+    def close(self) -> None:
+        self.closed = True
+
+
+def _display(clock: VirtualClock, window: FakeWindow, swaps: list[SwapRecord], paced: bool = True) -> WindowDisplay:
+    display = WindowDisplay(
+        WindowSettings(size=(64, 48)), frame_clock=FixedRateFrameClock(60.0) if paced else None, swap_log=swaps.append,
+        open_window=lambda settings: window,
+    )  # fmt: skip
+    display.connect(clock)
+    return display
+
+
+def _image(value: int) -> np.ndarray:
+    return np.full((48, 64, 3), value, dtype=np.uint8)
+
+
+def test_images_appear_at_the_refreshes_they_are_ready_for_and_stay() -> None:
+    clock, swaps = VirtualClock(), []
+    display = _display(clock, FakeWindow(clock), swaps)
+    first = display.present(_image(1), clock.now(), 1)
+    second = display.present(_image(2), clock.now(), 2)
+    assert second == first + 1
+    shown = [display.shown(k) for k in range(second + 2)]
+    assert shown[:first] == [NO_IMAGE] * first and shown[first:] == [1, 2, 2]
+    assert [s.refresh for s in swaps] == [first, second] and all(s.refresh == s.aimed_refresh for s in swaps)
+    assert display.vblank_time(second) == swaps[1].t_swap
+    assert display.photon_time(second, 0.5) == pytest.approx(swaps[1].t_swap + 0.5 * PERIOD)
+
+
+def test_a_swap_that_overruns_its_refresh_is_late_and_logged_so() -> None:
+    clock, swaps = VirtualClock(), []
+    window = FakeWindow(clock, swap_s=1.5 * PERIOD)
+    display = _display(clock, window, swaps)
+    display.present(_image(1), clock.now(), 1)
+    assert swaps[0].refresh == swaps[0].aimed_refresh + 1
+    assert swaps[0].row()[3] == 1
+    assert display.report()["late_swaps"] == 1
+
+
+def test_a_display_paced_by_its_swaps_is_measured_from_them() -> None:
+    clock, swaps = VirtualClock(10.0), []
+    window = FakeWindow(clock, swap_s=2e-4, vsync=True)
+    display = _display(clock, window, swaps, paced=False)
+    assert display.refresh_hz == pytest.approx(60.0, rel=1e-3)
+    assert display.timing_source == "swap-return"
+    k = display.present(_image(1), clock.now(), 1)
+    assert abs(swaps[0].t_swap - display.vblank_time(k)) < 1e-12
+    assert display.refresh_after(display.vblank_time(k)) == k + 1
+
+
+def test_an_unpaced_display_is_refused_with_one_clear_message() -> None:
+    clock = VirtualClock()
+    with pytest.raises(RigError, match="vsync is off"):
+        _display(clock, FakeWindow(clock, swap_s=2e-4), [], paced=False)
+
+
+def test_closing_the_window_ends_the_run() -> None:
+    clock = VirtualClock()
+    window = FakeWindow(clock)
+    display = _display(clock, window, [])
+    window.ask_close = True
+    with pytest.raises(RigError, match="window was closed"):
+        display.present(_image(1), clock.now(), 1)
+    display.close()
+    assert window.closed
