@@ -45,8 +45,9 @@ from predictors.smoothers import Estimate, Smoothers, two_sample
 
 HORIZONS_S = (0.01, 0.02, 0.04, 0.08, 0.16)
 SCORES_PER_SAMPLE = 2
-_LOG_HORIZONS = tuple(log(h) for h in HORIZONS_S)
 SCORE_EVERY = 1.0  # a horizon is scored at most once per this many horizons
+_LOG_HORIZONS = tuple(log(h) for h in HORIZONS_S)
+_SCORE_GAPS = tuple(SCORE_EVERY * h for h in HORIZONS_S)
 # History kept beyond the oldest anchor still needed, before the list is trimmed (amortised).
 _TRIM_AFTER = 256
 
@@ -115,13 +116,13 @@ class Adaptive:
         """Forget every sample and everything learnt."""
         self._scores = [HorizonScore(h) for h in HORIZONS_S]
         self._trusted: list[Choice] = [COLD_START] * len(HORIZONS_S)
+        self._kept: list[tuple[int, int] | None] = [None] * len(HORIZONS_S)  # the models each choice kept by default
         self._noise = [0.0, 0.0, 0.0]  # EW weight (s), sums of d.d - d.d_prev: orientation, position
         self._t: float | None = None
         self._restart()
 
     def _restart(self) -> None:
-        for score in self._scores:
-            score.last = None
+        self._last_scored = [-math.inf] * len(HORIZONS_S)
         self._smoothers = Smoothers()
         self._history: list[_Anchor] = []
         self._anchors = [0] * len(HORIZONS_S)
@@ -200,22 +201,15 @@ class Adaptive:
         `SCORE_EVERY` horizons, whose predictions from an earlier sample the newest one (which
         turned by r from the one before) has just overtaken. Each score weighs the seconds since
         its horizon was last scored."""
-        due: list[tuple[float, int]] = []
-        for k, score in enumerate(self._scores):
-            last = score.last
-            if last is None:
-                due.append((math.inf, k))
-            elif t - last >= SCORE_EVERY * score.horizon:
-                due.append((t - last, k))
-        if len(due) > SCORES_PER_SAMPLE:
-            due.sort(reverse=True)
+        lasts = self._last_scored
+        due = sorted((last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k])[:SCORES_PER_SAMPLE]
         history = self._history
         newest = len(history) - 1
         t_before, p_before, _, _ = history[newest - 1]
         p_now, q_now = self._position, self._orientation
         r0, r1, r2 = r
-        shortest = len(self._scores)
-        for _, k in due[:SCORES_PER_SAMPLE]:
+        scored = []
+        for last, k in due:
             score = self._scores[k]
             horizon = score.horizon
             i = self._anchors[k]
@@ -240,30 +234,35 @@ class Adaptive:
                 p_now[1] - back * (p_now[1] - p_before[1]) - p_anchor[1],
                 p_now[2] - back * (p_now[2] - p_before[2]) - p_anchor[2],
             ) if self._position_moved else None
-            weight = min(t - score.last, self.max_gap) if score.last is not None else min(t - t_before, horizon)
-            score.last = t
+            weight = min(t - last, self.max_gap) if last > -math.inf else min(t - t_before, horizon)
+            lasts[k] = t
             score.learn(turn, moved, estimates, weight, self.memory, self.gain_prior)
-            shortest = min(shortest, k)
-        self._trust(shortest)
+            scored.append(k)
+        if scored:
+            self._trust(tuple(scored))
         oldest = min(self._anchors)
         if oldest > _TRIM_AFTER:
             del history[:oldest]
             self._anchors = [i - oldest for i in self._anchors]
 
-    def _trust(self, start: int = 0) -> None:
-        """Each horizon's choice from `start` on (the shorter ones' are as they were), shortest
-        first: a ready horizon keeps the next shorter one's model (constant velocity for the
-        shortest) unless another beats it there by `margin`; a horizon not yet ready takes the next
-        shorter one's choice; before any is ready, `COLD_START`."""
-        trusted = self._trusted
+    def _trust(self, scored: tuple[int, ...]) -> None:
+        """Each horizon's choice, shortest first: a ready horizon keeps the next shorter one's
+        model (constant velocity for the shortest) unless another beats it there by `margin`; a
+        horizon not yet ready takes the next shorter one's choice; before any is ready,
+        `COLD_START`. A choice is made again only where the horizon was just `scored` or the model
+        it would keep changed."""
+        trusted, kept = self._trusted, self._kept
         choice: Choice | None = None
-        if start > 0 and trusted[start - 1] is not COLD_START:
-            choice = trusted[start - 1]
-        for k in range(start, len(trusted)):
-            score = self._scores[k]
+        for k, score in enumerate(self._scores):
             if score.ready:
-                choice = score.choose(choice or BASELINE, self.gain_prior, self.margin)
-            trusted[k] = choice or COLD_START
+                default = choice or BASELINE
+                models = (default[0][0], default[1][0])
+                if k in scored or models != kept[k]:
+                    kept[k] = models
+                    trusted[k] = score.choose(default, self.gain_prior, self.margin, self._position_moved)
+                choice = trusted[k]
+            else:
+                trusted[k] = choice or COLD_START
 
     def predict(self, t: float) -> Pose:
         """The pose at t (s): each part blended from the models trusted at the horizons either side

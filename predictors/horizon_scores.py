@@ -61,12 +61,11 @@ _FF, _FY, _SSE = 0, 1, 2
 class HorizonScore:
     """Scores and learnt gains at one horizon (s), and the choice they make."""
 
-    __slots__ = ("horizon", "scored", "last", "_orientation", "_position")
+    __slots__ = ("horizon", "scored", "_orientation", "_position")
 
     def __init__(self, horizon: float) -> None:
         self.horizon = horizon
         self.scored = 0.0
-        self.last: float | None = None
         self._orientation = [[0.0, 0.0, 0.0] for _ in MODELS]
         self._position = [[0.0, 0.0, 0.0] for _ in MODELS]
 
@@ -83,11 +82,13 @@ class HorizonScore:
         if truth_position is not None:
             _learn(self._position, 1, self.horizon, truth_position, anchor, weight, decay, prior)
 
-    def choose(self, default: Choice, gain_prior: float, margin: float) -> Choice:
+    def choose(self, default: Choice, gain_prior: float, margin: float, position: bool = True) -> Choice:
         """The model to trust here for each part: `default`'s unless another's scored squared error
-        is below (1 - margin) times its, then the one of least error; with its gain learnt here."""
+        is below (1 - margin) times its, then the one of least error; with its gain learnt here.
+        Without `position` (a stream whose position never moved) position keeps the default."""
         prior = gain_prior / self.scored
-        return _choose(self._orientation, default[0][0], prior, margin), _choose(self._position, default[1][0], prior, margin)
+        orientation = _choose(self._orientation, default[0][0], prior, margin)
+        return orientation, _choose(self._position, default[1][0], prior, margin) if position else default[1]
 
     @property
     def ready(self) -> bool:
