@@ -1,4 +1,5 @@
-"""CI runs the tuning notebook on its small default data, top to bottom, without errors."""
+"""CI runs the tuning notebook on its small default data, top to bottom, without errors: the tuning,
+and the default predictor's state over a recording."""
 
 from pathlib import Path
 
@@ -15,4 +16,5 @@ def test_tune_predictors_notebook_runs():
         output.get("text", "") for cell in notebook.cells if cell.cell_type == "code" for output in cell.get("outputs", [])
     )
     assert "kalman-cv (tuned)" in printed and "slerp" in printed
+    assert "tracker noise measured:" in printed and "it trusts" in printed and "adaptive / slerp: angle" in printed
     assert any("image/png" in output.get("data", {}) for cell in notebook.cells for output in cell.get("outputs", []))
