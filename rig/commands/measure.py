@@ -45,7 +45,7 @@ def _interval(ci: Any) -> str:
     return f", 95% CI [{ci[0]:.1f}, {ci[1]:.1f}] ms" if ci else ", no interval"
 
 
-def _lines(report: MeasureReport) -> list[str]:
+def _lines(report: MeasureReport, kept: bool) -> list[str]:
     video, log = report.video, report.log
     lines = [
         f"latency (video): {video['latency_ms']:.1f} ms{_interval(video['ci95_ms'])} by {video['method']}",
@@ -59,12 +59,15 @@ def _lines(report: MeasureReport) -> list[str]:
     if check:
         verdict = "agree" if check["agree"] else "DISAGREE"
         lines.append(f"self-test: video and log differ by {check['difference_ms']:+.2f} ms (tolerance {check['tolerance_ms']:g} ms): {verdict}")
-    lines.append(f"wrote {report.out_dir / MEASURE_FILE} and {report.out_dir / PLOT_FILE}")
+    if kept:
+        lines.append(f"wrote {report.out_dir / MEASURE_FILE} and {report.out_dir / PLOT_FILE}")
+    else:
+        lines.append("(the run was in a temporary folder; --out DIR keeps it)")
     return lines
 
 
-def _print(report: MeasureReport, as_json: bool) -> int:
-    print(json.dumps(report.to_dict(), default=str) if as_json else "\n".join(_lines(report)))
+def _print(report: MeasureReport, as_json: bool, kept: bool = True) -> int:
+    print(json.dumps(report.to_dict(), default=str) if as_json else "\n".join(_lines(report, kept)))
     check = report.run.get("self_test")
     return EXIT_DISAGREE if check and not check["agree"] else 0
 
@@ -77,7 +80,7 @@ def _self_test(args: argparse.Namespace) -> int:
     if args.out is not None:
         return _print(self_test(args.out, duration, external=args.external, overwrite=args.overwrite, progress=bar), args.json)
     with tempfile.TemporaryDirectory(prefix="rig-measure-self-test-") as scratch:
-        return _print(self_test(Path(scratch), duration, external=args.external, progress=bar), args.json)
+        return _print(self_test(Path(scratch), duration, external=args.external, progress=bar), args.json, kept=False)
 
 
 def _guided_check(args: argparse.Namespace) -> None:
