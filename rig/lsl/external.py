@@ -162,17 +162,14 @@ class MarkerDisplay:
                 "scanout_fraction": self.scanout_fraction}  # fmt: skip
 
     def close(self) -> None:
-        inlet, self._inlet = self._inlet, None
-        if inlet is not None:
-            self._drain_rest(inlet)
-            inlet.close_stream()
-
-    def _drain_rest(self, inlet: Any) -> None:
-        self._inlet = inlet
+        """Record the markers that came since the last refresh, then close the inlet."""
+        if self._inlet is None:
+            return
         try:
             if self._model is not None:
                 self._drain()
         except RigError:
-            pass
+            pass  # the renderer has gone: what it sent is recorded
         finally:
+            self._inlet.close_stream()
             self._inlet = None

@@ -30,7 +30,6 @@ from typing import Any
 from urllib.parse import parse_qsl
 
 import cv2
-import numpy as np
 
 from rig.clock import Clock
 from rig.devices.camera.frames import FrameWriter
