@@ -44,6 +44,7 @@ WINDOW_POSITION = (0, 0)
 EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "external_renderer.py"
 # The emulator outlasts the run: connecting, framing and the end take their time.
 EMULATOR_MARGIN_S = 30.0
+EXAMPLE_LOG = "external_renderer.log"
 
 
 def self_test(
@@ -81,7 +82,8 @@ def self_test(
             window_rect[0] = window.rect
 
     emulator = EmulatedPendulum(name, duration_s + EMULATOR_MARGIN_S, clock)
-    renderer = _start_example(streams) if external else None
+    out_dir.mkdir(parents=True, exist_ok=True)
+    renderer = _start_example(streams, out_dir) if external else None
     try:
         twin = TwinSetup(camera_config, layout, PendulumConfig(), pendulum_end, 1.0 / REFRESH_HZ, out_dir, seed=1)
         camera = ScreenCamera(twin, lambda: emulator.start, lambda: window_rect[0])
@@ -106,11 +108,13 @@ def _agreement(report: MeasureReport) -> dict[str, Any]:
     return {"difference_ms": difference, "tolerance_ms": AGREEMENT_MS, "agree": abs(difference) <= AGREEMENT_MS}
 
 
-def _start_example(streams: StreamNames) -> subprocess.Popen:
+def _start_example(streams: StreamNames, out_dir: Path) -> subprocess.Popen:
+    """The example renderer in a process of its own, its output in EXAMPLE_LOG."""
     if not EXAMPLE.is_file():
         raise RigError(f"the external-renderer example {EXAMPLE} is not here (it ships with the repository, not the wheel)")
     command = [sys.executable, str(EXAMPLE), "--pose", streams.pose, "--markers", streams.markers,
                "--size", "x".join(map(str, DISPLAY_SIZE)), "--position", ",".join(map(str, WINDOW_POSITION)),
                "--pace-hz", str(REFRESH_HZ)]  # fmt: skip
-    return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    with (out_dir / EXAMPLE_LOG).open("w", encoding="utf-8") as stream:
+        return subprocess.Popen(command, stdout=stream, stderr=subprocess.STDOUT)
 
