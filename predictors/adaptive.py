@@ -4,18 +4,20 @@ No parameter is tuned to a tracker or a person. The predictor runs several candi
 the motion side by side (`predictors.smoothers`: the velocity through the last two samples, and
 Kalman smoothers of 25, 10 and 4 Hz bandwidth), and keeps scoring their predictions at horizons of
 10, 20, 40, 80 and 160 ms against the samples that arrive later (`predictors.horizon_scores`).
-At each horizon it learns a gain on every candidate's velocity and trusts the model whose realised
-errors there have been smallest, and constant velocity from the last two samples (slerp
-extrapolation) until another has beaten it by `margin`. So a clean tracker gets a model that
-follows it, a noisy one a smoother, jittery micro-movements a damped velocity, each horizon its
-own; and the answer changes as the stream does, with a memory of `memory` seconds.
+At each horizon it learns a gain on the two-sample velocity from those errors, and trusts the
+model whose realised errors there have been smallest: at the shortest horizon constant velocity
+from the last two samples (slerp extrapolation) until another has beaten it by `margin`, at each
+longer one the shorter one's model until another has beaten that. So a clean tracker gets a model
+that follows it, a noisy one a smoother, jittery micro-movements a damped velocity, each horizon
+its own; and the answer changes as the stream does, with a memory of `memory` seconds.
 
 `predict(t)` answers any horizon h = t - (newest sample time): between two scored horizons it
 blends their predictions, weighted by where h lies between them on a log scale; below 10 ms it uses
-the 10 ms choice, above 160 ms the 160 ms one; before any horizon has been scored, constant
-velocity. Everything is driven by timestamps: the scores are per second of motion, a horizon is
-scored at most every half horizon (and at most `SCORES_PER_SAMPLE` horizons per sample, so the cost
-per sample stays bounded at 1000 Hz), and the smoothers' bandwidths are in Hz.
+the 10 ms choice, above 160 ms the 160 ms one; for the first second of scores, the least smoothing
+Kalman smoother (`predictors.horizon_scores.COLD_START`). Everything is driven by timestamps: the
+scores are per second of motion, each horizon is scored at most once per horizon, the two longest
+unscored first (`SCORES_PER_SAMPLE`, so the cost per sample stays bounded at any rate), and the
+smoothers' bandwidths are in Hz.
 
 Sample rules: samples are taken in sensor-time order; an older sample than the newest is dropped;
 one less than `min_interval` after the newest replaces it (a duplicate: the smoothers take it as a
@@ -60,7 +62,8 @@ MEMORY = Param(
 MARGIN = Param(
     "margin", 0.05, "",
     "A fraction: another model is trusted at a horizon only while its scored squared error there is "
-    "below (1 - margin) times constant velocity's.",
+    "below (1 - margin) times that of the model it would keep (constant velocity at the shortest "
+    "horizon, the next shorter horizon's choice at the others).",
     OPEN_UNIT,
 )
 GAIN_PRIOR = Param(
@@ -289,10 +292,12 @@ class Adaptive:
         d0 = d1 = d2 = m0 = m1 = m2 = 0.0
         for ((model, gain), (position_model, position_gain)), share in blend:
             a0, a1, a2, w0, w1, w2 = estimates[MODELS[model]][0]
-            reach = share * gain * h
-            d0 += share * a0 + reach * w0
-            d1 += share * a1 + reach * w1
-            d2 += share * a2 + reach * w2
+            # The turn gain h w after the offset a: a + u + u x a / 2 to second order, u = gain h w.
+            reach = gain * h
+            u0, u1, u2 = reach * w0, reach * w1, reach * w2
+            d0 += share * (a0 + u0 + 0.5 * (u1 * a2 - u2 * a1))
+            d1 += share * (a1 + u1 + 0.5 * (u2 * a0 - u0 * a2))
+            d2 += share * (a2 + u2 + 0.5 * (u0 * a1 - u1 * a0))
             a0, a1, a2, w0, w1, w2 = estimates[MODELS[position_model]][1]
             reach = share * position_gain * h
             m0 += share * a0 + reach * w0

@@ -26,11 +26,14 @@ candidate, with no quaternion arithmetic per candidate.
   dt times the velocity, the new sample moves the origin by r, and the measurement update pulls
   the offset towards zero (the measurement is the new sample, at offset zero):
 
-      a <- a + dt w - r - (a + dt w) x r / 2     (rotation vectors compose as x + y + x X y / 2
-                                                  to second order; exact when the axes agree)
+      a <- dt w + a + (dt w) x a / 2             (rotation vectors compose as log(exp x exp y) =
+      a <- a - r - a x r / 2                      x + y + x X y / 2 to second order; exact when
+                                                  the axes agree)
       a <- (1 - k0) a,   w <- w - k1 a_before    (k: the Kalman gain).
 
-  The dropped third-order terms are below 1e-3 rad for a step of 0.2 rad and an offset of 0.01 rad.
+  The dropped third-order terms, |x|^2 |y| / 12, are below 1e-5 rad for a step of 0.05 rad and an
+  offset of 0.05 rad; over 3 s of turning at 3 rad/s the smoothers follow the exact
+  multiplicative filter of `predictors.kalman` to 1e-4 rad (tests/predictors/test_smoothers.py).
 
 A low bandwidth smooths a noisy tracker and lags a sudden turn; a high one follows the motion and
 passes the noise on. `adaptive` runs them all and, at each horizon, trusts the one whose errors
@@ -101,7 +104,12 @@ class Smoothers:
             (a0, a1, a2, w0, w1, w2), (b0, b1, b2, v0, v1, v2) = state
             # Time update, then the origin moved to the new sample (rotation vectors composed to
             # second order), then the measurement update at offset zero.
-            a0, a1, a2 = a0 + dt * w0, a1 + dt * w1, a2 + dt * w2
+            u0, u1, u2 = dt * w0, dt * w1, dt * w2
+            a0, a1, a2 = (
+                a0 + u0 + 0.5 * (u1 * a2 - u2 * a1),
+                a1 + u1 + 0.5 * (u2 * a0 - u0 * a2),
+                a2 + u2 + 0.5 * (u0 * a1 - u1 * a0),
+            )
             a0, a1, a2 = (
                 a0 - r0 - 0.5 * (a1 * r2 - a2 * r1),
                 a1 - r1 - 0.5 * (a2 * r0 - a0 * r2),
