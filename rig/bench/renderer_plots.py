@@ -96,15 +96,16 @@ def plot_variants(rows: list[dict[str, Any]], path: Path) -> None:
     def draw(figure: Any, axes: list[Any]) -> None:
         specs = list(dict.fromkeys(r["spec"] for r in rows))
         sizes = sorted({r["triangles"] for r in rows})
-        markers = "osD^v<>pPX*h"
+        markers = dict(zip(specs, "osD^v<>pPX*hH8d"))
+        colours = dict(zip(sizes, ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")))
         for axis, figure_name, label in zip(axes, ("lab_error_pct", "dssim"), ("pixels with Lab error > 10 (%)", "DSSIM")):
-            for triangles, colour in zip(sizes, ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple")):
-                for spec, marker in zip(specs, markers):
-                    chosen = [r for r in rows if r["spec"] == spec and r["triangles"] == triangles and r["latency_saved_ms"] is not None]
-                    axis.scatter([r["latency_saved_ms"] for r in chosen], [r[figure_name] for r in chosen], marker=marker, color=colour,
-                                 label=f"{spec}, {triangles} tri")  # fmt: skip
+            for r in rows:
+                if r["latency_saved_ms"] is not None and r["spec"] in markers:
+                    axis.scatter(r["latency_saved_ms"], r[figure_name], marker=markers[r["spec"]], color=colours[r["triangles"]])
             axis.set(xlabel="latency saved against the direct renderer (ms, from video)", ylabel=label,
                      title=f"{label} against latency saved")  # fmt: skip
-        axes[0].legend(fontsize=6, ncol=2)
+        handles = [axes[0].scatter([], [], marker=m, color="k", label=spec) for spec, m in markers.items()]
+        handles += [axes[0].scatter([], [], marker="s", color=c, label=f"{n} triangles") for n, c in colours.items()]
+        axes[1].legend(handles=handles, fontsize=7, loc="best")
 
     _draw(path, 2, draw)

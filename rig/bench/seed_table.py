@@ -55,7 +55,7 @@ class SeedTableSpec:
     """What `--seed-table` measures."""
 
     first: int = 4_000
-    max_triangles: int = 16_000_000
+    max_triangles: int = 20_000_000
     max_frame_s: float = 60.0
     size: tuple[int, int] = (320, 240)
     predictor: str = "hold"

@@ -6,7 +6,7 @@ Reconstructions (Smit et al. 2010, section 4.1; Schollmeyer et al., section 4.1)
   as a depth-tested point splat sized by the warp's Jacobian;
 * "quad": the same vertex drawn as the warped pixel's parallelogram (a geometry shader);
 * "mesh": the client pixels as a triangle mesh, two triangles per 2x2 pixels, colours interpolated,
-  triangles across object or depth edges dropped;
+  triangles between objects that move apart dropped;
 * "grid": the adaptive grid's cells (`rig.render.warp_grid`), one quad each.
 
 The primitives drawn per client view are counted in `primitives`.
@@ -38,8 +38,8 @@ from rig.render.warp_shaders import (
     GRID_FRAGMENT_SHADER,
     ID_SCALE,
     WARP_FRAGMENT_SHADER,
-    WARP_MESH_GEOMETRY_SHADER,
     WARP_QUAD_GEOMETRY_SHADER,
+    mesh_geometry_shader,
     warp_vertex_shader,
 )
 
@@ -48,9 +48,6 @@ MAX_SPLAT_PX = 8.0
 """Largest point splat (pixels a side): a pixel magnified more than this leaves holes instead."""
 BACKGROUND_NDC_Z = 1.0 - 2.0**-10
 """NDC depth the background is warped to: behind every object, inside the far plane."""
-MESH_DEPTH_STEP = 0.01
-"""Largest client NDC depth difference within a mesh triangle: beyond it the pixels are taken to
-show different surfaces."""
 
 
 def mesh_indices(size: tuple[int, int]) -> np.ndarray:
@@ -59,6 +56,13 @@ def mesh_indices(size: tuple[int, int]) -> np.ndarray:
     corner = (np.arange(h - 1)[:, np.newaxis] * w + np.arange(w - 1)[np.newaxis, :]).ravel()
     quads = np.stack([corner, corner + 1, corner + w, corner + 1, corner + w + 1, corner + w], axis=1)
     return quads.astype(np.uint32).ravel()
+
+
+def motion_classes(matrices: np.ndarray) -> list[int]:
+    """Per object, the index of the first object with the same warp matrix: objects of one class
+    move together."""
+    rows = [np.asarray(m).tobytes() for m in matrices]
+    return [rows.index(row) for row in rows]
 
 
 class WarpServer:
@@ -87,7 +91,7 @@ class WarpServer:
         keep = self._keep
         self.max_splat = float(min(MAX_SPLAT_PX, ctx.info["GL_POINT_SIZE_RANGE"][1]))
 
-        geometry = {"quad": WARP_QUAD_GEOMETRY_SHADER, "mesh": WARP_MESH_GEOMETRY_SHADER}.get(reconstruction)
+        geometry = {"quad": WARP_QUAD_GEOMETRY_SHADER, "mesh": mesh_geometry_shader(object_count)}.get(reconstruction)
         fragment = GRID_FRAGMENT_SHADER if reconstruction == "grid" else WARP_FRAGMENT_SHADER
         program = keep(
             ctx.program(vertex_shader=warp_vertex_shader(reconstruction, object_count), geometry_shader=geometry, fragment_shader=fragment)
@@ -96,7 +100,7 @@ class WarpServer:
         settings = {
             "client_colour": 0, "client_surface": 1, "coverage": 2, "client_size": client_size, "id_scale": ID_SCALE,
             "background_ndc_z": BACKGROUND_NDC_Z, "server_size": tuple(float(v) for v in server_size),
-            "max_splat": self.max_splat, "splat_rounding": SPLAT_ROUNDING, "max_depth_step": MESH_DEPTH_STEP,
+            "max_splat": self.max_splat, "splat_rounding": SPLAT_ROUNDING,
         }  # fmt: skip
         for name, value in settings.items():
             if name in program:
@@ -145,6 +149,8 @@ class WarpServer:
             # moderngl takes matrices column-major; numpy holds them row-major
             columns = np.asarray(view_matrices, dtype=np.float64).transpose(0, 2, 1)
             self.warp_program["warp_matrices"].write(np.ascontiguousarray(columns, dtype=np.float32).tobytes())
+            if "motion_class" in self.warp_program:
+                self.warp_program["motion_class"].value = motion_classes(view_matrices)
             if "arbitrate" in self.warp_program:
                 self.warp_program["arbitrate"].value = view > 0
             target.colour.use(0)

@@ -176,7 +176,6 @@ _MESH_VERTEX_MAIN = """
 // One vertex per client pixel centre; triangles of neighbouring pixels are drawn by index.
 out Vertex {
     vec4 colour;  // rgb, and the object id in alpha
-    float client_depth;
 } vertex;
 
 void main() {
@@ -185,7 +184,6 @@ void main() {
     int id = object_of(surface);
     gl_Position = warped(id, pixel_ndc(vec2(texel) + 0.5), surface.x);
     vertex.colour = vec4(texelFetch(client_colour, texel, 0).rgb, float(id));
-    vertex.client_depth = surface.x;
 }
 """
 
@@ -237,26 +235,23 @@ void main() {
 
 WARP_MESH_GEOMETRY_SHADER = """
 #version 330
-// Mesh reconstruction (section 4.1; Mark and McMillan's connected pixel mesh): a triangle of three
-// neighbouring client pixels is drawn only where they show one surface: the same object, client
-// depths within max_depth_step of each other. Others would stretch a rubber sheet across a
-// silhouette; they are dropped and leave a hole for the fill.
+// Mesh reconstruction (section 4.1): the client pixels as one connected triangle mesh, as the seed
+// draws it, except between objects that move apart: a triangle whose pixels belong to objects with
+// different warps (motion_class) would stretch a rubber sheet across their silhouette; it is dropped
+// and leaves a hole for the fill. Within one motion the warp maps pixel centres onto the vertices,
+// so an unmoved part of the mesh reproduces the client image exactly.
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
-uniform float max_depth_step;
+uniform int motion_class[%OBJECTS%];
 in Vertex {
     vec4 colour;
-    float client_depth;
 } vertex[];
 out %SPLAT% splat;
+int motion_of(int i) {
+    return motion_class[int(vertex[i].colour.a + 0.5)];
+}
 void main() {
-    float id = vertex[0].colour.a;
-    if (vertex[1].colour.a != id || vertex[2].colour.a != id) {
-        return;
-    }
-    float lo = min(vertex[0].client_depth, min(vertex[1].client_depth, vertex[2].client_depth));
-    float hi = max(vertex[0].client_depth, max(vertex[1].client_depth, vertex[2].client_depth));
-    if (hi - lo > max_depth_step) {
+    if (motion_of(1) != motion_of(0) || motion_of(2) != motion_of(0)) {
         return;
     }
     for (int i = 0; i < 3; ++i) {
@@ -269,6 +264,11 @@ void main() {
     EndPrimitive();
 }
 """.replace("%SPLAT%", _SPLAT)
+
+
+def mesh_geometry_shader(object_count: int) -> str:
+    """WARP_MESH_GEOMETRY_SHADER for a scene of `object_count` objects."""
+    return WARP_MESH_GEOMETRY_SHADER.replace("%OBJECTS%", str(int(object_count)))
 
 _COVERAGE_TEST = """
 uniform float id_scale;

@@ -164,6 +164,22 @@ def test_the_adaptive_grid_draws_at_least_four_times_fewer_primitives_than_point
     assert errors["grid"] <= errors["point"]
 
 
+def test_an_unmoved_mesh_reproduces_the_client_image():
+    """At the client's own pose the mesh's vertices land on pixel centres, each pixel showing its
+    own colour; dropping the triangles between the sphere (its own warp) and the load leaves the
+    sphere's rim pixels to triangles on either side."""
+    renderer = opened(recon="mesh")
+    try:
+        client_frame(renderer, 0, [0.05, -0.02, 0.0])
+        image = display(renderer, 0, [0.05, -0.02, 0.0], 0)
+        reference = renderer.render_reference(np.array([0.05, -0.02, 0.0]))
+        holes = renderer.hole_fraction()
+    finally:
+        renderer.close()
+    assert holes * WIDTH * HEIGHT < 2 * np.pi * RADIUS * PX_PER_M
+    assert np.all(image == reference, axis=2).mean() > 0.995
+
+
 def test_the_mesh_warp_stays_close_to_the_reference():
     """The mesh interpolates colours and drops triangles across edges (their holes are filled): a
     little more error than point splats, nowhere near a failed warp's."""
