@@ -109,7 +109,8 @@ def _run(args: argparse.Namespace) -> int:
         raise ConfigError(f"rig measure needs --{', --'.join(missing)} (or --self-test)")
     settings, scanout = parse_window_address(args.display.removeprefix("window").removeprefix(":"))
     config = LiveConfig(
-        tracker=args.tracker, renderer=EXTERNAL if args.external else args.renderer, predictor=args.predictor,
+        tracker=args.tracker, renderer=EXTERNAL if args.external else args.renderer, predictor=args.predictor[0],
+        predictor_params=tuple(args.predictor[1].items()),
         duration_s=args.duration or 60.0, window=settings, scanout_fraction=scanout, photon_target=args.photon_target,
         streams=None if args.no_lsl else StreamNames(args.pose_stream, args.tracker_stream, args.marker_stream),
         mirror=args.mirror, until_still=args.until_still,
@@ -137,7 +138,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--renderer", default="warp", metavar="NAME",
                         help="the rig's renderer (warp, direct, warp:options, a plug-in) (default: %(default)s)")  # fmt: skip
     parser.add_argument("--external", action="store_true", help="measure an external renderer over LSL instead (see README)")
-    parser.add_argument("--predictor", default="default", help="the pose predictor (default: %(default)s)")
+    parser.add_argument("--predictor", type=options.predictor_spec, default=("default", {}), metavar="NAME[:key=value,...]",
+                        help="the pose predictor, with parameters or a `rig tune` file (default: default)")  # fmt: skip
     parser.add_argument("--display", default="window", metavar="SPEC",
                         help="the window: window[:MONITOR][?fullscreen=1&size=WxH&pos=X,Y&scanout=F] (default: %(default)s)")  # fmt: skip
     parser.add_argument("--duration", type=options.positive_float, metavar="S", help="seconds to run (default: 60; self-test 20)")

@@ -59,6 +59,7 @@ class LiveConfig:
     tracker: str
     renderer: str = "warp"
     predictor: str = "default"
+    predictor_params: tuple[tuple[str, Any], ...] = ()
     duration_s: float = 30.0
     window: WindowSettings = WindowSettings()
     scanout_fraction: float = 1.0
@@ -170,6 +171,7 @@ def run_live(
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise RigError(f"cannot make the output folder {out_dir}: {error.strerror}") from None
+    predictor = predictors.make(config.predictor, **dict(config.predictor_params))
     external = config.renderer == EXTERNAL
     width, height = (640, 480) if external else config.window.size
     if view is None:
@@ -195,7 +197,7 @@ def run_live(
         parts = SessionParts(
             clock=clock,
             tracker=PublishingTracker(swing or tracker, publisher),
-            predictor=predictors.make(config.predictor),
+            predictor=predictor,
             renderer=PublishingRenderer(renderer, publisher, clock),
             render_setup=setup,
             timing=timing_for(renderer, cost_model(None)),
