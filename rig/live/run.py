@@ -173,6 +173,7 @@ def run_live(
         raise RigError(f"cannot make the output folder {out_dir}: {error.strerror}") from None
     predictor = predictors.make(config.predictor, **dict(config.predictor_params))
     external = config.renderer == EXTERNAL
+    renderer = ExternalRenderer() if external else make_renderer(config.renderer)
     width, height = (640, 480) if external else config.window.size
     if view is None:
         view = frame_view(config.tracker, clock, width, height, config.mirror)
@@ -191,7 +192,6 @@ def run_live(
         publisher = LslPublisher(config.streams, display.refresh_hz, published)
         tracker = make_device("tracker", config.tracker, DeviceContext())
         swing = SwingWatch(tracker) if config.until_still else None
-        renderer = ExternalRenderer() if external else make_renderer(config.renderer)
         setup = RenderSetup(width=display.width, height=display.height, world_to_clip=view.world_to_clip,
                             sphere_radius_m=view.sphere_radius_m, scene_triangles=config.scene_triangles, wait_for_gpu=True)  # fmt: skip
         parts = SessionParts(
