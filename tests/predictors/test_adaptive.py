@@ -2,6 +2,7 @@
 synthetic streams, its state, and its sample rules beyond the shared hard cases."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ from hypothesis import strategies as st
 
 from predictors import PoseSample, PredictorError, make
 from predictors import quaternion as quat
+from predictors import scalar_quaternion as squat
 from predictors.adaptive import HORIZONS_S
 from predictors.evaluation import replay, score
 from predictors.horizon_scores import MODEL_NAMES
@@ -151,3 +153,27 @@ def test_law_predictions_are_continuous_across_the_scored_horizons(head, start, 
     below, above = predictor.predict(t - epsilon), predictor.predict(t + epsilon)
     assert np.linalg.norm(below.position - above.position) < 10.0 * epsilon
     assert quat.angle_between(below.orientation, above.orientation) < 100.0 * epsilon
+
+
+@pytest.mark.slow
+def test_a_million_samples_stay_exact_bounded_and_positive_definite():
+    """A thousand seconds at 1000 Hz of noiseless constant-velocity motion: the prediction is still
+    exact, the history it keeps for scoring stays bounded, and every smoother's covariance stays
+    positive definite. (Samples as plain tuples, which predictors take as they take a PoseSample:
+    building a million PoseSamples would take longer than the predictor.)"""
+    predictor = make("adaptive")
+    samples = 1_000_000
+    q0 = tuple(Q0.tolist())
+    (px, py, pz), (vx, vy, vz), (wx, wy, wz) = P0.tolist(), VELOCITY.tolist(), OMEGA.tolist()
+    for k in range(samples):
+        t = 0.001 * k
+        orientation = squat.rotated_by(wx * t, wy * t, wz * t, q0)
+        predictor.update(SimpleNamespace(t_sensor=t, position=(px + vx * t, py + vy * t, pz + vz * t), orientation=orientation))
+    t = 0.001 * (samples - 1)
+    for horizon in (0.0, 0.02, 0.1):
+        truth, prediction = constant_velocity(t + horizon), predictor.predict(t + horizon)
+        np.testing.assert_allclose(prediction.position, truth.position, rtol=0, atol=1e-6)
+        assert quat.angle_between(prediction.orientation, truth.orientation) < 1e-6
+    assert len(predictor._history) < 600
+    for covariance in predictor._smoothers._covariances:
+        assert min(covariance.diagonal_factor()) > 0.0
