@@ -38,7 +38,7 @@ from math import exp, log, sqrt
 from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
-from predictors.checks import finite_time, no_sample_yet, read_sample
+from predictors.checks import horizon, read_sample
 from predictors.extrapolators import MIN_INTERVAL
 from predictors.horizon_scores import BASELINE, COLD_START, MODEL_NAMES, MODELS, Choice, HorizonScore
 from predictors.params import MAX_GAP, MAX_HORIZON, OPEN_UNIT, POSITIVE, Param, ParamSet, declare_params
@@ -214,13 +214,13 @@ class Adaptive:
         scored = []
         for last, k in due:
             score = self._scores[k]
-            horizon = score.horizon
+            ahead = score.horizon
             i = self._anchors[k]
-            while i + 1 < newest and history[i + 1][0] + horizon <= t:
+            while i + 1 < newest and history[i + 1][0] + ahead <= t:
                 i += 1
             self._anchors[k] = i
             t_anchor, p_anchor, q_anchor, estimates = history[i]
-            target = t_anchor + horizon
+            target = t_anchor + ahead
             if not t_before < target <= t:
                 continue
             # The truth at the target, between the sample before and the newest: the turn from the
@@ -237,7 +237,7 @@ class Adaptive:
                 p_now[1] - back * (p_now[1] - p_before[1]) - p_anchor[1],
                 p_now[2] - back * (p_now[2] - p_before[2]) - p_anchor[2],
             ) if self._position_moved else None
-            weight = min(t - last, self.max_gap) if last > -math.inf else min(t - t_before, horizon)
+            weight = min(t - last, self.max_gap) if last > -math.inf else min(t - t_before, ahead)
             lasts[k] = t
             score.learn(turn, moved, estimates, weight, self.memory, self.gain_prior)
             scored.append(k)
@@ -270,13 +270,7 @@ class Adaptive:
     def predict(self, t: float) -> Pose:
         """The pose at t (s): each part blended from the models trusted at the horizons either side
         of t - (newest sample time), at most max_horizon seconds either way."""
-        last = self._t
-        if last is None:
-            raise no_sample_yet(self.name)
-        t = finite_time(t, self.name)
-        h = t - last
-        limit = self.max_horizon
-        h = limit if h > limit else -limit if h < -limit else h
+        t, h = horizon(t, self._t, self.max_horizon, self.name)
         trusted = self._trusted
         if h <= HORIZONS_S[0]:
             blend: tuple[tuple[Choice, float], ...] = ((trusted[0], 1.0),)

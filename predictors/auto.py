@@ -27,7 +27,7 @@ from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
-from predictors.checks import finite_time, no_sample_yet, read_sample
+from predictors.checks import horizon, read_sample
 from predictors.kalman import (
     ACCELERATION_NOISE,
     ANGULAR_ACCELERATION_NOISE,
@@ -158,13 +158,7 @@ class Auto:
 
     def predict(self, t: float) -> Pose:
         """The pose at t (s) from the chosen models."""
-        last = self._t
-        if last is None:
-            raise no_sample_yet(self.name)
-        t = finite_time(t, self.name)
-        h = t - last
-        limit = self.max_horizon
-        h = limit if h > limit else -limit if h < -limit else h
+        t, h = horizon(t, self._t, self.max_horizon, self.name)
         model = self._position_model
         if model == 0:
             position = self._position

@@ -39,6 +39,17 @@ def no_sample_yet(name: str) -> PredictorError:
     return PredictorError(f"predictor {name!r} has no sample yet; call update(sample) before predict(t)")
 
 
+def horizon(t: Any, newest: float | None, limit: float, name: str) -> tuple[float, float]:
+    """(t, h): the time asked as a float and its horizon from the newest sample's time, clamped to
+    [-limit, limit] (a drop-out holds the motion instead of flying away); PredictorError before the
+    first sample or for a time that is not finite."""
+    if newest is None:
+        raise no_sample_yet(name)
+    t = finite_time(t, name)
+    h = t - newest
+    return t, limit if h > limit else -limit if h < -limit else h
+
+
 def read_sample(sample: Any, name: str) -> tuple[float, Vector, Quaternion]:
     """(t_sensor, position, orientation) of a sample as floats; PredictorError if any is unusable.
 

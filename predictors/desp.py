@@ -25,7 +25,7 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
-from predictors.checks import finite_time, no_sample_yet, read_sample
+from predictors.checks import horizon, read_sample
 from predictors.params import LOGIT, MAX_GAP, MAX_HORIZON, OPEN_UNIT, POSITIVE, Param, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
 
@@ -121,15 +121,9 @@ class DoubleExponentialSmoothing:
 
     def predict(self, t: float) -> Pose:
         """The pose at t (s), extrapolated (t - newest sample time) / sample interval samples ahead."""
-        last = self._t
-        if last is None:
-            raise no_sample_yet(self.name)
-        t = finite_time(t, self.name)
+        t, h = horizon(t, self._t, self.max_horizon, self.name)
         state: Any = self._state
         interval = self._interval
-        h = t - last
-        limit = self.max_horizon
-        h = limit if h > limit else -limit if h < -limit else h
         tau = 0.0 if interval is None else h / interval
         a = self.position_alpha
         gain = 1.0 + a * tau / (1.0 - a)

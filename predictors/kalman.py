@@ -46,7 +46,7 @@ from __future__ import annotations
 from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
-from predictors.checks import finite_time, no_sample_yet, read_sample
+from predictors.checks import horizon, read_sample
 from predictors.kinematic_covariance import KinematicCovariance, damped_reach, damped_step
 from predictors.params import LOG, MAX_GAP, MAX_HORIZON, NON_NEGATIVE, POSITIVE, Param, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
@@ -255,13 +255,7 @@ class _KalmanPredictor:
     def predict(self, t: float) -> Pose:
         """The pose at t (s): the model run forward (or back) from the newest sample, at most
         max_horizon seconds."""
-        last = self._t
-        if last is None:
-            raise no_sample_yet(self.name)
-        t = finite_time(t, self.name)
-        h = t - last
-        limit = self.max_horizon
-        h = limit if h > limit else -limit if h < -limit else h
+        t, h = horizon(t, self._t, self.max_horizon, self.name)
         return Pose(t, self._position.at(h), self._orientation.at(h))  # type: ignore[union-attr]
 
     def reset(self) -> None:
