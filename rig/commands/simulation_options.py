@@ -39,6 +39,21 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--display-hz", type=options.positive_float, default=DisplayConfig().refresh_hz, help="display refresh rate (default: %(default)s)")
     group.add_argument("--tracker-hz", type=options.positive_float, default=TrackerConfig().rate_hz, help="tracker sample rate (default: %(default)s)")
     group.add_argument("--camera-fps", type=options.positive_float, default=CameraConfig().fps, help="camera frame rate (default: %(default)s)")
+    group.add_argument(
+        "--exposure",
+        type=_exposure_fraction,
+        default=1.0,
+        metavar="F",
+        help="camera exposure as a fraction of the frame interval, in (0, 1] (default: %(default)s, the whole interval)",
+    )
+    group.add_argument(
+        "--display-phase",
+        type=_refresh_fraction,
+        default=DisplayConfig().phase,
+        metavar="P",
+        help="when the display's refreshes start against the camera's frames, as a fraction of a refresh "
+        "in [0, 1) (default: %(default)s)",
+    )
     group.add_argument("--duration", type=options.positive_float, default=defaults.duration_s, help="filmed seconds (default: %(default)s)")
     group.add_argument("--seed", type=int, default=defaults.seed, help="random seed; the same seed gives the same video (default: %(default)s)")
     group.add_argument("--scene-triangles", type=options.non_negative_int, default=0, help="load geometry drawn behind the sphere (default: 0)")
@@ -81,6 +96,20 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--quality", type=options.positive_float, default=PendulumConfig().quality, help="pendulum quality factor Q (default: %(default)s)")
 
 
+def _exposure_fraction(text: str) -> float:
+    value = options.positive_float(text)
+    if value > 1.0:
+        raise argparse.ArgumentTypeError(f"an exposure is at most the whole frame interval (1), got {text}")
+    return value
+
+
+def _refresh_fraction(text: str) -> float:
+    value = options.non_negative_float(text)
+    if value >= 1.0:
+        raise argparse.ArgumentTypeError(f"a display phase is a fraction of a refresh below 1, got {text}")
+    return value
+
+
 def config_from_args(args: argparse.Namespace) -> SimulationConfig:
     predictor, params = args.predictor
     return SimulationConfig(
@@ -88,8 +117,8 @@ def config_from_args(args: argparse.Namespace) -> SimulationConfig:
         seed=args.seed,
         pendulum=PendulumConfig(period_s=args.period_s, amplitude_deg=args.amplitude_deg, quality=args.quality),
         tracker=TrackerConfig(rate_hz=args.tracker_hz, transport_delay_s=args.transport_delay_ms / 1e3),
-        display=DisplayConfig(refresh_hz=args.display_hz),
-        camera=CameraConfig(fps=args.camera_fps),
+        display=DisplayConfig(refresh_hz=args.display_hz, phase=args.display_phase),
+        camera=CameraConfig(fps=args.camera_fps, exposure_s=args.exposure / args.camera_fps),
         renderer=args.renderer,
         predictor=predictor,
         predictor_params=params,

@@ -1,10 +1,11 @@
 """A simulated high-speed camera filming the LED and the display (`SimCamera`).
 
-Each frame integrates the scene over its exposure by averaging `subsamples` instants (motion blur),
-adds a dark level and read noise, and saturates at 255 like an 8-bit sensor. The LED is a bright
-Gaussian spot whose core saturates, as bright as its drive level (0..255, the board's PWM) at each
-instant makes it; the display panel shows whatever each of its rows emits at
-each instant (the session works that out from the display's scan-out).
+Each frame integrates the scene over its exposure, adds a dark level and read noise, and saturates
+at 255 like an 8-bit sensor. The LED is a bright Gaussian spot whose core saturates, as bright as
+its drive level (0..255, the board's PWM) at each instant makes it, averaged over `subsamples`
+instants of the exposure (motion blur); the display panel's rows are integrated exactly, each
+refresh a row shows weighted by how long it shows it during the exposure (`rig.sim.scene`), so a
+refresh that switches inside an exposure is seen where it switches, as a real sensor sees it.
 
 Read noise is drawn from a bank of precomputed noise fields at random offsets: full per-pixel
 Gaussian draws would dominate the simulation's cost, and the analyser cannot tell the difference.
@@ -60,10 +61,10 @@ class CameraConfig:
     def exposure(self) -> float:
         """Exposure time (s); the whole frame interval unless set.
 
-        A full-interval exposure (a 360-degree shutter) is what the video method needs: the
-        display's staircase has components at multiples of the camera rate that a shorter exposure
-        aliases onto the swing frequency, biasing the measured phase by up to a millisecond when
-        camera and display rates are commensurate (240 fps filming 60 Hz).
+        An exposure shorter than a whole number of refreshes sees each refresh's held image for a
+        share of the exposure that depends on where the refresh falls in it; where camera and
+        display rates are commensurate that share repeats, and the video's timing of the sphere is
+        biased by up to half a refresh (``analysis.sampling`` works out by how much).
         """
         return self.exposure_s if self.exposure_s is not None else 1.0 / self.fps
 
@@ -160,7 +161,7 @@ class SimCamera:
             t_start = float(self.frame_times[self._next])
             instants = self.frame_times[self._next] + offsets
             image = self._sensor.expose(
-                self.scene.led_pixels(instants), self.scene.panel_light(instants), self.scene.panel, self.scene.led_levels(instants)
+                self.scene.led_pixels(instants), self.scene.panel_light(t_start, exposure), self.scene.panel, self.scene.led_levels(instants)
             )
             frames.append(CameraFrame(self._next, t_start, exposure, image))
             self._next += 1

@@ -1,7 +1,9 @@
 """A simulated display: vertical blanks, top-to-bottom scan-out and sample-and-hold.
 
-Refresh k starts at its vertical blank `t0 + k / refresh_hz`. Rows are scanned out from the top
-(row fraction 0) to the bottom (row fraction 1) over `scanout_fraction` of the refresh period, and
+Refresh k starts at its vertical blank `t0 + (k + phase) / refresh_hz`. In a simulated run t0 is
+the rig clock's start, the warm-up before the camera's first frame (often a whole number of
+refreshes, so that refreshes start with camera frames); `phase` (a fraction of a refresh) shifts
+the refreshes against the camera's frames, as an independent display clock does in a lab. Rows are scanned out from the top (row fraction 0) to the bottom (row fraction 1) over `scanout_fraction` of the refresh period, and
 each row keeps emitting what it was last given until it is scanned out again (sample-and-hold,
 no black insertion). A frame handed over at time t appears at the first vertical blank strictly
 after t (a swap requested exactly at a blank has missed it), and at most one new frame appears
@@ -34,6 +36,7 @@ class DisplayConfig:
     height: int = 240
     scanout_fraction: float = 1.0
     t0: float = 0.0
+    phase: float = 0.0
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.refresh_hz) and 1.0 <= self.refresh_hz <= 1000.0):
@@ -42,6 +45,13 @@ class DisplayConfig:
             raise ConfigError(f"display resolution must be at least 16x16, got {self.width}x{self.height}")
         if not 0.0 < self.scanout_fraction <= 1.0:
             raise ConfigError(f"scan-out fraction must be in (0, 1], got {self.scanout_fraction}")
+        if not (np.isfinite(self.phase) and 0.0 <= self.phase < 1.0):
+            raise ConfigError(f"display phase must be a fraction of a refresh in [0, 1), got {self.phase}")
+
+    @property
+    def origin(self) -> float:
+        """The vertical blank of refresh 0 (s)."""
+        return self.t0 + self.phase / self.refresh_hz
 
 
 class SimDisplay:
@@ -69,14 +79,14 @@ class SimDisplay:
 
     def vblank_time(self, k: int) -> float:
         """Start of refresh k (s); k may also be an integer array."""
-        return self.config.t0 + k * self.period_s
+        return self.config.origin + k * self.period_s
 
     def refresh_after(self, t: float) -> int:
         """Index of the first vertical blank strictly after time t: when a frame handed over at t appears.
 
         A time within a nanosecond-scale rounding error of a blank counts as at that blank.
         """
-        return int(np.floor((t - self.config.t0) / self.period_s + _ROUNDING)) + 1
+        return int(np.floor((t - self.config.origin) / self.period_s + _ROUNDING)) + 1
 
     def scanout_delay(self, row_fraction: float | np.ndarray) -> float | np.ndarray:
         """Time from the vertical blank until the row at `row_fraction` (0 top, 1 bottom) is lit."""
@@ -88,7 +98,7 @@ class SimDisplay:
 
     def refresh_shown(self, t: np.ndarray, row_fraction: np.ndarray) -> np.ndarray:
         """Index of the refresh that row `row_fraction` shows at time t (broadcast); -1 before the first."""
-        since = np.asarray(t) - self.config.t0 - self.scanout_delay(np.asarray(row_fraction))
+        since = np.asarray(t) - self.config.origin - self.scanout_delay(np.asarray(row_fraction))
         return np.maximum(np.floor(since / self.period_s).astype(np.int64), -1)
 
     def present(self, image: np.ndarray, t_ready: float, image_id: int) -> int:

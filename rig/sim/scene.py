@@ -52,20 +52,27 @@ class FilmedScene:
         """The LED's drive level 0..255 at each instant; None for an LED always fully on."""
         return self._board.led_level(instants) if self._board is not None else None
 
-    def panel_light(self, instants: np.ndarray) -> np.ndarray:
-        """The display panel's light averaged over the given instants, row by row (scan-out)."""
-        content = self.display.content
-        refresh = self.display.refresh_shown(instants[:, None], self._rows[None, :])
+    def panel_light(self, start: float, exposure: float) -> np.ndarray:
+        """The display panel's light averaged over the exposure [start, start + exposure], row by row:
+        each refresh a row shows counts for exactly the time it shows it during the exposure
+        (scan-out), so where a refresh switches inside an exposure is not rounded to an instant."""
+        display = self.display
+        end = start + exposure
+        first = display.refresh_shown(np.array(start), self._rows)
+        last = display.refresh_shown(np.array(end), self._rows)
+        refresh = first[None, :] + np.arange(int((last - first).max()) + 1)[:, None]
+        begins = display.vblank_time(refresh) + display.scanout_delay(self._rows)[None, :]
+        shown = np.clip(np.minimum(begins + display.period_s, end) - np.maximum(begins, start), 0.0, None) / exposure
         # Only the last few refreshes can be on screen: look them up without copying all of content.
-        first = max(int(refresh.min()), 0)
-        recent = np.asarray(content[first:])
-        image_ids = np.where(refresh >= 0, recent[np.maximum(refresh, 0) - first], NO_IMAGE)
+        oldest = max(int(refresh.min()), 0)
+        recent = np.asarray(display.content[oldest:])
+        image_ids = np.where(refresh >= 0, recent[np.clip(refresh - oldest, 0, len(recent) - 1)], NO_IMAGE)
         _, _, pw, ph = self.panel
         light = np.zeros((ph, pw), dtype=np.float32)
         for image_id in np.unique(image_ids):
-            weight = (image_ids == image_id).mean(axis=0).astype(np.float32)
-            shown = self._panel_image(int(image_id)) if image_id != NO_IMAGE else self._black
-            light += weight[:, None] * shown
+            weight = np.where(image_ids == image_id, shown, 0.0).sum(axis=0).astype(np.float32)
+            image = self._panel_image(int(image_id)) if image_id != NO_IMAGE else self._black
+            light += weight[:, None] * image
         return light
 
     def _panel_image(self, image_id: int) -> np.ndarray:
