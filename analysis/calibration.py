@@ -4,7 +4,8 @@ Most videos are decoded once: their first frames are held to find the ROIs and t
 before tracking starts. A video that can skip frames and decode rectangles cheaply (Motion-JPEG) is
 instead calibrated on a sample of its first frames, then read again from the start (see
 ``analysis.tracks``). Without ROIs from the user, the two largest moving bright regions are the
-blobs, and a rule tells the LED from the sphere.
+blobs: the LED is the one on the side the user names, or else, provisionally, the left one, until
+the whole video's evidence decides (``analysis.identity``, applied by ``analysis.tracks``).
 """
 
 from __future__ import annotations
@@ -36,28 +37,27 @@ CALIBRATION_SAMPLED_FRAMES = 120
 # until both blobs swing from the start of the frames calibrated on (see calibration_window), but
 # never more than this many bytes of it.
 CALIBRATION_MAX_BYTES = 1024 * 2**20
-# Blobs whose typical peaks differ by less than this fraction count as equally bright.
-EQUAL_BRIGHTNESS = 0.02
 # A blob swings when its place changes by this many times its size, and this many pixels, over
 # about SWING_SAMPLES frames.
 SWING_SIZES = 2.0
 SWING_MIN_PX = 4.0
 SWING_SAMPLES = 32
 
-BRIGHTER_RULE = "auto: brighter blob is the LED"
-LEFT_RULE = "auto: blobs equally bright, left blob is the LED"
+PROVISIONAL_RULE = "auto: left blob, until the evidence decides"
 SIDES = ("left", "right")
 
 
 @dataclass(frozen=True)
 class Calibration:
     """The LED's and the sphere's blob models, where their ROIs came from ("given" or "auto") and
-    the rule that told the LED from the sphere."""
+    the rule that told the LED from the sphere; ``decided`` is False while that is provisional (the
+    left blob taken as the LED until the evidence in the whole video decides)."""
 
     led: BlobModel
     sphere: BlobModel
     roi_source: str
     led_rule: str
+    decided: bool = True
 
 
 def calibration_plan(fps: float | None, decodes_in_part: bool) -> tuple[int, int]:
@@ -72,15 +72,9 @@ def _side_rule(side: str) -> str:
     return f"given: {side} blob is the LED"
 
 
-def _auto_models(
-    images: Sequence[np.ndarray], led_side: str | None, warnings: list[str]
-) -> tuple[BlobModel, BlobModel, str]:
-    """LED and sphere models from the two largest moving regions, and the rule that told them apart.
-
-    With ``led_side`` the blob on that side is the LED. Otherwise the brighter blob (higher typical
-    peak above its background) is the LED; if both are equally bright (within EQUAL_BRIGHTNESS,
-    e.g. both saturated) the left one is.
-    """
+def _auto_models(images: Sequence[np.ndarray], led_side: str | None, warnings: list[str]) -> Calibration:
+    """LED and sphere models from the two largest moving regions: the LED on ``led_side`` if
+    given, else provisionally the left one (not decided)."""
     regions = find_moving_regions(images)
     if len(regions) < 2:
         raise AnalysisError(
@@ -95,16 +89,11 @@ def _auto_models(
         )
     first, second = (calibrate_blob(roi, images, "auto-detected") for roi in regions[:2])
     left, right = (first, second) if first.roi.x <= second.roi.x else (second, first)
-    if led_side is not None:
-        return (left, right, _side_rule("left")) if led_side == "left" else (right, left, _side_rule("right"))
-    brighter, dimmer = (first, second) if first.typical_peak >= second.typical_peak else (second, first)
-    if dimmer.typical_peak < (1 - EQUAL_BRIGHTNESS) * brighter.typical_peak:
-        return brighter, dimmer, BRIGHTER_RULE
-    warnings.append(
-        "the two blobs are equally bright; took the left one as the LED. "
-        "Give led_side or led_roi and sphere_roi if that is wrong"
-    )
-    return left, right, LEFT_RULE
+    if led_side == "right":
+        return Calibration(right, left, "auto", _side_rule("right"))
+    if led_side == "left":
+        return Calibration(left, right, "auto", _side_rule("left"))
+    return Calibration(left, right, "auto", PROVISIONAL_RULE, decided=False)
 
 
 def calibrate(
@@ -113,8 +102,7 @@ def calibrate(
     """The blob models from the frames held: in the given (LED, sphere) ROIs, else in the two
     largest moving regions (see ``_auto_models``); warnings about the choice go to ``warnings``."""
     if given is None:
-        led, sphere, rule = _auto_models(images, led_side, warnings)
-        return Calibration(led, sphere, "auto", rule)
+        return _auto_models(images, led_side, warnings)
     return Calibration(calibrate_blob(given[0], images, "LED"), calibrate_blob(given[1], images, "sphere"), "given", "given")
 
 

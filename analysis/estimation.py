@@ -3,11 +3,15 @@
 The free swing is measured once (``analysis.swing``); its phase lag, known modulo one period, and
 the swing's one-off events decide the whole number of periods (``analysis.cycles``); then each
 requested estimator (``analysis.estimators``) runs on the same context, each taking that same
-whole number of periods.
+whole number of periods. Every estimate is then checked for model misfit (``analysis.misfit``,
+which widens a failing estimate's interval) and for the camera's sampling of the display
+(``analysis.sampling``, which corrects the bias where the video identifies it and otherwise
+widens the interval by it); each adds a warning when it changed something.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -19,9 +23,12 @@ from analysis.cycles import DEFAULT_LATENCY_RANGE_S, resolve_cycles
 from analysis.errors import AnalysisError
 from analysis.estimators.contract import EstimationContext
 from analysis.estimators.registry import ALL, DEFAULT_METHOD, estimators_for
+from analysis.misfit import MisfitReport, check_fit
 from analysis.phase import fft_phase_latency
-from analysis.result import LatencyResult
-from analysis.swing import measure_swing
+from analysis.result import LatencyResult, MethodResult
+from analysis.sampling import SamplingBias, measure_sampling
+from analysis.sampling.residuals import timing_residuals
+from analysis.swing import during, measure_swing
 from analysis.timing import implausible_period_warning
 from analysis.tracking import Track
 from analysis.tracks import Tracks
@@ -43,6 +50,8 @@ def estimate(
     latency_range_ms: Sequence[float] = tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S),
     seed: int = 0,
     reference_departures: Callable[[Track], Mapping[str, float]] | None = None,
+    refresh_hz: float | None = None,
+    exposure_ms: float | None = None,
 ) -> LatencyResult:
     """Measure by how much the sphere lags the LED in tracks from ``analysis.tracks.track``.
 
@@ -53,9 +62,13 @@ def estimate(
     other instruments saw the pendulum depart from rest, in the sense of ``analysis.onset`` (e.g. a
     rig board's encoder, its clock aligned by the LED's blink code, which it reads from the LED
     track); with the sphere's departure each gives a lag that fixes the whole number of periods.
+    ``refresh_hz`` (the display's refresh rate) and ``exposure_ms`` (the camera's exposure) are
+    what the user knows of them; without them the video is searched for both
+    (``analysis.sampling``).
     """
     estimators = estimators_for(method)
     range_s = latency_range_s(latency_range_ms)
+    check_sampling_options(refresh_hz, exposure_ms)
     started = time.perf_counter()
     warnings = list(tracks.warnings)
     references = reference_departures(tracks.led) if reference_departures is not None else {}
@@ -70,7 +83,21 @@ def estimate(
         warnings.append(cycles.warning)
     context = EstimationContext(swing, cycles, seed, warnings)
     results = {estimator.name: estimator.estimate(context) for estimator in estimators}
-    primary = results[DEFAULT_METHOD if method == ALL else method]
+    primary_name = DEFAULT_METHOD if method == ALL else method
+    measured = results[primary_name]
+    residuals = timing_residuals(swing.signals, measured.latency_ms / 1e3, during(tracks.sphere, swing.span_s))
+    half_width_s = (measured.ci95_ms[1] - measured.ci95_ms[0]) / 2e3 if measured.ci95_ms is not None else 0.0
+    checks = check_fit(swing, windowed_latency(swing.windows, measured.latency_ms / 1e3), residuals, half_width_s)
+    sampling = (
+        measure_sampling(residuals, tracks.led, swing.period_s, refresh_hz, None if exposure_ms is None else exposure_ms / 1e3)
+        if residuals is not None
+        else None
+    )
+    results = {name: _adjusted(result, checks, sampling) for name, result in results.items()}
+    primary = results[primary_name]
+    for warning in (checks.warning(), _sampling_warning(sampling, measured, primary, checks)):
+        if warning:
+            warnings.append(warning)
     both = tracks.led.valid & tracks.sphere.valid
     diagnostics: dict[str, Any] = {
         **tracks.diagnostics,
@@ -99,6 +126,49 @@ def estimate(
         cycles=cycles,
         windowed=windowed_latency(swing.windows, primary.latency_ms / 1e3),
         diagnostics=diagnostics,
+        sampling=sampling,
+        checks=checks,
         led_track=tracks.led,
         sphere_track=tracks.sphere,
     )
+
+
+def check_sampling_options(refresh_hz: float | None, exposure_ms: float | None) -> None:
+    """AnalysisError unless the display's refresh and the camera's exposure, where given, are
+    positive finite numbers."""
+    for name, value, unit in (("refresh_hz", refresh_hz, "Hz"), ("exposure_ms", exposure_ms, "ms")):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise AnalysisError(f"{name} must be a positive number of {unit}, not {value!r}")
+
+
+def _adjusted(result: MethodResult, checks: MisfitReport, sampling: SamplingBias | None) -> MethodResult:
+    """An estimator's result with its interval widened by a failed check, then corrected and
+    widened for the camera's sampling of the display."""
+    latency_s = result.latency_ms / 1e3
+    ci_s = None if result.ci95_ms is None else (result.ci95_ms[0] / 1e3, result.ci95_ms[1] / 1e3)
+    widened = checks.widen(latency_s, ci_s)
+    corrected, interval = sampling.apply(latency_s, widened) if sampling is not None else (latency_s, widened)
+    details = {
+        **result.details,
+        "measured_ms": result.latency_ms,
+        "statistical_ci95_ms": result.ci95_ms and list(result.ci95_ms),
+        "sampling_correction_ms": (latency_s - corrected) * 1e3,
+    }
+    return dataclasses.replace(
+        result,
+        latency_ms=corrected * 1e3,
+        ci95_ms=None if interval is None else (interval[0] * 1e3, interval[1] * 1e3),
+        details=details,
+    )
+
+
+def _sampling_warning(
+    sampling: SamplingBias | None, measured: MethodResult, adjusted: MethodResult, checks: MisfitReport
+) -> str | None:
+    """The sampling's warning about the primary estimate, ``measured`` before and ``adjusted``
+    after the checks and the sampling changed it."""
+    if sampling is None:
+        return None
+    ci_s = None if measured.ci95_ms is None else (measured.ci95_ms[0] / 1e3, measured.ci95_ms[1] / 1e3)
+    final = None if adjusted.ci95_ms is None else (adjusted.ci95_ms[0] / 1e3, adjusted.ci95_ms[1] / 1e3)
+    return sampling.warning(checks.widen(measured.latency_ms / 1e3, ci_s), final)

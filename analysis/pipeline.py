@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.cycles import DEFAULT_LATENCY_RANGE_S
-from analysis.estimation import estimate, latency_range_s
+from analysis.estimation import check_sampling_options, estimate, latency_range_s
 from analysis.estimators.registry import DEFAULT_METHOD, estimators_for
 from analysis.result import LatencyResult
 from analysis.tracking import Track
@@ -29,6 +29,8 @@ def analyse(
     tracks_csv: str | Path | None = None,
     seed: int = 0,
     reference_departures: Callable[[Track], Mapping[str, float]] | None = None,
+    refresh_hz: float | None = None,
+    exposure_ms: float | None = None,
 ) -> LatencyResult:
     """Measure the latency between the LED and the rendered sphere in a video.
 
@@ -36,7 +38,8 @@ def analyse(
     or (N, H, W, 3) BGR; ``fps`` overrides the file's frame rate and is required for arrays and
     image folders. ROIs are [x, y, width, height] in pixels: give both or neither; without them the
     two largest moving bright regions are used, the LED being the one on ``led_side`` ("left" or
-    "right") if given, else the brighter. ``method`` is a registered estimator's name (fft, xcorr,
+    "right") if given, else the one the physical evidence names (``analysis.identity``; an
+    AnalysisError asks for the ROIs when it does not decide). ``method`` is a registered estimator's name (fft, xcorr,
     sinefit, bayes, see ``analysis.estimators.registry``) or all (every one, sinefit reported
     first). Latencies are looked for in ``latency_range_ms``.
     ``progress(done, total)`` is called as frames are tracked (for clips of
@@ -45,14 +48,24 @@ def analyse(
     names times (s, on the video's clock) at which other instruments saw the pendulum depart from
     rest, in the sense of ``analysis.onset`` (e.g. a rig board's encoder, its clock aligned by the
     LED's blink code, which it reads from the LED track); with the sphere's departure each gives a
-    lag that fixes the whole number of periods.
+    lag that fixes the whole number of periods. ``refresh_hz`` (the display's refresh rate) and
+    ``exposure_ms`` (the camera's exposure) are what the user knows of them; without them the video
+    is searched for both, to work out how the camera's sampling of the display biases the latency
+    (``analysis.sampling``).
     """
     # The options are checked before the video is read: a typo should not cost a tracking pass.
     estimators_for(method)
     latency_range_s(latency_range_ms)
+    check_sampling_options(refresh_hz, exposure_ms)
     tracks = track(
         source, fps=fps, led_roi=led_roi, sphere_roi=sphere_roi, led_side=led_side, progress=progress, tracks_csv=tracks_csv
     )
     return estimate(
-        tracks, method, latency_range_ms=latency_range_ms, seed=seed, reference_departures=reference_departures
+        tracks,
+        method,
+        latency_range_ms=latency_range_ms,
+        seed=seed,
+        reference_departures=reference_departures,
+        refresh_hz=refresh_hz,
+        exposure_ms=exposure_ms,
     )

@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from analysis.cycles import CycleResolution
+from analysis.misfit import MisfitReport
+from analysis.sampling import SamplingBias
 from analysis.tracking import Roi, Track
 from analysis.windows import WindowedLatency
 
@@ -43,7 +45,10 @@ class LatencyResult:
     latency_ms, ci95_ms and model are those of ``method``; ``methods`` holds every estimator run.
     roi_source says where the ROIs came from ("given" or "auto"); led_rule how the LED was told
     from the sphere. ambiguous is True when the whole number of periods in the latency could not
-    be decided (see ``analysis.cycles``); a warning then says why.
+    be decided (see ``analysis.cycles``); a warning then says why. sampling says what the
+    camera's sampling of the display may do to the latency (None where it could not be measured),
+    checks how well the model fits (``analysis.misfit``); each method's latency and interval already
+    allow for both, and ``warnings`` says where either changed them.
     """
 
     latency_ms: float
@@ -66,6 +71,8 @@ class LatencyResult:
     diagnostics: dict[str, Any]
     led_track: Track = field(repr=False)
     sphere_track: Track = field(repr=False)
+    sampling: SamplingBias | None = field(default=None, repr=False)
+    checks: MisfitReport | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready summary (without the tracks)."""
@@ -87,5 +94,7 @@ class LatencyResult:
             "methods": {name: result.to_dict() for name, result in self.methods.items()},
             "cycles": self.cycles.to_dict(),
             "windowed": self.windowed.to_dict() if self.windowed is not None else None,
+            "sampling": None if self.sampling is None else self.sampling.to_dict(),
+            "checks": None if self.checks is None else self.checks.to_dict(),
             "diagnostics": dict(self.diagnostics),
         }

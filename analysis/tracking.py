@@ -107,7 +107,11 @@ class Track:
     """A blob's position per frame. x and y are NaN where valid is False (no blob in that frame).
 
     t is the frame time in s; peak is the blob's brightest pixel above the ROI background;
-    clipped marks frames where the blob touched its ROI's edge (so it is not valid there).
+    clipped marks frames where the blob touched its ROI's edge (so it is not valid there). Where
+    the tracker measured them (NaN in frames without a blob): level is the brightest pixel's own
+    value (saturation shows there), mass the blob's summed intensity above the background, and
+    spread (N, 3) its intensity-weighted second central moments xx, yy, xy in px^2 (its size,
+    and its motion blur along the way it moves).
     """
 
     t: np.ndarray
@@ -116,6 +120,9 @@ class Track:
     valid: np.ndarray
     peak: np.ndarray
     clipped: np.ndarray
+    level: np.ndarray | None = None
+    mass: np.ndarray | None = None
+    spread: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -132,13 +139,19 @@ class BlobModel:
 
 
 class Detection(NamedTuple):
-    """One blob in one frame; x, y in frame pixels, NaN when not valid."""
+    """One blob in one frame; x, y in frame pixels, NaN when not valid; level, mass and the second
+    moments as in ``Track``, NaN where the blob was not measured."""
 
     x: float
     y: float
     peak: float
     valid: bool
     clipped: bool
+    level: float = math.nan
+    mass: float = math.nan
+    sxx: float = math.nan
+    syy: float = math.nan
+    sxy: float = math.nan
 
 
 def find_moving_regions(frames: Sequence[np.ndarray]) -> list[Roi]:
@@ -302,19 +315,24 @@ class BlobTracker:
             if found is None:
                 self._position = None
                 return Detection(np.nan, np.nan, peak, False, False)
-        x, y, peak, clipped = found
+        x, y, peak, clipped, level, moments = found
         if clipped:
             self._position = None
             return Detection(np.nan, np.nan, peak, False, True)
         self._step = (x - position[0], y - position[1]) if position is not None else (0.0, 0.0)
         self._longest_step = max(self._longest_step, abs(self._step[0]), abs(self._step[1]))
         self._position = (x, y)
-        return Detection(self._corner[0] + x, self._corner[1] + y, peak, True, False)
+        mass = moments["m00"]
+        return Detection(
+            self._corner[0] + x, self._corner[1] + y, peak, True, False, level, mass,
+            moments["mu20"] / mass, moments["mu02"] / mass, moments["mu11"] / mass,
+        )  # fmt: skip
 
     def _measure(
         self, crop: np.ndarray, centre: tuple[float, float], half: float
-    ) -> tuple[float, float, float, bool] | None:
-        """(x, y, peak, clipped) in ROI coordinates of the blob near ``centre``, or None if none there."""
+    ) -> tuple[float, float, float, bool, float, dict[str, float]] | None:
+        """(x, y, peak, clipped, level, moments) in ROI coordinates of the blob near ``centre``, or
+        None if none there; level is the brightest pixel's value, moments OpenCV's of the blob."""
         background = self._background
         height, width = crop.shape
         grow = self._grow
@@ -342,7 +360,8 @@ class BlobTracker:
                 if mass <= 0:
                     # signed weights: a blob barely above the threshold can sum to nothing with its noise
                     return None
-                return x0 + sx0 + moments["m10"] / mass, y0 + sy0 + moments["m01"] / mass, peak, clipped
+                level = float(crop[y0 + top[1], x0 + top[0]])
+                return x0 + sx0 + moments["m10"] / mass, y0 + sy0 + moments["m01"] / mass, peak, clipped, level, moments
             cx, cy = x0 + bx + bw / 2, y0 + by + bh / 2
             half *= 2
         return self._measure(crop, (width / 2, height / 2), max(width, height))

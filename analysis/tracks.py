@@ -6,7 +6,11 @@ it is decoded; from then on only the rectangle around both ROIs is decoded
 (``analysis.video.frames.Crop``). A video that can skip frames and decode rectangles cheaply
 (Motion-JPEG) is instead calibrated on a sample of its first frames and then read again from the
 start, every frame's rectangle alone. With all detections in hand the frame times are decided
-(``analysis.timing``), frames the recorder repeated are left out, and each track is checked.
+(``analysis.timing``), frames the recorder repeated are left out, and so are frames in which a
+blob shows much less of its light than usual (partly hidden: its centroid is not its centre).
+Where neither the user's ROIs nor a side said which blob is the LED, the whole video's evidence
+decides (``analysis.identity``); when it does not, the analysis stops and asks for the ROIs. Then
+each track is checked.
 """
 
 from __future__ import annotations
@@ -31,7 +35,10 @@ from analysis.calibration import (
     calibration_window,
 )
 from analysis.errors import AnalysisError
+from analysis.identity import Identity, decide
+from analysis.phase import estimate_frequency
 from analysis.report import TrackStream, write_tracks_csv
+from analysis.signals import swing_signals
 from analysis.timing import FrameTimes, check_count, frame_times, repeated_frames
 from analysis.tracking import BlobTracker, Detection, Roi, Track
 from analysis.video.file import VideoFile
@@ -42,6 +49,8 @@ from analysis.video.sources import open_frames
 MIN_VALID = 0.5
 # A blob cut off by its ROI's edge in more than this fraction of frames has left its ROI.
 MAX_CLIPPED = 0.1
+# A blob showing less than this fraction of its median summed light is partly hidden.
+MIN_LIGHT = 0.7
 PROGRESS_EVERY = 64
 # Clips shorter than this (by their stated length) report no progress: they are done at once.
 PROGRESS_MIN_SECONDS = 3.0
@@ -85,10 +94,15 @@ class _Tracked:
         self.rows[1].append(detections[1])
 
     def track_of(self, which: int, times: np.ndarray, drop: np.ndarray) -> Track:
+        """The track of one blob; frames in ``drop``, and frames where it is partly hidden, are not valid."""
         rows = self.rows[which]
         x = np.array([d.x for d in rows], dtype=np.float64)
         y = np.array([d.y for d in rows], dtype=np.float64)
+        mass = np.array([d.mass for d in rows], dtype=np.float64)
         valid = np.array([d.valid for d in rows], dtype=bool) & ~drop
+        if np.any(valid):
+            valid &= mass >= MIN_LIGHT * float(np.median(mass[valid]))
+        spread = np.array([(d.sxx, d.syy, d.sxy) for d in rows], dtype=np.float64).reshape(-1, 3)
         return Track(
             t=times,
             x=np.where(valid, x, np.nan),
@@ -96,6 +110,9 @@ class _Tracked:
             valid=valid,
             peak=np.array([d.peak for d in rows], dtype=np.float64),
             clipped=np.array([d.clipped for d in rows], dtype=bool),
+            level=np.array([d.level for d in rows], dtype=np.float64),
+            mass=mass,
+            spread=np.where(valid[:, None], spread, np.nan),
         )
 
     def positions(self, which: int) -> tuple[np.ndarray, np.ndarray]:
@@ -199,6 +216,23 @@ def check_track(track: Track, name: str, warnings: list[str]) -> None:
         )
 
 
+def _identity(first: Track, second: Track, fps: float) -> Identity:
+    """Which of the two blobs is the LED (``analysis.identity``); AnalysisError when the evidence
+    does not decide, which names the evidence and asks for the regions."""
+    signals = swing_signals(first, second)
+    frequency = estimate_frequency(signals.uniform()[1], 1.0 / signals.frame_interval)
+    identity = decide(first, second, (signals.led, signals.sphere), signals.frame_interval, 1.0 / frequency)
+    if identity.first_is_led is None:
+        evidence = ", ".join(f"{name} {value:+.1f}" for name, value in identity.evidence.items())
+        raise AnalysisError(
+            "cannot tell the LED from the sphere: the evidence (log-odds that the left blob is the LED: "
+            f"{evidence}; total {identity.margin:+.1f}) does not decide. Give the LED's and the sphere's regions "
+            "(led_roi and sphere_roi; --led-roi X,Y,W,H --sphere-roi X,Y,W,H on the command line) or the LED's "
+            "side (led_side, --led-side)"
+        )
+    return identity
+
+
 def _rois(
     video: FrameSource, led_roi: Sequence[float] | None, sphere_roi: Sequence[float] | None
 ) -> tuple[Roi, Roi] | None:
@@ -225,9 +259,10 @@ def track(
     or (N, H, W, 3) BGR; ``fps`` overrides the file's frame rate and is required for arrays and
     image folders. ROIs are [x, y, width, height] in pixels: give both or neither; without them the
     two largest moving bright regions are used, the LED being the one on ``led_side`` ("left" or
-    "right") if given, else the brighter. ``progress(done, total)`` is called as frames are tracked
-    (for clips of PROGRESS_MIN_SECONDS or more). ``tracks_csv`` receives every frame's row as it is
-    measured, then the final table once the frame times are decided (``analysis.report``); it is
+    "right") if given, else the one the physical evidence names (``analysis.identity``; an
+    AnalysisError asks for the ROIs when it does not decide). ``progress(done, total)`` is called
+    as frames are tracked (for clips of PROGRESS_MIN_SECONDS or more). ``tracks_csv`` receives
+    every frame's row as it is measured (the left blob first as the LED while that is undecided), then the final table once the frame times are decided (``analysis.report``); it is
     written before the tracks are checked, so tracks that fail a check stay on disk to look at.
     """
     if led_side is not None and led_side not in SIDES:
@@ -255,6 +290,12 @@ def track(
         )
     led = tracked.track_of(0, times.t, repeats)
     sphere = tracked.track_of(1, times.t, repeats)
+    led_roi, sphere_roi, rule = calibration.led.roi, calibration.sphere.roi, calibration.led_rule
+    if not calibration.decided:
+        identity = _identity(led, sphere, times.fps)
+        rule = identity.rule()
+        if not identity.first_is_led:
+            led, sphere, led_roi, sphere_roi = sphere, led, sphere_roi, led_roi
     diagnostics: dict[str, Any] = {
         "time_source": times.source,
         "dropped_frames": times.dropped,
@@ -264,9 +305,8 @@ def track(
         "clipped_frames": {"led": int(np.count_nonzero(led.clipped)), "sphere": int(np.count_nonzero(sphere.clipped))},
     }
     tracks = Tracks(
-        led, sphere, stamps, times, calibration.led.roi, calibration.sphere.roi, calibration.roi_source,
-        calibration.led_rule, tuple(warnings), diagnostics, seconds,
-    )  # fmt: skip
+        led, sphere, stamps, times, led_roi, sphere_roi, calibration.roi_source, rule, tuple(warnings), diagnostics, seconds
+    )
     if tracks_csv is not None:
         write_tracks_csv(tracks_csv, tracks)
     check_track(led, "LED", warnings)

@@ -3,6 +3,12 @@
 This module imports only the standard library and the rig's error types, so that an interrupt or a
 signal at any moment, imports included, ends in the rig's own message and exit status: the command
 modules (and numpy, OpenCV, JAX behind them) are imported once the handlers are in place.
+
+Exit statuses: 0 a clean result; EXIT_WARNINGS (3) measured, but read the warnings (`rig analyse`:
+an interval widened or corrected for how the camera samples the display, a model misfit, missing
+frames; the number stands, with its caveats printed); EXIT_USER_ERROR (2) bad input, or a video
+that cannot be measured; EXIT_INTERRUPTED (130) and EXIT_TERMINATED (143) a run stopped, its
+records kept. A few commands add their own (`rig demo` and `rig measure`: 1 for a disagreement).
 """
 
 from __future__ import annotations
@@ -35,6 +41,7 @@ COMMANDS = (
 )
 """The command modules in rig.commands, in the order `rig --help` lists them."""
 EXIT_USER_ERROR = 2
+EXIT_WARNINGS = 3
 EXIT_INTERRUPTED = 130
 EXIT_TERMINATED = 143
 

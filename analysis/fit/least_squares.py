@@ -35,6 +35,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from analysis.fit import model
+from analysis.longrun import long_run_variance
 from analysis.signals import BinnedSignals, SwingSignals, binned
 
 BINS_PER_PERIOD = 16
@@ -177,18 +178,6 @@ def structure_of(name: str, start: np.ndarray) -> model.Structure:
 def scaled_guess(guess: Guess, problem: FitProblem) -> np.ndarray:
     physical = np.array([2 * math.pi * guess.frequency_hz, guess.damping, guess.chirp, guess.latency_s, guess.gain])
     return physical / problem.scales
-
-
-def long_run_variance(series: np.ndarray, bandwidth: int) -> float:
-    """Newey-West variance of a sum of a correlated series: Bartlett-weighted autocovariances."""
-    count = series.size
-    bandwidth = min(bandwidth, count - 1)
-    size = 1 << math.ceil(math.log2(2 * count))
-    spectrum = np.fft.rfft(series, size)
-    autocovariance = np.fft.irfft(np.abs(spectrum) ** 2, size)[: bandwidth + 1]
-    lags = np.arange(bandwidth + 1)
-    weights = 1.0 - lags / (bandwidth + 1)
-    return float(autocovariance[0] + 2 * np.sum(weights[1:] * autocovariance[1:]))
 
 
 def _variances(params: np.ndarray, coefficients: np.ndarray, structure: model.Structure, problem: FitProblem) -> tuple[float, float, np.ndarray]:

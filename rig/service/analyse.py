@@ -23,7 +23,9 @@ DEFAULT_LATENCY_RANGE_MS = (DEFAULT_LATENCY_RANGE_S[0] * 1e3, DEFAULT_LATENCY_RA
 
 @dataclass(frozen=True)
 class AnalysisRequest:
-    """What to analyse and how (see `analysis.analyse`); `board` is a board recording folder."""
+    """What to analyse and how (see `analysis.analyse`); `board` is a board recording folder;
+    `display_hz` and `exposure_ms` are the display's refresh rate and the camera's exposure, where
+    the lab knows them (else the video is searched for both)."""
 
     video: Path
     fps: float | None = None
@@ -35,6 +37,8 @@ class AnalysisRequest:
     seed: int = 0
     tracks_csv: Path | None = None
     board: Path | None = None
+    display_hz: float | None = None
+    exposure_ms: float | None = None
 
 
 @dataclass(frozen=True)
@@ -63,5 +67,7 @@ def analyse(request: AnalysisRequest, progress: Callable[[int, int], object] | N
         tracks_csv=request.tracks_csv,
         seed=request.seed,
         reference_departures=board.departures if board is not None else None,
+        refresh_hz=request.display_hz,
+        exposure_ms=request.exposure_ms,
     )
     return Measurement(result, board)

@@ -1,4 +1,5 @@
-"""`rig analyse`: one line or JSON on stdout, tracks CSV and plot files, exit status 2 on bad input."""
+"""`rig analyse`: one line or JSON on stdout, tracks CSV and plot files; exit status 0 for a clean
+result, 3 for one with warnings, 2 on bad input."""
 
 import csv
 import json
@@ -10,6 +11,10 @@ from analysis import MethodResult, register_estimator, unregister_estimator
 from rig.cli import main
 
 
+# The clip's camera (120 fps, exposing whole frames) and display (60 Hz), as a lab that knows them says.
+KNOWN = ["--display-hz", "60", "--exposure-ms", f"{1e3 / 120.0}"]
+
+
 @pytest.fixture
 def clip_file(tmp_path, scene, render_video, mjpg_file):
     clip = scene(latency_s=0.045, period_s=0.9, duration_s=4.3, fps=120.0)
@@ -17,15 +22,27 @@ def clip_file(tmp_path, scene, render_video, mjpg_file):
 
 
 def test_one_line_summary_with_the_interval(clip_file, capsys):
-    assert main(["analyse", str(clip_file)]) == 0
-    line = capsys.readouterr().out.splitlines()[0]
-    assert line.startswith("latency 45.")
-    assert "95% CI" in line and "by sinefit" in line and "per swing sd" in line
+    assert main(["analyse", str(clip_file), *KNOWN]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("latency 45.")
+    assert "95% CI" in out[0] and "by sinefit" in out[0] and "per swing sd" in out[0]
+    assert not any(line.startswith("warning:") for line in out)
+
+
+def test_a_result_with_warnings_exits_3_and_prints_them(clip_file, capsys):
+    # Without the camera's settings, 120 fps on 60 Hz samples each refresh at two phases that the
+    # video cannot place exactly: the interval is widened, and the warning says why.
+    assert main(["analyse", str(clip_file)]) == 3
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("latency 45.")
+    assert any(line.startswith("warning: the camera (120 fps") and "--exposure-ms" in line for line in out)
+    assert main(["analyse", str(clip_file), "--json"]) == 3
+    assert json.loads(capsys.readouterr().out)["warnings"]
 
 
 def test_json_csv_and_plot_for_every_method(tmp_path, clip_file, capsys):
     tracks, plot = tmp_path / "tracks.csv", tmp_path / "plot.png"
-    code = main(["analyse", str(clip_file), "--method", "all", "--json", "--csv", str(tracks), "--plot", str(plot)])
+    code = main(["analyse", str(clip_file), *KNOWN, "--method", "all", "--json", "--csv", str(tracks), "--plot", str(plot)])
     assert code == 0
     report = json.loads(capsys.readouterr().out)
     assert report["method"] == "sinefit"
@@ -44,7 +61,7 @@ def test_image_folder_needs_and_takes_a_frame_rate(tmp_path, scene, render_video
         cv2.imwrite(str(folder / f"img{index:04d}.png"), frame)
     assert main(["analyse", str(folder), "--method", "fft"]) == 2
     assert "no frame rate is known" in capsys.readouterr().err
-    assert main(["analyse", str(folder), "--fps", "120", "--method", "fft", "--json"]) == 0
+    assert main(["analyse", str(folder), "--fps", "120", *KNOWN, "--method", "fft", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["latency_ms"] == pytest.approx(30.0, abs=0.5)
 
 
@@ -82,7 +99,7 @@ def test_method_choices_follow_the_estimator_registry(clip_file, capsys):
     assert exit_.value.code == 2 and "invalid choice" in capsys.readouterr().err
     register_estimator(ChosenPeriods())
     try:
-        assert main(["analyse", str(clip_file), "--method", "chosen-periods", "--json"]) == 0
+        assert main(["analyse", str(clip_file), *KNOWN, "--method", "chosen-periods", "--json"]) == 0
     finally:
         unregister_estimator("chosen-periods")
     report = json.loads(capsys.readouterr().out)

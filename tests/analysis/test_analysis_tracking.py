@@ -221,7 +221,11 @@ def test_8bit_frames_are_located_exactly_as_their_float_copies():
     tracker, float_tracker = BlobTracker(model), BlobTracker(float_model)
     found = [tracker.locate(frame) for frame in sequence]
     float_found = [float_tracker.locate(frame.astype(np.float32)) for frame in sequence]
-    assert np.array_equal(np.array(found, dtype=float), np.array(float_found, dtype=float), equal_nan=True)
+    found, float_found = np.array(found, dtype=float), np.array(float_found, dtype=float)
+    # Positions, peaks and masses agree exactly; second moments to the last few bits (OpenCV sums
+    # integer and float pixels in different orders).
+    assert np.array_equal(found[:, :7], float_found[:, :7], equal_nan=True)
+    np.testing.assert_allclose(found[:, 7:], float_found[:, 7:], rtol=1e-12, atol=1e-12)
 
 
 def test_a_window_whose_signed_weights_sum_to_nothing_holds_no_blob():

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from rig.cli import build_parser, main
+from rig.cli import EXIT_USER_ERROR, EXIT_WARNINGS, build_parser, main
 
 COMMANDS = ["demo", "simulate", "analyse", "sweep", "report", "bench", "tune", "board"]
 
@@ -68,14 +68,43 @@ def test_a_negative_rate_is_rejected_before_anything_runs(option: str, tmp_path:
     assert not (tmp_path / "x").exists()
 
 
+# The short video's camera: 120 fps exposing whole frames, filming a 60 Hz display.
+KNOWN_CAMERA = ["--display-hz", "60", "--exposure-ms", f"{1e3 / 120}"]
+
+
 def test_analyse_json_carries_the_contract(short_video: Path, capsys: pytest.CaptureFixture[str]) -> None:
     capsys.readouterr()
-    assert main(["analyse", str(short_video), "--json"]) == 0
+    assert main(["analyse", str(short_video), "--json", *KNOWN_CAMERA]) == 0
     result = json.loads(capsys.readouterr().out)
-    for key in ("latency_ms", "ci95_ms", "method", "model", "period_s", "frames", "frames_used", "ambiguous", "warnings"):
+    keys = ("latency_ms", "ci95_ms", "method", "model", "period_s", "frames", "frames_used", "ambiguous", "warnings")
+    for key in (*keys, "sampling", "checks"):
         assert key in result
     truth = json.loads((short_video.parent / "truth.json").read_text())
     assert result["latency_ms"] == pytest.approx(truth["latency_ms"], abs=1.0)
+    assert result["warnings"] == []
+
+
+def test_analyse_exits_3_when_the_result_comes_with_warnings(
+    short_video: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 120 fps on 60 Hz, exposure unknown: the video cannot place the refreshes among the two
+    # phases exactly, so the interval is widened and a warning says so; the number still stands.
+    capsys.readouterr()
+    assert main(["analyse", str(short_video), "--json"]) == EXIT_WARNINGS == 3
+    result = json.loads(capsys.readouterr().out)
+    truth = json.loads((short_video.parent / "truth.json").read_text())
+    assert result["ci95_ms"][0] <= truth["latency_ms"] <= result["ci95_ms"][1]
+    assert any("--exposure-ms" in warning for warning in result["warnings"])
+
+
+@pytest.mark.parametrize("option", [["--display-hz", "0"], ["--exposure-ms", "-1"], ["--exposure-ms", "nan"]])
+def test_analyse_rejects_a_bad_display_rate_or_exposure(
+    short_video: Path, option: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exit_:
+        main(["analyse", str(short_video), *option])
+    assert exit_.value.code == EXIT_USER_ERROR
+    assert "must be a positive number" in capsys.readouterr().err
 
 
 def test_predictor_parameters_are_parsed() -> None:
