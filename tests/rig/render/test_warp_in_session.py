@@ -27,6 +27,7 @@ def warp_run(out: Path, app_frame_ms: float, warp_ms: float | None = DEFAULT_SER
         camera=SMALL_CAMERA,
         display=DisplayConfig(width=160, height=120),
         renderer="warp",
+        predictor="hold",  # no prediction: the costs show in the latency as they are
         scene_triangles=2_000,
         app_frame_ms=app_frame_ms,
         warp_ms=warp_ms,
@@ -82,7 +83,8 @@ def test_demo_compare_prints_both_latencies_and_the_warp_is_faster(tmp_path: Pat
     parser = argparse.ArgumentParser()
     demo.add_parser(parser.add_subparsers())
     args = parser.parse_args(
-        ["demo", "--compare", "--out", str(tmp_path), "--duration", "2.5", "--camera-fps", "120", "--scene-triangles", "2000", "--app-frame-ms", "60", "--json"]
+        ["demo", "--compare", "--out", str(tmp_path), "--duration", "2.5", "--camera-fps", "120", "--scene-triangles", "2000", "--app-frame-ms", "60",
+         "--predictor", "hold", "--json"]  # fmt: skip
     )
     assert args.func(args) == 0
     report = json.loads(capsys.readouterr().out)
