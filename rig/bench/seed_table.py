@@ -162,10 +162,24 @@ def _cell(value: float | None, digits: int = 1) -> str:
     return "-" if value is None else f"{value:.{digits}f}"
 
 
+def _no_crossover(rows: list[dict[str, Any]]) -> str:
+    """Why a table has no crossover: which renderer was faster at every size both were measured."""
+    by = {(r["renderer"], r["triangles"]): r for r in rows if r["latency_measured_ms"] is not None}
+    both = sorted(n for renderer, n in by if renderer == "direct" and ("warp", n) in by)
+    if not both:
+        return "none: no size with both latencies measured"
+    smallest = by["direct", both[0]]
+    if by["direct", both[0]]["latency_measured_ms"] > by["warp", both[0]]["latency_measured_ms"]:
+        return (f"below {both[0]} triangles: the warp's latency was lower already there, where a direct frame takes "
+                f"{smallest['frame_ms_median']:.1f} ms ({smallest['frame_ms_median'] / smallest['refresh_ms']:.2f} refreshes)")
+    return f"above {both[-1]} triangles: the direct renderer's latency was lower at every size both were measured"
+
+
 def seed_table_text(rows: list[dict[str, Any]]) -> str:
     """Ours and the seed's, side by side, with each crossover."""
-    lines = ["this machine (costs " + ", ".join(sorted({r["cost_source"] for r in rows})) + f", {rows[0]['width']}x{rows[0]['height']}, "
-             f"{1e3 / rows[0]['refresh_ms']:g} Hz, predictor {rows[0]['predictor']}):" if rows else "this machine: no rows"]  # fmt: skip
+    sources = "; ".join(f"{renderer} {'/'.join(sorted({r['cost_source'] for r in rows if r['renderer'] == renderer}))}" for renderer in ("direct", "warp"))
+    lines = [f"this machine (costs: {sources}; {rows[0]['width']}x{rows[0]['height']}, {1e3 / rows[0]['refresh_ms']:g} Hz, "
+             f"predictor {rows[0]['predictor']}):" if rows else "this machine: no rows"]  # fmt: skip
     lines.append(f"{'triangles':>10} | {'direct frame':>12} {'latency (sd)':>16} {'/refresh':>8} | {'warp frame':>10} "
                  f"{'latency (sd)':>16} {'/refresh':>8} {'missed':>7}")  # fmt: skip
     by = {(r["renderer"], r["triangles"]): r for r in rows}
@@ -182,10 +196,11 @@ def seed_table_text(rows: list[dict[str, Any]]) -> str:
             f"{int(faces):>10} | {ref_ms:>9.1f} ms {_cell(ref):>8} ({_cell(ref_sd)}) {_cell(ref / SEED_REFRESH_MS if ref else None, 2):>8} | "
             f"{warp_ms:>7.1f} ms {warp:>8.1f} ({warp_sd}) {warp / SEED_REFRESH_MS:>8.2f}"
         )
-    for name, found in (("this machine", crossover(rows)), ("seed", crossover(seed_rows()))):
+    for name, table in (("this machine", rows), ("seed", seed_rows())):
+        found = crossover(table)
         lines.append(
             f"crossover, {name}: " + (f"{found['triangles'] / 1e6:.3g}M triangles, where a direct frame takes {found['direct_frame_ms']:.1f} ms "
-                                      f"({found['direct_frame_refreshes']:.2f} refreshes)" if found else "none within the sizes measured")
+                                      f"({found['direct_frame_refreshes']:.2f} refreshes)" if found else _no_crossover(table))
         )  # fmt: skip
     notes = sorted({r["latency_note"] for r in rows if r.get("latency_note")})
     return "\n".join(lines + [f"run: {note}" for note in notes])
