@@ -6,8 +6,9 @@ scan-out; for an external renderer, its swap markers, `renderer_markers.csv`), a
 measured and when (`tracker.csv`). The latency it implies is the one a perfect camera would
 measure: the delay tau that best lines up the sphere's position as the display holds it with the
 tracker's positions shifted by tau, along the swing's main axis (`rig.sim.truth.effective_latency`,
-the definition the simulation's truth uses). Beside it, the mean and spread of the frame-by-frame
-sensor-to-photon delays.
+the definition the simulation's truth uses), over the whole run or over the instants a camera
+filmed (which weights the run as the video does: frames a loaded camera dropped are missing from
+both). Beside it, the mean and spread of the frame-by-frame sensor-to-photon delays.
 """
 
 from __future__ import annotations
@@ -15,13 +16,14 @@ from __future__ import annotations
 import csv
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from predictors import read_samples
 from rig.errors import RigError
-from rig.sim.truth import effective_latency
+from rig.sim.truth import SCAN_STEP_S, effective_latency, shown_signal
 
 # Left out at each end of the run: the predictor and the display settle, the last frames may be cut.
 EDGE_S = 0.5
@@ -59,9 +61,29 @@ def swing_period(t: np.ndarray, x: np.ndarray) -> float:
     return float(np.median(np.diff(crossings)))
 
 
-def log_latency(out_dir: Path, shown: dict[str, np.ndarray], scanout_s: np.ndarray | float = 0.0) -> LogLatency:
+def delay_at(instants: np.ndarray, switch: np.ndarray, drawn: np.ndarray, truth: Callable[[np.ndarray], np.ndarray],
+             period_s: float, guess_s: float) -> float:  # fmt: skip
+    """The delay tau (s) minimising the squared difference between the held signal (`drawn` from each
+    `switch` time) and truth(t - tau), over the given instants only (those a camera filmed)."""
+    held = shown_signal(switch, drawn, instants)
+    t, held = instants[np.isfinite(held)], held[np.isfinite(held)]
+
+    def cost(tau: float) -> float:
+        return float(np.mean((held - truth(t - tau)) ** 2))
+
+    taus = np.arange(guess_s - period_s / 2, guess_s + period_s / 2, SCAN_STEP_S)
+    coarse = taus[int(np.argmin([cost(tau) for tau in taus]))]
+    return float(minimize_scalar(cost, bounds=(coarse - SCAN_STEP_S, coarse + SCAN_STEP_S), method="bounded",
+                                 options={"xatol": 1e-7}).x)  # fmt: skip
+
+
+def log_latency(
+    out_dir: Path, shown: dict[str, np.ndarray], scanout_s: np.ndarray | float = 0.0, instants: np.ndarray | None = None
+) -> LogLatency:
     """The latency implied by a run's logs: `shown` has per shown image its switch time `t` (photons
-    leave its row at t + scanout_s) and its pose's `px py pz` and `t_sensor`."""
+    leave its row at t + scanout_s) and its pose's `px py pz` and `t_sensor`. With `instants` (the
+    times a camera filmed), over those instants only: what that camera would have measured of the
+    logged display, whatever it missed."""
     samples = read_samples(out_dir / "tracker.csv")
     if len(samples) < 10 or len(shown.get("t", ())) < 10:
         raise RigError(f"{out_dir} holds too few tracker samples or shown frames to work out the logged latency")
@@ -83,7 +105,17 @@ def log_latency(out_dir: Path, shown: dict[str, np.ndarray], scanout_s: np.ndarr
     if span[1] - span[0] < 2 * period:
         raise RigError("the run is too short for the logged latency: it needs two swings after its first and last half second")
     delays = (switch - sensor)[(switch >= span[0]) & (switch <= span[1])]
-    tau = effective_latency(switch, drawn, lambda t: np.interp(t, t_sensor, along), span, period, float(np.mean(delays)))
+
+    def truth(t: np.ndarray) -> np.ndarray:
+        return np.interp(t, t_sensor, along)
+
+    if instants is None:
+        tau = effective_latency(switch, drawn, truth, span, period, float(np.mean(delays)))
+    else:
+        filmed = np.asarray(instants)[(instants >= span[0]) & (instants <= span[1])]
+        if filmed.size < 10:
+            raise RigError("the camera filmed too little of the logged run to compare the two")
+        tau = delay_at(filmed, switch, drawn, truth, period, float(np.mean(delays)))
     return LogLatency(tau * 1e3, float(np.mean(delays)) * 1e3, float(np.std(delays)) * 1e3, int(len(delays)), period)
 
 

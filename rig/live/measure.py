@@ -1,7 +1,8 @@
 """`measure`: a live run filmed by a camera, then three answers side by side (see `MeasureReport`).
 
 1. the video's: the analyser (`rig.service.analyse`) on the camera's video, with its 95 % interval;
-2. the rig's own log's: the latency its logged swaps and tracker samples imply (`rig.live.log_latency`);
+2. the rig's own log's: the latency its logged swaps and tracker samples imply (`rig.live.log_latency`),
+   at the instants the camera filmed (so that both weight the run alike) and over the whole run;
 3. with a rig board recording (`--board DIR`, from `rig board record` during the run), the
    photodiode's (`analysis.board.photodiode_latency`).
 
@@ -10,6 +11,7 @@ All three go into `measure.json` and `measure.png`, beside the run's files.
 
 from __future__ import annotations
 
+import csv
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,6 +20,7 @@ from typing import Any, Callable
 import numpy as np
 
 from analysis.board.photodiode_latency import estimate_from_recording
+from rig.devices.camera.frames import FRAMES_FILE
 from rig.devices.camera.opencv_camera import OpenCvCamera, opencv_camera
 from rig.errors import RigError
 from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
@@ -61,15 +64,26 @@ class MeasureReport:
         }
 
 
+def filmed_instants(out_dir: Path) -> np.ndarray:
+    """When the camera took each frame it delivered (not the stand-ins for dropped ones)."""
+    with (out_dir / FRAMES_FILE).open(encoding="utf-8", newline="") as stream:
+        return np.array([float(row["t_capture"]) for row in csv.DictReader(stream) if row["filled"] == "0"])
+
+
 def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[str, Any]:
-    """The log's answer for a run folder (`rig.live.log_latency`)."""
-    if not external:
-        return log_latency(out_dir, shown_by_window(out_dir)).to_dict()
-    shown = shown_by_markers(out_dir)
-    view, display = run["view"], run["display"]
-    setup = RenderSetup(1, 1, np.array(view["world_to_clip"]), view["sphere_radius_m"])
-    rows = np.array([setup.row_fraction(p) for p in np.column_stack([shown["px"], shown["py"], shown["pz"]])])
-    return log_latency(out_dir, shown, rows * display["scanout_fraction"] / display["refresh_hz"]).to_dict()
+    """The log's answer for a run folder (`rig.live.log_latency`) at the instants the camera filmed,
+    which weights the run as the video does, and over the whole run beside it."""
+    scanout: np.ndarray | float = 0.0
+    if external:
+        shown = shown_by_markers(out_dir)
+        view, display = run["view"], run["display"]
+        setup = RenderSetup(1, 1, np.array(view["world_to_clip"]), view["sphere_radius_m"])
+        rows = np.array([setup.row_fraction(p) for p in np.column_stack([shown["px"], shown["py"], shown["pz"]])])
+        scanout = rows * display["scanout_fraction"] / display["refresh_hz"]
+    else:
+        shown = shown_by_window(out_dir)
+    filmed = log_latency(out_dir, shown, scanout, filmed_instants(out_dir)).to_dict()
+    return {**filmed, "whole_run_latency_ms": log_latency(out_dir, shown, scanout).latency_ms}
 
 
 def analyse_run(out_dir: Path, fps: float | None, options: VideoOptions, board: Path | None, run: dict[str, Any],

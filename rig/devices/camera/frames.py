@@ -50,12 +50,15 @@ class FrameWriter:
     def typical_interval_s(self) -> float:
         return float(np.median(self._intervals)) if len(self._intervals) >= 3 else self.nominal_interval_s
 
-    def write(self, grey: np.ndarray, t_capture: float, t_backend_ms: float | None) -> int:
-        """Append a frame captured at `t_capture`; how many dropped frames were filled before it."""
+    def write(self, grey: np.ndarray, t_capture: float, t_backend_ms: float | None, t_slot: float | None = None) -> int:
+        """Append a frame captured at `t_capture`; how many dropped frames were filled before it.
+        `t_slot` is where the frame belongs on the camera's schedule where the camera knows it
+        (drops are then found from the schedule, not from the capture times' jitter)."""
         filled = 0
+        t_slot = t_capture if t_slot is None else t_slot
         if self._last is not None:
             t_previous, previous = self._last
-            gap = t_capture - t_previous
+            gap = t_slot - t_previous
             interval = self.typical_interval_s
             if gap > DROP_FACTOR * interval:
                 missing = int(round(gap / interval)) - 1
@@ -69,9 +72,9 @@ class FrameWriter:
             else:
                 self._intervals.append(gap)
         self._append(grey, t_capture, t_backend_ms, False)
-        self._last = (t_capture, grey)
+        self._last = (t_slot, grey)
         if self._first is None:
-            self._first = t_capture
+            self._first = t_slot
         return filled
 
     def _append(self, grey: np.ndarray, t: float, t_backend_ms: float | None, filled: bool) -> None:

@@ -1,12 +1,13 @@
 """The emulated tracker of the self-test and the live bench: the simulated pendulum streamed on an
-LSL outlet by the rig's emulator (`rig.emulate`), on a thread of the rig's process, with the instant
-its motion started on the rig clock (the camera twin draws the LED from it)."""
+LSL outlet by the rig's emulator (`rig.emulate`), from a process of its own, with the instant its
+motion started on the rig clock (the camera twin draws the LED from it)."""
 
 from __future__ import annotations
 
-import threading
+import math
+import multiprocessing
 import time
-from typing import Sequence
+from typing import Any, Sequence
 
 from rig.clock import MonotonicClock
 from rig.emulate.encode import Emission
@@ -14,9 +15,12 @@ from rig.emulate.faults import FaultPlan
 from rig.emulate.motion import Motion
 from rig.emulate.sinks import LslSink
 from rig.emulate.streamer import stream
+from rig.errors import RigError
 
 TRACKER_HZ = 500.0
 STOP_POLL_S = 0.1
+STOP_TIMEOUT_S = 10.0
+READY_TIMEOUT_S = 60.0
 
 
 class _Stopped(Exception):
@@ -24,47 +28,71 @@ class _Stopped(Exception):
 
 
 class _StoppableSink(LslSink):
-    """The emulator's LSL outlet, which ends the sending loop once the run is over."""
+    """The emulator's LSL outlet, which ends the sending loop once `stop` is set."""
 
-    stopped = False
+    def __init__(self, name: str, rate_hz: float, stop: Any) -> None:
+        super().__init__(name, rate_hz, source_id=name)
+        self._stop = stop
 
     def wait_for_reader(self, stop_at: float) -> bool:
-        while not self.stopped and time.monotonic() < stop_at:
+        while not self._stop.is_set() and time.monotonic() < stop_at:
             if super().wait_for_reader(min(stop_at, time.monotonic() + STOP_POLL_S)):
                 return True
         return False
 
     def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
-        if self.stopped:
+        if self._stop.is_set():
             raise _Stopped
         return super().send(emissions, rate_hz)
 
 
-class EmulatedPendulum:
-    """The emulated LSL tracker `name` streaming the simulated pendulum on a thread for `duration_s`
-    once a reader connects; `start` is when the motion's time 0 was, on `clock`."""
+def _emulate(name: str, duration_s: float, rate_hz: float, origin_s: float, start: Any, ready: Any, stop: Any) -> None:
+    """The emulator's process: `ready` once its outlet is up, then stream until the duration is over
+    or `stop` is set; `start` gets the rig time of the motion's time 0."""
+    sink = _StoppableSink(name, rate_hz, stop)
+    motion = Motion(rate_hz, duration_s)
+    ready.set()
 
-    def __init__(self, name: str, duration_s: float, clock: MonotonicClock, rate_hz: float = TRACKER_HZ) -> None:
-        self.start: float | None = None
-        self.events: list[str] = []
-        self._origin = clock.origin_ns / 1e9
-        self._sink = _StoppableSink(name, rate_hz, source_id=name)
-        self._motion = Motion(rate_hz, duration_s)
-        self._thread = threading.Thread(target=self._run, args=(duration_s,), name="emulated tracker", daemon=True)
-        self._thread.start()
-
-    def _device_clock(self, t: float) -> float:
-        if self.start is None:
-            self.start = t - self._origin
+    def device_clock(t: float) -> float:
+        if math.isnan(start.value):
+            start.value = t - origin_s
         return t
 
-    def _run(self, duration_s: float) -> None:
-        try:
-            stream(self._motion, self._sink, duration_s, FaultPlan(), self._device_clock, None, self.events.append)
-        except _Stopped:
-            pass
+    try:
+        stream(motion, sink, duration_s, FaultPlan(), device_clock, None)
+    except _Stopped:
+        pass
+    finally:
+        sink.close()
+
+
+class EmulatedPendulum:
+    """The emulated LSL tracker `name` streaming the simulated pendulum for `duration_s` once a reader
+    connects, from a process of its own (a thread of the rig's would starve while the rig renders);
+    `start` is when the motion's time 0 was, on `clock` (None before it starts)."""
+
+    def __init__(self, name: str, duration_s: float, clock: MonotonicClock, rate_hz: float = TRACKER_HZ) -> None:
+        context = multiprocessing.get_context("spawn")
+        self._start = context.Value("d", math.nan)
+        self._stop = context.Event()
+        ready = context.Event()
+        self._process = context.Process(
+            target=_emulate, args=(name, duration_s, rate_hz, clock.origin_ns / 1e9, self._start, ready, self._stop),
+            name="emulated tracker", daemon=True,
+        )  # fmt: skip
+        self._process.start()
+        if not ready.wait(READY_TIMEOUT_S):
+            self.close()
+            raise RigError(f"the emulated tracker did not start within {READY_TIMEOUT_S:g} s")
+
+    @property
+    def start(self) -> float | None:
+        value = self._start.value
+        return None if math.isnan(value) else value
 
     def close(self) -> None:
-        self._sink.stopped = True
-        self._thread.join()
-        self._sink.close()
+        self._stop.set()
+        self._process.join(STOP_TIMEOUT_S)
+        if self._process.is_alive():
+            self._process.terminate()
+            self._process.join()

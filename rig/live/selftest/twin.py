@@ -9,8 +9,8 @@ the LED is drawn where the emulator's pendulum is at that instant plus the displ
 scan-out to the sphere's row (found in the image): a real monitor lights that row that much after
 the swap the X server shows at once. The sphere and the LED of a frame are thus filmed at the same
 instant, however the process is scheduled, and frames go to disk through the `FrameWriter` real
-cameras use. The sensor is the simulated one (`rig.sim.camera.CameraSensor`: dark level, read
-noise, saturation).
+cameras use, each stamped with that instant (its slot finds the frames dropped). The sensor is the
+simulated one (`rig.sim.camera.CameraSensor`: dark level, read noise, saturation).
 
 Use a frame rate that shares no small common multiple with the refresh rate: a zero-length
 exposure at commensurate rates samples the held image at a few phases only, which biases the
@@ -90,7 +90,7 @@ def _film(setup: TwinSetup, origin_ns: int, rect: tuple[int, int, int, int], mot
             t_light = (before + clock.now()) / 2.0 + _row_fraction(grey) * setup.scanout_s
             panel = cv2.resize(grey, (pw, ph), interpolation=cv2.INTER_AREA).astype(np.float32)
             led = layout.led_pixels(pendulum.led_position(np.array([t_light - motion_start.value])).reshape(1, 3))
-            writer.write(sensor.expose(led, c.display_black_dn + panel * gain, layout.panel), start + slot / c.fps, None)
+            writer.write(sensor.expose(led, c.display_black_dn + panel * gain, layout.panel), t_light, None, start + slot / c.fps)
     except Exception as error:  # noqa: BLE001 - reported to the run, which ends with it
         failure = f"the camera twin stopped: {type(error).__name__}: {error}"
     finally:

@@ -70,6 +70,17 @@ class RefusingCapture:
         return self.values.get(prop, 0.0)
 
 
+def test_a_camera_that_knows_its_schedule_finds_drops_from_it_whatever_its_jitter(tmp_path: Path) -> None:
+    writer = FrameWriter(tmp_path, FPS, 64, 48)
+    slots = [i for i in range(30) if i not in (7, 8, 20)]
+    jitter = np.random.default_rng(3).uniform(-0.45, 0.45, len(slots)) / FPS
+    for slot, late in zip(slots, jitter):
+        writer.write(np.zeros((48, 64), dtype=np.uint8), slot / FPS + late, None, slot / FPS)
+    writer.close()
+    assert (writer.dropped, writer.frames) == (3, 30)
+    assert writer.measured_fps() == pytest.approx(FPS)
+
+
 def test_a_setting_the_camera_refuses_is_reported_not_accepted() -> None:
     check = apply_settings(RefusingCapture(), CameraSettings(fps=240.0, size=(640, 480), fourcc="MJPG"), "device")
     assert check.refused == ["fps 240.0 (the camera reports 30.0)"]

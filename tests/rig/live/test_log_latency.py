@@ -55,6 +55,20 @@ def test_a_scan_out_delay_adds_to_the_logged_latency(tmp_path: Path) -> None:
     assert log_latency(tmp_path, shown, 0.004).latency_ms == pytest.approx(plain + 4.0, abs=0.1)
 
 
+def test_at_the_instants_a_camera_filmed_the_log_weights_the_run_as_the_video_does(tmp_path: Path) -> None:
+    axis = np.array([1.0, 0.0, 0.0])
+    _write_tracker(tmp_path, axis)
+    switch = np.arange(0.2, 7.8, REFRESH_S)
+    # 20 ms behind until 4 s, then 60 ms: a camera that filmed only the first half sees 20 ms
+    sensor = switch - np.where(switch < 4.0, 0.020, 0.060)
+    positions = _swing(sensor, axis)
+    shown = {"t": switch, "t_sensor": sensor, "px": positions[:, 0], "py": positions[:, 1], "pz": positions[:, 2]}
+    instants = np.random.default_rng(2).uniform(0.8, 3.9, 400)
+    first_half = log_latency(tmp_path, shown, instants=np.sort(instants)).latency_ms
+    assert first_half == pytest.approx(20.0 + 0.5 * REFRESH_S * 1e3, abs=0.5)
+    assert log_latency(tmp_path, shown).latency_ms > first_half + 10.0
+
+
 def test_too_short_a_log_is_refused(tmp_path: Path) -> None:
     _write_tracker(tmp_path, np.array([1.0, 0.0, 0.0]), seconds=2.0)
     switch = np.arange(0.2, 1.8, REFRESH_S)
