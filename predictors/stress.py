@@ -2,12 +2,12 @@
 
 Every stream is a trace whose truth is the clean motion at 1000 Hz and whose samples are what a
 tracker of some kind would deliver from it: its rate (30 to 1000 Hz), irregular sample times, white
-or coloured noise, repeated samples (a tracker that did not update), and motion that starts and
-stops at once. `stress_streams` builds the named set that `rig bench predictors --stress` runs;
+noise (`Trace.with_noise`) or coloured noise, repeated samples (a tracker that did not update), and
+motion that starts and stops at once. `stress_streams` builds the named set that `rig bench predictors --stress` runs;
 the pieces compose for other sets:
 
     truth = head_motion_truth(20.0, seed=1)
-    stream = with_white_noise(sampled(truth, 90.0, jitter=0.3, seed=1), 0.0005, math.radians(0.1), seed=1)
+    stream = sampled(truth, 90.0, jitter=0.3, seed=1).with_noise(0.0005, math.radians(0.1), seed=1)
 
 A predictor developed on two recordings is judged on others: these streams are where a design
 choice is checked before it is ever run on a recording.
@@ -80,11 +80,6 @@ def sampled(truth: Trace, rate_hz: float, jitter: float = 0.0, seed: int = 0, na
     return replace(stream, name=name or f"{truth.name}-{rate_hz:g}Hz")
 
 
-def with_white_noise(trace: Trace, position_std_m: float, orientation_std_rad: float, seed: int) -> Trace:
-    """`Trace.with_noise`: independent noise on every sample."""
-    return trace.with_noise(position_std_m, orientation_std_rad, seed)
-
-
 def with_coloured_noise(
     trace: Trace, position_std_m: float, orientation_std_rad: float, correlation: float, seed: int
 ) -> Trace:
@@ -131,16 +126,16 @@ def stress_streams(duration_s: float = 20.0, seed: int = 0) -> list[Trace]:
         return replace(trace, name=name)
 
     return [
-        named(with_white_noise(sampled(head, 30.0, seed=seed), 0.0002, 0.02 * degree, seed), "head-30Hz"),
+        named(sampled(head, 30.0, seed=seed).with_noise(0.0002, 0.02 * degree, seed), "head-30Hz"),
         named(sampled(head, 60.0, seed=seed), "head-60Hz-clean"),
-        named(with_white_noise(sampled(head, 120.0, seed=seed), 0.0005, 0.1 * degree, seed), "head-120Hz"),
-        named(with_white_noise(sampled(head, 1000.0, seed=seed), 0.001, 0.3 * degree, seed), "head-1000Hz-noisy"),
+        named(sampled(head, 120.0, seed=seed).with_noise(0.0005, 0.1 * degree, seed), "head-120Hz"),
+        named(sampled(head, 1000.0, seed=seed).with_noise(0.001, 0.3 * degree, seed), "head-1000Hz-noisy"),
         named(
-            with_repeats(with_white_noise(sampled(head, 60.0, jitter=0.3, seed=seed), 0.0, 0.05 * degree, seed), 0.05, seed),
+            with_repeats(sampled(head, 60.0, jitter=0.3, seed=seed).with_noise(0.0, 0.05 * degree, seed), 0.05, seed),
             "head-60Hz-jitter-repeats",
         ),
         named(with_coloured_noise(sampled(head, 90.0, seed=seed), 0.001, 0.2 * degree, -0.6, seed), "head-90Hz-alternating"),
         named(with_coloured_noise(sampled(head, 250.0, seed=seed), 0.001, 0.1 * degree, 0.9, seed), "head-250Hz-drifting"),
-        named(with_white_noise(sampled(stops, 60.0, seed=seed), 0.0002, 0.03 * degree, seed), "stops-60Hz"),
-        named(with_white_noise(sampled(stops, 500.0, seed=seed), 0.0005, 0.1 * degree, seed), "stops-500Hz"),
+        named(sampled(stops, 60.0, seed=seed).with_noise(0.0002, 0.03 * degree, seed), "stops-60Hz"),
+        named(sampled(stops, 500.0, seed=seed).with_noise(0.0005, 0.1 * degree, seed), "stops-500Hz"),
     ]

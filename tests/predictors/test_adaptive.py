@@ -15,7 +15,7 @@ from predictors import scalar_quaternion as squat
 from predictors.adaptive import HORIZONS_S
 from predictors.evaluation import replay, score
 from predictors.horizon_scores import MODEL_NAMES
-from predictors.stress import head_motion_truth, sampled, sudden_stops, with_coloured_noise, with_white_noise
+from predictors.stress import head_motion_truth, sampled, sudden_stops, with_coloured_noise
 
 laws = settings(deadline=None, max_examples=20, derandomize=True)
 
@@ -52,7 +52,7 @@ def test_noiseless_constant_velocity_is_predicted_exactly(horizon):
 
 
 def test_a_noisy_fast_tracker_is_smoothed_far_below_constant_velocity(head):
-    stream = with_white_noise(sampled(head, 500.0, seed=1), 0.001, math.radians(0.3), seed=1)
+    stream = sampled(head, 500.0, seed=1).with_noise(0.001, math.radians(0.3), seed=1)
     for horizon in (0.02, 0.05):
         angular, position = rms(stream, "adaptive", horizon)
         cv_angular, cv_position = rms(stream, "slerp", horizon)
@@ -79,7 +79,7 @@ def test_sudden_stops_after_the_first_turn_cost_nothing_over_constant_velocity()
     """Velocity steps are constant velocity's best case. From a still start the first turn can find
     a smoother trusted (at rest it was the better model): that costs 12% at 20 ms over
     a 30 s stream (seed 9: the worst of six), all of it in that turn; after it, within half a percent."""
-    stream = with_white_noise(sampled(sudden_stops(30.0, seed=9), 60.0, seed=9), 0.0002, math.radians(0.03), seed=9)
+    stream = sampled(sudden_stops(30.0, seed=9), 60.0, seed=9).with_noise(0.0002, math.radians(0.03), seed=9)
     horizons = [0.02, 0.05, 0.1]
     errors = {}
     for name in ("adaptive", "slerp"):
@@ -93,7 +93,7 @@ def test_sudden_stops_after_the_first_turn_cost_nothing_over_constant_velocity()
 
 
 def test_state_reports_the_noise_it_measured_and_the_sample_interval(head):
-    stream = with_white_noise(sampled(head, 250.0, seed=6), 0.002, math.radians(0.5), seed=6)
+    stream = sampled(head, 250.0, seed=6).with_noise(0.002, math.radians(0.5), seed=6)
     predictor = make("adaptive")
     for sample in stream.samples():
         predictor.update(sample)
@@ -118,7 +118,7 @@ def test_an_orientation_only_stream_predicts_position_as_held(head):
 
 
 def test_a_gap_restarts_the_estimates_but_keeps_what_was_learnt(head):
-    stream = with_white_noise(sampled(head, 250.0, seed=8), 0.001, math.radians(0.3), seed=8)
+    stream = sampled(head, 250.0, seed=8).with_noise(0.001, math.radians(0.3), seed=8)
     predictor = make("adaptive", max_gap=0.5)
     samples = stream.samples()
     for sample in samples:
@@ -146,7 +146,7 @@ def test_law_predictions_are_continuous_across_the_scored_horizons(head, start, 
     """Where the blend changes hands the prediction moves by its speed times the step, no jump
     (a jump between two models' predictions would be of order 1e-3 rad and 1e-3 m)."""
     predictor = make("adaptive")
-    samples = with_white_noise(sampled(head, 120.0, seed=9), 0.001, math.radians(0.2), seed=9).samples()[:600]
+    samples = sampled(head, 120.0, seed=9).with_noise(0.001, math.radians(0.2), seed=9).samples()[:600]
     for sample in samples:
         predictor.update(sample)
     t = samples[-1].t_sensor + start
