@@ -133,7 +133,7 @@ def _learn(stats: list[list[float]], part: int, h: float, truth: Vector, anchor:
     learnt[_FY] = fy * decay + weight * (f0 * y0 + f1 * y1 + f2 * y2)
     learnt[_SSE] = sse * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
     for model in range(2, len(stats)):
-        a0, a1, a2, w0, w1, w2 = anchor[model - 1][part]
+        a0, a1, a2, w0, w1, w2 = anchor[MODELS[model]][part]
         e0, e1, e2 = t0 - a0 - h * w0, t1 - a1 - h * w1, t2 - a2 - h * w2
         smoothed = stats[model]
         smoothed[_SSE] = smoothed[_SSE] * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
