@@ -133,11 +133,13 @@ def _swing_checks(swing: Swing, windowed: WindowedLatency | None) -> tuple[list[
         "per-swing consistency",
         chi2 <= limit,
         f"the {count} swings' latencies scatter by {np.std(latency, ddof=1) * 1e3:.2f} ms, "
-        f"{math.sqrt(chi2 / (count - 1)) * WINDOW_NOISE_ALLOWANCE:.1f} times their noise",
+        f"{math.sqrt(chi2 / (count - 1)):.1f} times what their noise allows",
     )
-    centred = t - t.mean()
+    centred = t - float(weights @ t / weights.sum())
     slope = float(weights @ (centred * (latency - mean)) / (weights @ centred**2))
-    slope_error = math.sqrt(max(chi2 / (count - 1), 1.0) / float(weights @ centred**2))
+    # The slope's error from the scatter about the line (no less than the noise allows).
+    about_line = float(weights @ (latency - mean - slope * centred) ** 2) / max(count - 2, 1)
+    slope_error = math.sqrt(max(about_line, 1.0) / float(weights @ centred**2))
     statistic = abs(slope) / slope_error
     drift = Check(
         "drift",
@@ -176,8 +178,12 @@ def _residual_checks(residuals: TimingResiduals | None, swing: Swing, half_width
     harmonics = Check(
         "residual harmonics",
         fundamental == 0.0 or fundamental < MATERIAL * half_width_s,
-        (f"the residuals keep the swing frequency itself ({fundamental * 1e3:.2f} ms as timing)" if fundamental else "none at the swing frequency")
-        + "".join(f"; {order} x the swing frequency: {timing * 1e3:.2f} ms as timing" for order, timing in timings.items() if order > 1),
+        (
+            f"the residuals keep the swing frequency itself ({fundamental * 1e3:.2f} ms as timing)"
+            if fundamental
+            else "none at the swing frequency"
+        )
+        + "".join(f"; {order} x the swing frequency: {t * 1e3:.2f} ms as timing" for order, t in timings.items() if order > 1),
     )
     period_frames = max(1, round(fps / frequency))
     one = long_run_variance(series - series.mean(), period_frames)

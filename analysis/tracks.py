@@ -262,7 +262,8 @@ def track(
     "right") if given, else the one the physical evidence names (``analysis.identity``; an
     AnalysisError asks for the ROIs when it does not decide). ``progress(done, total)`` is called
     as frames are tracked (for clips of PROGRESS_MIN_SECONDS or more). ``tracks_csv`` receives
-    every frame's row as it is measured (the left blob first as the LED while that is undecided), then the final table once the frame times are decided (``analysis.report``); it is
+    every frame's row as it is measured (the left blob first as the LED while that is undecided),
+    then the final table once the frame times are decided (``analysis.report``); it is
     written before the tracks are checked, so tracks that fail a check stay on disk to look at.
     """
     if led_side is not None and led_side not in SIDES:

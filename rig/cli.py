@@ -28,6 +28,7 @@ COMMANDS = (
     "demo",
     "simulate",
     "analyse",
+    "plan",
     "sweep",
     "report",
     "bench",

@@ -26,7 +26,7 @@ from analysis.tracking import Track
 
 # Residuals may be correlated over this fraction of a swing period.
 CORRELATION_PERIODS = 0.1
-# The bias counts as identified when its 95 % range is within this fraction of its size either
+# The bias counts as identified when its range (BIAS_RANGE) is within this fraction of its size either
 # side of it; it is corrected where that is worth doing, at least this fraction of the latency's
 # own 95 % half-width.
 IDENTIFIED_SPREAD = 0.5
@@ -35,8 +35,8 @@ WORTH_CORRECTING = 0.5
 WIDENING_NOTICE = 0.25
 WIDENING_NOTICE_S = 0.05e-3
 # A bias range is summarised by this many mixture components.
-MIXTURE_COMPONENTS = 256
-QUANTILE_GRID = 2048
+MIXTURE_COMPONENTS = 64
+QUANTILE_GRID = 512
 NORMAL_95 = 1.959963984540054
 # The bias's range: all but this much of its posterior either side.
 BIAS_RANGE = (0.005, 0.995)
@@ -97,7 +97,8 @@ class SamplingBias:
         if self.correction_for(ci_s) != 0.0:
             low, high = self.range_s
             return (
-                f"{camera} samples the {self.refresh_hz:.4g} Hz display ({self.refresh_source}) {self._phases_text()}; the sphere's timing in the video is off by {self.correction_s * 1e3:+.2f} ms "
+                f"{camera} samples the {self.refresh_hz:.4g} Hz display ({self.refresh_source}) {self._phases_text()}; "
+                f"the sphere's timing in the video is off by {self.correction_s * 1e3:+.2f} ms "
                 f"({low * 1e3:+.2f} to {high * 1e3:+.2f}), which was corrected. To avoid it, film at a rate the "
                 f"display's does not divide or multiply, or expose for {_whole_refreshes(self.refresh_hz)}"
             )

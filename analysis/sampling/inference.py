@@ -16,7 +16,12 @@ much of a refresh, so each nominal rate is first tuned within that tolerance to 
 residuals line up best (the sum of squares the per-bin means explain), when they line up better
 than chance. Without a rate from the user the candidates are the common refresh rates and the
 rates whose refreshes alias onto a line in the residuals' spectrum; those whose likelihood comes
-within CONSISTENT_LOG_LIKELIHOOD of the best remain possible.
+within CONSISTENT_LOG_LIKELIHOOD of the best remain possible. A display's refreshes and what it
+shows are told apart only by the staircase's shape: a renderer that updates the sphere at another
+rate than the display's (a 120 Hz tracker held on a 144 Hz display) makes a pattern of its own,
+which some other rate may fit better than the display's. So unless the best rate's staircase
+explains at least TRUSTED_EXPLAINED of the timing residuals (a display's steps, plainly seen), the
+common rates too fast for the camera to see the steps of stay possible, however they fit.
 """
 
 from __future__ import annotations
@@ -49,12 +54,16 @@ FINE_EXPOSURE_STEPS = 48
 # The elongation counts where at least this many frames measured it.
 SHAPE_MIN_FRAMES = 32
 CONSISTENT_LOG_LIKELIHOOD = 6.0
+TRUSTED_EXPLAINED = 0.9
 # A hypothesis whose bias quantiles span more than this fraction of what its exposures allow at any
 # phase does not place the phase.
 UNPLACED = 0.5
 # Each model is taken to be off by up to this fraction of what it explains, per frame: the sphere
 # spans rows that switch at different times, a display's pixels take time to settle.
 MODEL_ERROR = 0.1
+# The elongation is trusted to this fraction of the largest a double image gives (two equal images a
+# refresh's travel apart, at the swing's typical speed).
+SHAPE_RESOLUTION = 0.2
 # A spectral line: this many times the median power, above LINE_MIN_HZ (slower lines are the
 # swing's own harmonics).
 LINE_POWER = 25.0
@@ -98,7 +107,7 @@ class _Folding:
     timing; for the elongation D (frames where it was measured), sum v^2, sum v^4, sum D v^2 and
     its totals."""
 
-    def __init__(self, residuals: TimingResiduals, refresh_hz: float, bins: int) -> None:
+    def __init__(self, residuals: TimingResiduals, refresh_hz: float, bins: int, shape: bool = True) -> None:
         phase = refresh_hz * residuals.t
         index = ((phase - np.floor(phase)) * bins).astype(np.int64) % bins
         v2 = residuals.v**2
@@ -106,7 +115,7 @@ class _Folding:
         self.w = np.bincount(index, v2, bins)
         self.x = np.bincount(index, residuals.v * residuals.r, bins)
         self.shape: tuple[np.ndarray, np.ndarray, np.ndarray, float, float, int] | None = None
-        if residuals.elongation is not None:
+        if shape and residuals.elongation is not None:
             measured = np.isfinite(residuals.elongation)
             if np.count_nonzero(measured) >= SHAPE_MIN_FRAMES:
                 where, d, q = index[measured], residuals.elongation[measured], v2[measured]
@@ -117,6 +126,27 @@ class _Folding:
         """The sum of squares a free timing offset per bin explains."""
         used = self.w > 0
         return float(np.sum(self.x[used] ** 2 / self.w[used]))
+
+
+@dataclass(frozen=True)
+class _Model:
+    """A rate's model per phase bin and exposure: the bias (s) and its square, the elongation factor
+    V / f^2 and its square, as spectra along the bins (for circular correlation)."""
+
+    rate: float
+    bins: int
+    spectra: tuple[np.ndarray, ...]
+
+
+def _model(rate: float, exposures_s: np.ndarray, bins: int = PHASE_BINS, shape: bool = True) -> _Model:
+    centres = (np.arange(bins) + 0.5) / bins
+    exposures = exposures_s[:, None] * rate
+    biases = exposure_bias(centres[None, :], exposures) / rate
+    tables = [biases, biases**2]
+    if shape:
+        spread = exposure_spread(centres[None, :], exposures) / rate**2
+        tables += [spread, spread**2]
+    return _Model(rate, bins, tuple(np.fft.rfft(table, axis=1) for table in tables))
 
 
 @dataclass(frozen=True)
@@ -131,27 +161,26 @@ class _Fit:
     mean: np.ndarray
 
 
-def _fit(residuals: TimingResiduals, rate: float, exposures_s: np.ndarray, bins: int = PHASE_BINS, shape: bool = True) -> _Fit:
-    """The misfits at ``rate`` for every exposure and phase j / bins, each phase a circular shift of
-    the per-bin model, so three FFTs per term."""
-    folding = _Folding(residuals, rate, bins)
-    centres = (np.arange(bins) + 0.5) / bins
-    exposures = exposures_s[:, None] * rate
-    biases = exposure_bias(centres[None, :], exposures) / rate
+def _fit(residuals: TimingResiduals, model: _Model, rate: float | None = None) -> _Fit:
+    """The misfits of ``model`` for every exposure and phase j / bins, the frames folded at ``rate``
+    (the model's own by default): each phase a circular shift of the per-bin model, so a few FFTs."""
+    rate = model.rate if rate is None else rate
+    folding = _Folding(residuals, rate, model.bins, shape=len(model.spectra) > 2)
 
-    def correlate(values: np.ndarray, model: np.ndarray) -> np.ndarray:
-        return np.fft.irfft(np.conj(np.fft.rfft(values))[None, :] * np.fft.rfft(model, axis=1), bins, axis=1)
+    def correlate(values: np.ndarray, spectrum: np.ndarray) -> np.ndarray:
+        return np.fft.irfft(np.conj(np.fft.rfft(values))[None, :] * spectrum, model.bins, axis=1)
 
+    bias, bias_square = model.spectra[:2]
     total_w, total_x = folding.w.sum(), folding.x.sum()
-    mean = correlate(folding.w, biases) / max(total_w, 1e-300)
+    mean = correlate(folding.w, bias) / max(total_w, 1e-300)
     squares = float(residuals.r @ residuals.r)
-    timing = squares + 2 * correlate(folding.x, biases) - 2 * mean * total_x + correlate(folding.w, biases**2) - mean**2 * total_w
+    timing = squares + 2 * correlate(folding.x, bias) - 2 * mean * total_x + correlate(folding.w, bias_square) - mean**2 * total_w
     shape_chi2 = None
-    if shape and folding.shape is not None:
+    if folding.shape is not None:
+        spread, spread_square = model.spectra[2:]
         q, q2, dq, total_d, total_d2, count = folding.shape
-        spread = exposure_spread(centres[None, :], exposures) / rate**2
         cross, model_sum = correlate(dq, spread), correlate(q, spread)
-        shape_chi2 = total_d2 - 2 * cross + correlate(q2, spread**2) - (total_d - model_sum) ** 2 / count
+        shape_chi2 = total_d2 - 2 * cross + correlate(q2, spread_square) - (total_d - model_sum) ** 2 / count
     return _Fit(rate, folding, timing, shape_chi2, mean)
 
 
@@ -168,8 +197,11 @@ def _tuned_rate(residuals: TimingResiduals, nominal_hz: float, exposures_s: np.n
     if half < fine:
         return nominal_hz
 
+    # Within the tolerance the model hardly changes: only the folding moves.
+    model = _model(nominal_hz, exposures_s, TUNING_BINS, shape=False)
+
     def misfit(rate: float) -> float:
-        return float(_fit(residuals, rate, exposures_s, TUNING_BINS, shape=False).timing.min())
+        return float(_fit(residuals, model, rate).timing.min())
 
     coarse = min(half, COARSE_STEPS * fine)
     rates = nominal_hz + coarse * np.arange(-math.floor(half / coarse), math.floor(half / coarse) + 1)
@@ -229,7 +261,7 @@ def refresh_hypotheses(
     ``exposure_s`` is the range the exposure lies in; ``bandwidth`` (frames) the span over which
     residuals may be correlated."""
     exposures = _exposure_grid(*exposure_s)
-    fits = [_fit(residuals, rate, exposures) for rate in _candidate_rates(residuals, fps, refresh_hz, exposures)]
+    fits = [_fit(residuals, _model(rate, exposures)) for rate in _candidate_rates(residuals, fps, refresh_hz, exposures)]
     with_shape = all(fit.shape is not None for fit in fits)
     timing_scale = min(float(fit.timing.min()) for fit in fits) / residuals.r.size
     shape_scale = min(float(fit.shape.min()) for fit in fits) / fits[0].folding.shape[5] if with_shape else 1.0
@@ -242,16 +274,21 @@ def refresh_hypotheses(
     left = _leftovers(residuals, best, float(exposures[exposure_index]), int(phase_index))
     timing_scale = max(timing_scale * inflation(left[0], bandwidth), (MODEL_ERROR * left[2]) ** 2, 1e-300)
     if with_shape:
-        shape_scale = max(shape_scale * inflation(left[1], bandwidth), (MODEL_ERROR * left[3]) ** 2, 1e-300)
+        # Only a clear double image counts: the sphere's rows switch one after another, so a switch
+        # near an exposure's edge doubles some rows of it and not others.
+        straddle = SHAPE_RESOLUTION * 0.25 * float(np.sqrt(np.mean(residuals.v**4))) / best.rate**2
+        shape_scale = max(shape_scale * inflation(left[1], bandwidth), (MODEL_ERROR * left[3]) ** 2, straddle**2, 1e-300)
     hypotheses = []
     most = max(float(-0.5 * misfit(fit, timing_scale, shape_scale).min()) for fit in fits)
+    unseen = refresh_hz is None and 1.0 - float(best.timing.min()) / float(residuals.r @ residuals.r) < TRUSTED_EXPLAINED
     fine = _exposure_grid(*exposure_s, FINE_EXPOSURE_STEPS)
     for fit in fits:
         top = float(-0.5 * misfit(fit, timing_scale, shape_scale).min())
-        if top < most - CONSISTENT_LOG_LIKELIHOOD:
+        too_fast = unseen and fit.rate in COMMON_REFRESH_HZ and fit.rate >= fps * (1 - RATE_TOLERANCE)
+        if top < most - CONSISTENT_LOG_LIKELIHOOD and not too_fast:
             continue
         # The likelihood may be far narrower in the exposure than the coarse grid's steps.
-        refined = _fit(residuals, fit.rate, fine) if fine.size > exposures.size else fit
+        refined = _fit(residuals, _model(fit.rate, fine)) if fine.size > exposures.size else fit
         log_likelihood = -0.5 * misfit(refined, timing_scale, shape_scale)
         weights = np.exp(log_likelihood - log_likelihood.max()).ravel()
         hypotheses.append(RefreshHypothesis(fit.rate, top, refined.mean.ravel(), weights / weights.sum()))

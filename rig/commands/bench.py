@@ -11,12 +11,13 @@ import math
 import os
 import sys
 import tempfile
+import time
 from pathlib import Path
 from typing import Any, Callable
 
 import predictors
 from predictors import read_trace
-from rig.bench import analyser, batch
+from rig.bench import analyser, analyser_grid, batch
 from rig.bench import predictors as predictor_bench
 from rig.commands import options
 from rig.commands.bench_live import add_live
@@ -46,34 +47,50 @@ def _plot(draw: Callable[[], None], path: Path) -> None:
 # -- analyser ------------------------------------------------------------------------------------
 
 
+def _analyser_cases(args: argparse.Namespace) -> list[analyser_grid.Case]:
+    if args.quick:
+        return analyser_grid.quick_grid()
+    mixed = analyser_grid.grid(args.cases) if args.grid in ("all", "mixed") else []
+    return mixed + (analyser_grid.hard_grid() if args.grid in ("all", "hard") else [])
+
+
 def _run_analyser(args: argparse.Namespace) -> int:
-    cases = analyser.quick_grid() if args.quick else analyser.grid(args.cases)
+    cases = _analyser_cases(args)
+    started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="rig-bench-analyser-") as scratch:
         folder = args.runs if args.runs is not None else Path(scratch)
         report = analyser.run_bench(cases, folder, _log)
+    report["seconds"] = time.perf_counter() - started
     if args.json is not None:
         _write_json(args.json, report)
     if args.plot is not None:
         _plot(lambda: analyser.plot(report["summary"], report["cases"], args.plot), args.plot)
-    print(analyser.table(report["summary"]))
+    for group, summary in report["summaries"].items():
+        print(f"{group} ({summary['sinefit']['cases']} cases):")
+        print(analyser.table(summary))
     for target, met in report["targets_met"].items():
         print(f"{target}: {'met' if met else 'not met' if met is not None else 'n/a'}")
+    print(f"{len(cases)} cases in {report['seconds'] / 60:.1f} minutes")
     return 0
 
 
 def _add_analyser(benchmarks: argparse._SubParsersAction) -> None:
     parser = benchmarks.add_parser(
         "analyser",
-        help="error, interval coverage and speed of each latency estimator on simulated videos",
-        description="Simulate videos of known latency over a grid of periods, frame rates, refresh rates, "
-        "swings, damping and impairments, analyse each with every method, and report per method the median "
-        "and worst error, the coverage of the 95%% intervals and the speed against decoding alone. "
-        "The default grid takes about fifteen minutes on two cores; --quick runs two tiny cases.",
+        help="error, interval coverage, confidently wrong answers and speed of each latency estimator on simulated videos",
+        description="Simulate videos of known latency over two grids, analyse each with every method, and report "
+        "per method the median and worst error, the coverage of the 95%% intervals, the confidently wrong answers "
+        "(truth outside the interval by more than max(0.5 ms, its half-width)), the refusals and the speed against "
+        "decoding alone. The mixed grid spans periods, frame rates, refresh rates, swings, damping and "
+        "impairments; the hard grid, what goes wrong in a lab: camera rates that lock to the display's, short "
+        "exposures, a dim LED or sphere, swapped sides, a second bright object, a partly hidden blob, decimated "
+        "films. Both take about forty minutes on two cores; --quick runs three tiny cases.",
     )
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the summary and every case as JSON")
+    parser.add_argument("--json", type=Path, metavar="OUT", help="write the summaries and every case as JSON")
     parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot speed against error per method")
-    parser.add_argument("--quick", action="store_true", help="two short cases (a smoke test)")
-    parser.add_argument("--cases", type=options.positive_int, default=analyser.DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
+    parser.add_argument("--quick", action="store_true", help="three short cases (a smoke test)")
+    parser.add_argument("--grid", choices=("all", "mixed", "hard"), default="all", help="which grid to run (default: %(default)s)")
+    parser.add_argument("--cases", type=options.positive_int, default=analyser_grid.DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
     parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the simulated videos here (default: a temporary folder)")
     parser.set_defaults(func=_run_analyser)
 

@@ -5,12 +5,14 @@
 Each is a plain function with a typed request or config and a typed result: `simulate` runs the
 simulated rig (`SimulationConfig` -> `SimulationResult` with its `Truth`), `analyse` measures the
 latency in a video (`AnalysisRequest` -> `Measurement`), `demo` does both and compares
-(`DemoReport`), `tune` fits a predictor to recorded motion (`TuneReport`). The benchmarks are in
+(`DemoReport`), `tune` fits a predictor to recorded motion (`TuneReport`), `plan` recommends how
+to film (`PlanRequest` -> `Plan`). The benchmarks are in
 `rig.bench`, registered by name.
 """
 
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
 from rig.service.demo import DemoReport, compare_renderers, comparison_config, demo
+from rig.service.plan import Plan, PlanRequest, plan
 from rig.service.simulate import SimulationResult, simulate
 from rig.service.tune import TuneReport, split_traces, tune
 from rig.sim.config import SimulationConfig
@@ -20,6 +22,8 @@ __all__ = [
     "AnalysisRequest",
     "DemoReport",
     "Measurement",
+    "Plan",
+    "PlanRequest",
     "SimulationConfig",
     "SimulationResult",
     "Truth",
@@ -28,6 +32,7 @@ __all__ = [
     "compare_renderers",
     "comparison_config",
     "demo",
+    "plan",
     "simulate",
     "split_traces",
     "tune",

@@ -9,7 +9,7 @@ import pytest
 
 from rig.cli import EXIT_USER_ERROR, EXIT_WARNINGS, build_parser, main
 
-COMMANDS = ["demo", "simulate", "analyse", "sweep", "report", "bench", "tune", "board"]
+COMMANDS = ["demo", "simulate", "analyse", "plan", "sweep", "report", "bench", "tune", "board"]
 
 
 @pytest.mark.parametrize("command", [[]] + [[c] for c in COMMANDS] + [["bench", subject] for subject in ("analyser", "predictors", "renderers")])

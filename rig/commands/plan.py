@@ -1,0 +1,108 @@
+"""`rig plan`: which camera setting, film length and layout measure the latency to the accuracy wanted.
+
+Simulates every camera rate and exposure on offer filming the display (`rig.service.plan`), prints
+each one's expected 95 % half-width and sampling bias bound, and recommends one, checked by a
+simulation, with the `rig simulate` and `rig analyse` lines that film and measure it. Exit status
+0 with a recommendation, 1 when no setting on offer reaches the accuracy, 2 for bad options.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from rig.commands import options
+from rig.service import Plan, PlanRequest, plan
+from rig.sim.pendulum import PendulumConfig
+
+EXIT_UNREACHABLE = 1
+
+
+def _numbers(text: str) -> tuple[float, ...]:
+    """A comma-separated list of positive numbers."""
+    return tuple(options.positive_float(part) for part in text.split(","))
+
+
+def _log(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def _print(result: Plan) -> None:
+    request = result.request
+    print(
+        f"filming a {request.display_hz:g} Hz display, a {request.period_s:g} s pendulum swinging "
+        f"{request.amplitude_deg:g} degrees, for a 95% half-width of {request.accuracy_ms:g} ms:"
+    )
+    print("| camera fps | exposure | phases per refresh | bias if phase-locked | half-width (trial) | film for the accuracy |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    for s in result.settings:
+        film = f"{s.film_s:g} s" if s.film_s is not None else "not reached"
+        phases = "all (walk)" if s.phases is None else str(s.phases)
+        print(
+            f"| {s.camera_fps:g} | {s.exposure:.0%} ({s.exposure_ms:.3g} ms) | {phases} | +-{s.bias_bound_ms:.2f} ms | "
+            f"{s.statistical_ms + s.added_ms:.3f} ms over {s.trial_s:g} s | {film} |"
+        )
+    best = result.recommended
+    if best is None:
+        print(f"no setting on offer reaches {request.accuracy_ms:g} ms: offer a faster camera, or expose for whole refreshes")
+        return
+    checked = result.checked or {}
+    print(
+        f"recommended: {best.camera_fps:g} fps exposing {best.exposure:.0%} of each frame ({best.exposure_ms:.3g} ms), "
+        f"{best.film_s:g} s of film; checked by simulation: 95% half-width {checked.get('half_width_ms', 0.0):.3f} ms, "
+        f"error {checked.get('error_ms', 0.0):+.3f} ms"
+    )
+    print(f"layout: {result.layout['advice']}; LED region {result.layout['led_roi']}, sphere region {result.layout['sphere_roi']}")
+    for line in result.commands():
+        print(f"  {line}")
+
+
+def _run(args: argparse.Namespace) -> int:
+    request = PlanRequest(
+        display_hz=args.display_hz,
+        camera_fps=args.camera_fps,
+        exposures=args.exposures,
+        period_s=args.period_s,
+        amplitude_deg=args.amplitude_deg,
+        accuracy_ms=args.accuracy_ms,
+    )
+    result = plan(request, _log, args.runs)
+    if args.json:
+        print(json.dumps(result.to_dict()))
+    else:
+        _print(result)
+    return 0 if result.recommended is not None else EXIT_UNREACHABLE
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "plan",
+        help="recommend the camera setting, film length and layout that reach a latency accuracy",
+        description="Simulate each camera frame rate and exposure on offer filming the display, analyse each as a "
+        "lab would (the settings given), and recommend the one that reaches the wanted 95%% half-width with the "
+        "shortest film, checked by a simulation; print every setting's expected half-width and the bias a "
+        "phase-locked camera could have. Exit status 0 with a recommendation, 1 when none reaches the accuracy.",
+    )
+    parser.add_argument("--display-hz", type=options.positive_float, required=True, help="the display's refresh rate")
+    parser.add_argument(
+        "--camera-fps", type=_numbers, required=True, metavar="F,F,...", help="the camera's frame rates on offer (20-2000)"
+    )
+    parser.add_argument(
+        "--exposures",
+        type=_numbers,
+        default=(1.0,),
+        metavar="E,E,...",
+        help="exposures on offer, as fractions of the frame interval in (0, 1] (default: 1, the whole interval)",
+    )
+    parser.add_argument("--period-s", type=options.positive_float, default=1.0, help="the pendulum's period (default: %(default)s)")
+    parser.add_argument(
+        "--amplitude-deg", type=options.positive_float, default=PendulumConfig().amplitude_deg, help="its swing (default: %(default)s)"
+    )
+    parser.add_argument(
+        "--accuracy-ms", type=options.positive_float, default=1.0, help="the 95%% half-width wanted, in ms (default: %(default)s)"
+    )
+    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the simulated films here (default: a temporary folder)")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.set_defaults(func=_run)
