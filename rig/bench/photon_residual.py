@@ -19,7 +19,7 @@ from rig.bench.renderer_latency import LatencyRun, film_latency
 from rig.bench.renderers import BenchGrid, machine_name
 from rig.session import DEFAULT_SERVER_MS, PHOTON_TARGETS
 
-RESIDUAL_PREDICTORS = ("kalman-ca", "kalman-cv", "desp", "slerp", "hold")
+RESIDUAL_PREDICTORS = ("adaptive", "kalman-ca", "kalman-cv", "desp", "slerp", "hold")
 RESIDUAL_TRIANGLES = 10_000
 
 Log = Callable[[str], None]

@@ -153,7 +153,7 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--variant", action="append", metavar="SPEC", help="a warp variant for --variants; repeat for several (default: the seeds' features one by one)")
     parser.add_argument("--predictor", default="hold", help="the predictor of every latency run, both renderers alike (default: %(default)s, as the seeds' Table 2)")
     parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")
-    parser.add_argument("--residual-predictor", action="append", metavar="NAME", help="a predictor for --photon-residual; repeat for several (default: kalman-ca, kalman-cv, desp, slerp, hold)")
+    parser.add_argument("--residual-predictor", action="append", metavar="NAME", help="a predictor for --photon-residual; repeat for several (default: adaptive, kalman-ca, kalman-cv, desp, slerp, hold)")
     parser.add_argument("--server-ms", type=options.positive_float, metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
     parser.add_argument("--max-frame-s", type=options.positive_float, default=seed_table.SeedTableSpec().max_frame_s, help="--seed-table: the largest direct frame, in seconds, a scene may take (default: %(default)s)")
     parser.add_argument("--max-triangles", type=options.positive_int, metavar="N", help="--seed-table: the largest load (default: 20000000, 720 MB and the GL driver's copy)")
