@@ -10,8 +10,9 @@ box says an object is (level 0), another object warped behind a box's front (lev
 box's own object warped behind the back of the nearest box (level 2). Holes where no box is are
 background and need nothing but the background.
 
-Holes are resolved as the seeds do: the hole map is read in blocks of HOLE_BLOCK x HOLE_BLOCK
-pixels; for each block holding a load hole, the leaves whose boxes a ray through the block's centre
+Holes are resolved as the seeds do: the hole map is read back and reduced to blocks of HOLE_BLOCK
+x HOLE_BLOCK pixels (the seed reduces it on the GPU before reading it); for each block holding a
+load hole, the leaves whose boxes a ray through the block's centre
 meets (here: whose projected bounds contain the centre) are taken nearest first, at most
 LEAVES_PER_RAY of them, and their triangles are drawn into the warped image, depth-tested, at the
 server's pose; a sphere hole redraws the sphere. What stays a level-0 hole is filled afterwards.
