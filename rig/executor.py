@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import socket
 from typing import Any, Callable, Iterator, Sequence
 
 from rig.errors import ConfigError, RigError
@@ -41,6 +42,21 @@ def _on_dask(client: Any) -> Jobs:
     return run
 
 
+def _check_reachable(scheduler: str, timeout_s: float = 5.0) -> None:
+    """Refuse a tcp:// scheduler nobody listens at before a Dask client is made (a client that
+    fails to connect leaves its event loop's thread behind)."""
+    scheme, _, where = scheduler.partition("://")
+    if scheme != "tcp":
+        return
+    host, _, port = where.rpartition(":")
+    if not host or not port.isdigit():
+        raise ConfigError(f"--scheduler must be tcp://HOST:PORT, got {scheduler}")
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s).close()
+    except OSError as error:
+        raise RigError(f"cannot reach the Dask scheduler at {scheduler}: {error.strerror or error}") from None
+
+
 @contextlib.contextmanager
 def executor(workers: int | None = None, scheduler: str | None = None) -> Iterator[Jobs]:
     """Jobs run serially here (neither given), on a local Dask cluster of `workers` processes with
@@ -58,6 +74,7 @@ def executor(workers: int | None = None, scheduler: str | None = None) -> Iterat
     logging.getLogger("distributed").setLevel(logging.ERROR)
     with contextlib.ExitStack() as stack:
         if scheduler is not None:
+            _check_reachable(scheduler)
             try:
                 client = stack.enter_context(Client(scheduler, timeout="10s"))
             except OSError as error:

@@ -16,15 +16,18 @@ from analysis.estimators.registry import DEFAULT_METHOD
 from analysis.plots import plot_tracks
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options
+from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
 from rig.commands.formatting import board_line, summary_line
 from rig.errors import RigError
 from rig.progress import ProgressBar
 from rig.service import AnalysisRequest, analyse
+from rig.service.batch import find_videos
 
 
 def _run(args: argparse.Namespace) -> int:
+    videos = find_videos(args.videos)
     request = AnalysisRequest(
-        video=args.video,
+        video=videos[0],
         fps=args.fps,
         led_roi=args.led_roi,
         sphere_roi=args.sphere_roi,
@@ -37,6 +40,9 @@ def _run(args: argparse.Namespace) -> int:
         display_hz=args.display_hz,
         exposure_ms=args.exposure_ms,
     )
+    if is_batch(args, videos):
+        check_batch_options(args)
+        return run_batch_command(args, request, videos)
     measurement = analyse(request, ProgressBar("analysing"))
     result, board = measurement.result, measurement.board
     if args.plot is not None:
@@ -104,7 +110,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "method), xcorr (cross-correlation), sinefit (joint least-squares fit, the default), bayes (posterior "
         "by MCMC), all. Fits compile once per process; set JAX_COMPILATION_CACHE_DIR to keep them between runs.",
     )
-    parser.add_argument("video", type=Path, help="video file (mp4, avi, mov, mkv) or folder of numbered images")
+    parser.add_argument(
+        "videos",
+        type=Path,
+        nargs="+",
+        metavar="VIDEO",
+        help="video file (mp4, avi, mov, mkv), folder of numbered images, folder of videos, or glob; "
+        "more than one makes a batch",
+    )
     add_analysis_options(parser)
     parser.add_argument("--method", choices=(*analysis.methods(), "all"), default=DEFAULT_METHOD, help="estimator (default: %(default)s)")
     parser.add_argument(
@@ -124,5 +137,31 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--seed", type=int, default=0, help="random seed of the bayes sampler (default: %(default)s)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--csv", type=Path, metavar="FILE", help="write both tracks as CSV, row by row as they are measured")
-    parser.add_argument("--plot", type=Path, metavar="FILE.png", help="plot tracks, fits, residuals and latency over time")
+    parser.add_argument(
+        "--plot",
+        type=Path,
+        metavar="FILE.png",
+        help="plot tracks, fits, residuals and latency over time (a batch: the summary's latencies, by default beside it)",
+    )
+    add_batch_options(parser)
     parser.set_defaults(func=_run)
+
+
+def add_batch_options(parser: argparse.ArgumentParser) -> None:
+    batch = parser.add_argument_group(
+        "many videos",
+        "Several videos, folders or globs make a batch: one row per video (a bad video is a failed row, the batch "
+        "goes on), written as each finishes. Exit status 3 when any video failed or came with warnings.",
+    )
+    batch.add_argument("--summary", type=Path, metavar="FILE.csv", help="write the rows here, the same as JSON and a plot beside it")
+    batch.add_argument("--workers", type=options.positive_int, metavar="N", help="analyse on a local Dask cluster of N processes")
+    batch.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="analyse on an existing Dask cluster (its workers must reach the videos)")
+    batch.add_argument(
+        "--labels",
+        type=Path,
+        metavar="FILE.csv",
+        help="labels per video: a CSV whose first column is video (path or file name), one column per label "
+        "(default: each video labelled by its folder)",
+    )
+    batch.add_argument("--group", metavar="LABEL", help="colour the summary plot by this label (default: the first)")
+    batch.add_argument("--overwrite", action="store_true", help="replace an existing --summary")

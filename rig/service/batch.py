@@ -200,3 +200,15 @@ def run_batch(
 def requests_for(videos: Sequence[Path], template: AnalysisRequest) -> list[AnalysisRequest]:
     """One request per video, each as the template asks (ROIs, method, range...)."""
     return [replace(template, video=video) for video in videos]
+
+
+def write_summary_plot(rows: Sequence[dict[str, Any]], path: Path, group: str | None) -> None:
+    """The batch's latencies with their intervals per video, coloured by the label `group`, and
+    against swing frequency where the videos' periods differ."""
+    from rig.report.figures import summary_figure
+
+    figure = summary_figure(rows, group)
+    try:
+        figure.savefig(path, dpi=110)
+    except OSError as error:
+        raise RigError(f"cannot write the plot {path}: {error.strerror or error}") from None

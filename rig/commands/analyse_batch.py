@@ -1,0 +1,63 @@
+"""`rig analyse` of many videos (several paths, folders, globs, or `--summary`): one summary row per
+video, serially or on Dask, written as each video finishes (see `rig.service.batch`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from rig.cli import EXIT_WARNINGS
+from rig.errors import ConfigError
+from rig.progress import ProgressBar
+from rig.service import AnalysisRequest
+from rig.service.batch import BatchItem, check_summary_path, labels_from, run_batch, write_summary_plot
+
+
+def is_batch(args: argparse.Namespace, videos: list[Path]) -> bool:
+    return len(videos) > 1 or any(value is not None for value in (args.summary, args.workers, args.scheduler))
+
+
+def check_batch_options(args: argparse.Namespace) -> None:
+    """Options that name one video's outputs have no meaning for many; refuse them before any work."""
+    for option, value in (("--csv", args.csv), ("--board", args.board)):
+        if value is not None:
+            raise ConfigError(f"{option} is for one video; a batch writes its rows with --summary FILE.csv")
+    if args.summary is not None:
+        check_summary_path(args.summary, args.overwrite)
+    if args.plot is not None and args.summary is None:
+        raise ConfigError("--plot of a batch needs --summary FILE.csv (the plot shows the summary's rows)")
+
+
+def _line(row: dict[str, Any]) -> str:
+    if row["status"] == "failed":
+        return f"{row['video']}: failed: {row['error']}"
+    interval = f" (95% CI {row['ci95_low_ms']:.2f} to {row['ci95_high_ms']:.2f} ms)" if row["ci95_low_ms"] is not None else ""
+    flag = " [warnings]" if row["status"] == "warning" else ""
+    return f"{row['video']}: {row['latency_ms']:.2f} ms{interval} by {row['method']}{flag}"
+
+
+def run_batch_command(args: argparse.Namespace, template: AnalysisRequest, videos: list[Path]) -> int:
+    """Exit 0 when every video measured cleanly, 3 when any failed or came with warnings."""
+    labels = labels_from(args.labels, videos)
+    group = args.group or next(iter(next(iter(labels.values()), {})), None)
+    if group is not None and args.group is not None and not any(group in values for values in labels.values()):
+        raise ConfigError(f"--group {group}: no such label (labels: {', '.join(sorted({k for v in labels.values() for k in v}))})")
+    items = [BatchItem(replace(template, video=video), labels[video]) for video in videos]
+    progress = ProgressBar("analysing", unit="videos")
+    rows = run_batch(items, args.summary, args.workers, args.scheduler, progress)
+    plot = args.plot or (args.summary.with_suffix(".png") if args.summary is not None else None)
+    if plot is not None:
+        write_summary_plot(rows, plot, group)
+    if args.json:
+        print(json.dumps(rows))
+    else:
+        for row in rows:
+            print(_line(row))
+        counts = {status: sum(row["status"] == status for row in rows) for status in ("ok", "warning", "failed")}
+        print(f"{len(rows)} videos: {counts['ok']} ok, {counts['warning']} with warnings, {counts['failed']} failed")
+        if args.summary is not None:
+            print(f"summary: {args.summary}, {args.summary.with_suffix('.json')} and the plot {plot}")
+    return 0 if all(row["status"] == "ok" for row in rows) else EXIT_WARNINGS
