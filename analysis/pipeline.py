@@ -3,6 +3,7 @@ measures the latency in its tracks (``analysis.estimation.estimate``)."""
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import numpy as np
 
 from analysis.cycles import DEFAULT_LATENCY_RANGE_S
 from analysis.estimation import check_sampling_options, estimate, latency_range_s
+from analysis.estimators.contract import Estimator
 from analysis.estimators.registry import DEFAULT_METHOD, estimators_for
 from analysis.result import LatencyResult
 from analysis.tracking import Track
@@ -54,12 +56,16 @@ def analyse(
     (``analysis.sampling``).
     """
     # The options are checked before the video is read: a typo should not cost a tracking pass.
-    estimators_for(method)
+    estimators = estimators_for(method)
     latency_range_s(latency_range_ms)
     check_sampling_options(refresh_hz, exposure_ms)
-    tracks = track(
-        source, fps=fps, led_roi=led_roi, sphere_roi=sphere_roi, led_side=led_side, progress=progress, tracks_csv=tracks_csv
-    )
+    preparing = _prepare_in_background(estimators)
+    try:
+        tracks = track(
+            source, fps=fps, led_roi=led_roi, sphere_roi=sphere_roi, led_side=led_side, progress=progress, tracks_csv=tracks_csv
+        )
+    finally:
+        preparing.join()
     return estimate(
         tracks,
         method,
@@ -69,3 +75,19 @@ def analyse(
         refresh_hz=refresh_hz,
         exposure_ms=exposure_ms,
     )
+
+
+def _prepare_in_background(estimators: Sequence[Estimator]) -> threading.Thread:
+    """Each estimator's ``prepare`` (its imports: JAX alone takes about a second) on a thread, so
+    that it overlaps the tracking, whose decoding waits on OpenCV with the GIL released."""
+
+    def prepare() -> None:
+        for estimator in estimators:
+            try:
+                getattr(estimator, "prepare", lambda: None)()
+            except Exception:  # noqa: BLE001 - estimate() meets the same failure and reports it
+                return
+
+    thread = threading.Thread(target=prepare, name="analysis-prepare", daemon=True)
+    thread.start()
+    return thread

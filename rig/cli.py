@@ -24,23 +24,23 @@ from typing import Sequence
 from rig.compile_cache import keep_compiled_fits
 from rig.errors import RigError
 
-COMMANDS = (
-    "demo",
-    "simulate",
-    "analyse",
-    "plan",
-    "sweep",
-    "report",
-    "bench",
-    "tune",
-    "board",
-    "record_tracker",
-    "devices",
-    "emulate",
-    "record",
-    "measure",
-)
-"""The command modules in rig.commands, in the order `rig --help` lists them."""
+COMMANDS = {
+    "demo": "demo",
+    "simulate": "simulate",
+    "analyse": "analyse",
+    "plan": "plan",
+    "sweep": "sweep",
+    "report": "report",
+    "bench": "bench",
+    "tune": "tune",
+    "board": "board",
+    "record-tracker": "record_tracker",
+    "devices": "devices",
+    "emulate-tracker": "emulate",
+    "record": "record",
+    "measure": "measure",
+}
+"""Each command and its module in rig.commands, in the order `rig --help` lists them."""
 EXIT_USER_ERROR = 2
 EXIT_WARNINGS = 3
 EXIT_INTERRUPTED = 130
@@ -59,19 +59,23 @@ def user_errors() -> tuple[type[Exception], ...]:
     return (RigError, PredictorError, AnalysisError)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The whole command line; or, when `argv` names a command, that command alone, so that a
+    command starts without importing every other command's libraries."""
     parser = argparse.ArgumentParser(
         prog="rig",
         description="Measure motion-to-photon latency with a pendulum, an LED and a camera; simulate the rig.",
     )
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in COMMANDS:
-        importlib.import_module(f"rig.commands.{name}").add_parser(subparsers)
+    named = next((word for word in argv or () if not word.startswith("-")), None)
+    for module in (COMMANDS[named],) if named in COMMANDS else COMMANDS.values():
+        importlib.import_module(f"rig.commands.{module}").add_parser(subparsers)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv).parse_args(argv)
     try:
         return args.func(args)
     except user_errors() as error:

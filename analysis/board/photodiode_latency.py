@@ -29,7 +29,6 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import minimize_scalar
 
 from analysis.board.recording import ENCODER, PASSAGES, TICK_HZ, load_table
 from analysis.errors import AnalysisError
@@ -159,6 +158,8 @@ def estimate_board_latency(
     if not np.isfinite(costs).any():
         raise AnalysisError("the passages over the photodiode do not fit the pendulum: they need both directions of swing")
     best = int(np.argmin(costs))
+    from scipy.optimize import minimize_scalar  # here: the camera path imports this module for its encoder model alone
+
     refined = minimize_scalar(
         fit.cost,
         bounds=(max(0.0, grid[best] - GRID_STEP_S), min(limit, grid[best] + GRID_STEP_S)),

@@ -15,6 +15,9 @@ class BayesEstimator:
     name = "bayes"
     gives_interval = True
 
+    def prepare(self) -> None:
+        import analysis.fit.posterior  # noqa: F401
+
     def estimate(self, context: EstimationContext) -> MethodResult:
         # JAX and emcee are imported only when asked for, as in ``joint_fit``.
         from analysis.fit.posterior import sample_posterior

@@ -44,7 +44,10 @@ class EstimationContext:
 class Estimator(Protocol):
     """A latency estimator: ``name`` is the ``method`` that asks for it, ``gives_interval`` whether
     its result has a 95 % interval, and ``estimate`` turns the shared context into its result
-    (``MethodResult.method`` is ``name``; ``seconds`` the time the estimator itself took)."""
+    (``MethodResult.method`` is ``name``; ``seconds`` the time the estimator itself took).
+
+    An estimator may also have ``prepare()``, which loads what ``estimate`` will need (a heavy
+    import): the pipeline calls it in the background while the video is tracked."""
 
     @property
     def name(self) -> str: ...

@@ -37,6 +37,9 @@ class SineFitEstimator:
     name = "sinefit"
     gives_interval = True
 
+    def prepare(self) -> None:
+        import analysis.fit.least_squares  # noqa: F401
+
     def estimate(self, context: EstimationContext) -> MethodResult:
         started = time.perf_counter()
         fit = context.shared(joint_fit)

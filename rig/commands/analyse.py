@@ -13,7 +13,6 @@ from pathlib import Path
 import analysis
 from analysis.cycles import DEFAULT_LATENCY_RANGE_S
 from analysis.estimators.registry import DEFAULT_METHOD
-from analysis.plots import plot_tracks
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options
 from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
@@ -46,6 +45,8 @@ def _run(args: argparse.Namespace) -> int:
     measurement = analyse(request, ProgressBar("analysing"))
     result, board = measurement.result, measurement.board
     if args.plot is not None:
+        from analysis.plots import plot_tracks
+
         try:
             plot_tracks(result, args.plot)
         except OSError as error:

@@ -10,7 +10,6 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
-from analysis.plots import plot_tracks
 from rig.errors import RigError
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
 from rig.service.simulate import TRUTH_FILE, SimulationResult, simulate
@@ -76,6 +75,8 @@ def demo(config: SimulationConfig, out: Path, progress: ProgressFactory | None =
     result = measurement.result
     plot = out / "demo.png"
     try:
+        from analysis.plots import plot_tracks
+
         plot_tracks(result, plot, title=f"rig demo: measured {result.latency_ms:.2f} ms, true {simulation.truth.latency_ms:.2f} ms")
     except OSError as error:
         raise RigError(f"cannot write the plot {plot}: {error}") from error

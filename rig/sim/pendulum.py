@@ -23,13 +23,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.integrate import OdeSolution, solve_ivp
-from scipy.special import ellipk
 
 from rig.errors import ConfigError
+
+if TYPE_CHECKING:
+    from scipy.integrate import OdeSolution
 
 MAX_AMPLITUDE_DEG = 45.0
 _RTOL = 1e-11
@@ -38,7 +40,7 @@ _ATOL = 1e-12
 
 def _positive_finite(value: float | None, name: str) -> None:
     if value is None or not math.isfinite(value) or value <= 0.0:
-        raise ConfigError(f"PendulumConfig.{name} must be a positive finite number, got {value!r}")
+        raise ConfigError(f"pendulum.{name} must be a positive finite number, got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -75,28 +77,28 @@ class PendulumConfig:
         _positive_finite(self.g, "g")
         if not (0.0 < self.amplitude_deg <= MAX_AMPLITUDE_DEG):
             raise ConfigError(
-                f"PendulumConfig.amplitude_deg must be in (0, {MAX_AMPLITUDE_DEG:g}] degrees, "
+                f"pendulum.amplitude_deg must be in (0, {MAX_AMPLITUDE_DEG:g}] degrees, "
                 f"got {self.amplitude_deg!r}"
             )
         if math.isnan(self.quality) or self.quality <= 0.0:
             raise ConfigError(
-                f"PendulumConfig.quality must be a positive Q factor (math.inf for no damping), "
+                f"pendulum.quality must be a positive Q factor (math.inf for no damping), "
                 f"got {self.quality!r}"
             )
         if not (0.0 <= self.phase_deg < 360.0):
-            raise ConfigError(f"PendulumConfig.phase_deg must be in [0, 360) degrees, got {self.phase_deg!r}")
+            raise ConfigError(f"pendulum.phase_deg must be in [0, 360) degrees, got {self.phase_deg!r}")
         if self.release_s is not None:
             if not math.isfinite(self.release_s):
-                raise ConfigError(f"PendulumConfig.release_s must be a finite time in seconds, got {self.release_s!r}")
+                raise ConfigError(f"pendulum.release_s must be a finite time in seconds, got {self.release_s!r}")
             if self.phase_deg != 0.0:
                 raise ConfigError(
-                    "PendulumConfig.release_s and phase_deg exclude each other: a held pendulum starts "
+                    "pendulum.release_s and phase_deg exclude each other: a held pendulum starts "
                     f"from rest at its release, so leave phase_deg at 0 (got {self.phase_deg!r})"
                 )
         pivot = np.asarray(self.pivot, dtype=np.float64)
         if pivot.shape != (3,) or not np.isfinite(pivot).all():
             raise ConfigError(
-                f"PendulumConfig.pivot must be three finite coordinates in metres, got {self.pivot!r}"
+                f"pendulum.pivot must be three finite coordinates in metres, got {self.pivot!r}"
             )
 
     @property
@@ -148,6 +150,8 @@ class Pendulum:
     def period_s(self) -> float:
         """The exact undamped period at the release amplitude A: 4 sqrt(L / g) K(sin^2(A / 2))."""
         m = math.sin(self.amplitude_rad / 2.0) ** 2
+        from scipy.special import ellipk
+
         return 4.0 / self.omega0 * float(ellipk(m))
 
     def _integrate(self) -> OdeSolution:
@@ -157,6 +161,8 @@ class Pendulum:
         def rate(_t: float, y: np.ndarray) -> list[float]:
             theta, omega = y
             return [omega, -w0_squared * math.sin(theta) - damping * omega]
+
+        from scipy.integrate import solve_ivp  # here: importing the rig's services need not load the integrators
 
         result = solve_ivp(
             rate,

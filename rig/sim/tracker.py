@@ -25,7 +25,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from predictors import PoseSample
 from rig.clock import Clock
@@ -48,17 +47,17 @@ class TrackerConfig:
     def __post_init__(self) -> None:
         if not (math.isfinite(self.rate_hz) and self.rate_hz > 0.0):
             raise ConfigError(
-                f"TrackerConfig.rate_hz must be a positive finite rate in Hz, got {self.rate_hz!r}"
+                f"tracker.rate_hz must be a positive finite rate in Hz, got {self.rate_hz!r}"
             )
         for name in ("position_noise_m", "orientation_noise_deg", "transport_delay_s", "jitter_s"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
-                raise ConfigError(f"TrackerConfig.{name} must be a finite number >= 0, got {value!r}")
+                raise ConfigError(f"tracker.{name} must be a finite number >= 0, got {value!r}")
         if not (0.0 <= self.dropout < 1.0):
-            raise ConfigError(f"TrackerConfig.dropout must be a probability in [0, 1), got {self.dropout!r}")
+            raise ConfigError(f"tracker.dropout must be a probability in [0, 1), got {self.dropout!r}")
         if not (0.0 <= self.phase_s < 1.0 / self.rate_hz):
             raise ConfigError(
-                f"TrackerConfig.phase_s must be in [0, 1 / rate_hz) = [0, {1.0 / self.rate_hz!r}) s, "
+                f"tracker.phase_s must be in [0, 1 / rate_hz) = [0, {1.0 / self.rate_hz!r}) s, "
                 f"got {self.phase_s!r}"
             )
 
@@ -90,6 +89,8 @@ def simulate_tracker(
 
     positions, orientations = pendulum.sensor_pose(t_sensor)
     positions = positions + position_noise
+    from scipy.spatial.transform import Rotation  # here: scipy.spatial takes longer to import than most runs take to use it
+
     measured = Rotation.from_quat(orientations, scalar_first=True) * Rotation.from_rotvec(rotation_noise)
     orientations = measured.as_quat(scalar_first=True)
     orientations /= np.linalg.norm(orientations, axis=1, keepdims=True)

@@ -19,7 +19,6 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from rig.devices.protocols import NO_IMAGE
 from rig.errors import RigError
@@ -69,6 +68,8 @@ def effective_latency(
         return float(np.mean((shown - np.interp(t - tau, table_t, table_x)) ** 2))
 
     coarse = taus[int(np.argmin([coarse_cost(tau) for tau in taus]))]
+    from scipy.optimize import minimize_scalar  # here: importing the rig's services need not load scipy.optimize
+
     fine = minimize_scalar(cost, bounds=(coarse - SCAN_STEP_S, coarse + SCAN_STEP_S), method="bounded", options={"xatol": 1e-7})
     return float(fine.x)
 
