@@ -18,7 +18,11 @@ correlated over no more than a swing period. Each assumption is checked after ev
   allows for the second and third harmonic of each): they are reported, not held against the fit;
 - residual correlation: those residuals are correlated over no more than about a period (their
   long-run variance over CORRELATION_SPANS periods is no more than CORRELATION_GROWTH times that
-  over one).
+  over one). Each long-run variance is taken relative to what it would be for uncorrelated
+  residuals of the clip's length: centring a series on its own mean takes from a Bartlett sum
+  over B lags about B / n of the variance, which over three periods of a six-period clip is half
+  of it and would hide even a random walk. The check has power on clips of tens of periods; on
+  short clips the per-swing checks above stand in for it.
 
 A failed check adds a warning and widens the interval to at least the spread of the per-swing
 latencies: their standard error times Student's t over the swings, what resampling whole swings
@@ -186,8 +190,10 @@ def _residual_checks(residuals: TimingResiduals | None, swing: Swing, half_width
         + "".join(f"; {order} x the swing frequency: {t * 1e3:.2f} ms as timing" for order, t in timings.items() if order > 1),
     )
     period_frames = max(1, round(fps / frequency))
-    one = long_run_variance(series - series.mean(), period_frames)
-    longer = long_run_variance(series - series.mean(), CORRELATION_SPANS * period_frames)
+    centred = series - series.mean()
+    one = long_run_variance(centred, period_frames) / _white_share(centred.size, period_frames)
+    spans = CORRELATION_SPANS * period_frames
+    longer = long_run_variance(centred, spans) / _white_share(centred.size, spans)
     growth = longer / one if one > 0 else 1.0
     correlation = Check(
         "residual correlation",
@@ -195,6 +201,15 @@ def _residual_checks(residuals: TimingResiduals | None, swing: Swing, half_width
         f"the residuals' variance over {CORRELATION_SPANS} periods is {growth:.1f} times that over one",
     )
     return [harmonics, correlation]
+
+
+def _white_share(count: int, bandwidth: int) -> float:
+    """The share of an uncorrelated series' variance that ``long_run_variance`` keeps, in
+    expectation, once the series is centred on its own mean: 1 - (n + 2 sum_k (1 - k / (B + 1))
+    (n - k)) / n^2 over lags k = 1..B (B clamped as there)."""
+    lags = np.arange(1, min(bandwidth, count - 1) + 1, dtype=np.float64)
+    kept = 1.0 - (count + 2.0 * float(np.sum((1.0 - lags / (lags.size + 1)) * (count - lags)))) / count**2
+    return max(kept, 1e-12)
 
 
 def check_fit(
