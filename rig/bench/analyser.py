@@ -34,6 +34,7 @@ import analysis
 from analysis.sampling.model import commensurate
 from analysis.video.sources import open_frames
 from rig.bench.analyser_grid import Case, film_fps, impaired
+from rig.executor import executor
 from rig.service import SimulationResult, simulate
 
 TARGETS = {
@@ -272,19 +273,32 @@ def plot(summary: dict[str, dict[str, Any]], rows: list[dict[str, Any]], path: P
     figure.savefig(path, dpi=110)
 
 
-def run_bench(cases: list[Case], folder: Path, log: Log) -> dict[str, Any]:
-    """Every case, each simulation once (films that share one share it); the rows, the summaries
-    per group of cases (GROUPS) and the targets."""
-    rows = []
-    runs: dict[Any, SimulationResult] = {}
-    for index, case in enumerate(cases):
-        log(f"[{index + 1}/{len(cases)}] {case.name}")
-        key = repr(case.config)
-        if key not in runs:
-            started = time.perf_counter()
-            runs[key] = simulate(case.config, folder / f"run{len(runs):03d}", overwrite=True)
-            log(f"  simulated in {time.perf_counter() - started:.0f} s")
-        rows.append(run_case(case, runs[key], log))
+def film_and_analyse(job: tuple[Path, tuple[Case, ...], Log]) -> list[dict[str, Any]]:
+    """Simulate the film that ``cases`` share (one config) into the folder, and each case's row.
+    A job for `rig.executor`: a worker process can run it."""
+    folder, cases, log = job
+    started = time.perf_counter()
+    run = simulate(cases[0].config, folder, overwrite=True)
+    log(f"  {folder.name} simulated in {time.perf_counter() - started:.0f} s")
+    return [run_case(case, run, log) for case in cases]
+
+
+def run_bench(
+    cases: list[Case], folder: Path, log: Log, workers: int | None = None, scheduler: str | None = None
+) -> dict[str, Any]:
+    """Every case, each simulation once (cases that share a film share it), serially or on Dask
+    (`rig.executor`); the rows in the order of the cases, the summaries per group of cases
+    (GROUPS) and the targets. On Dask, speed ratios are taken with the workers sharing the cores."""
+    films: dict[str, list[int]] = {}
+    for position, case in enumerate(cases):
+        films.setdefault(repr(case.config), []).append(position)
+    jobs = [(folder / f"run{index:03d}", tuple(cases[p] for p in positions), log) for index, positions in enumerate(films.values())]
+    by_position: dict[int, dict[str, Any]] = {}
+    with executor(workers, scheduler) as run:
+        for index, film_rows in run(film_and_analyse, jobs):
+            by_position.update(zip(list(films.values())[index], film_rows))
+            log(f"[{len(by_position)}/{len(cases)} cases]")
+    rows = [by_position[position] for position in range(len(cases))]
     summaries = {
         group: summarise(chosen)
         for group, members in GROUPS.items()

@@ -36,6 +36,7 @@ import numpy as np
 from predictors import Pose
 from rig.bench.renderer_latency import LatencyRun, film_latency
 from rig.errors import ConfigError
+from rig.executor import executor
 from rig.render import gl, make_renderer
 from rig.render.direct import DirectRenderer
 from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
@@ -262,9 +263,21 @@ def warp_row(base: dict[str, Any], m: WarpMeasurement, triangles: int, size: tup
     }  # fmt: skip
 
 
-def run_bench(grid: BenchGrid, predictors: dict[str, str], runs_dir: Path, log: Log) -> list[dict[str, Any]]:
+def _film_latency(job: tuple[LatencyRun, float, float, Path]) -> dict[str, Any]:
+    return film_latency(*job)
+
+
+def run_bench(
+    grid: BenchGrid,
+    predictors: dict[str, str],
+    runs_dir: Path,
+    log: Log,
+    workers: int | None = None,
+    scheduler: str | None = None,
+) -> list[dict[str, Any]]:
     """Every row of the benchmark (see the module docstring); `predictors` names each renderer's
-    predictor in the latency runs ("direct", "warp")."""
+    predictor in the latency runs ("direct", "warp"). The timings run here, one at a time; the
+    latency films (simulate, then analyse) on `rig.executor`'s workers when asked."""
     machine = machine_name()
     log(f"machine: {machine}")
     rows: list[dict[str, Any]] = []
@@ -302,14 +315,19 @@ def run_bench(grid: BenchGrid, predictors: dict[str, str], runs_dir: Path, log: 
             if ("warp", triangles) in expected and resolution_index == 0:
                 expected["warp", triangles] = (expected["warp", triangles][0], float(np.median(m.wall_s)))
             rows += [warp_row(base, m, triangles, (width, height), ratio) for ratio in grid.ratios]
-    for (renderer, triangles), (app_s, server_s) in expected.items():
-        started = time.perf_counter()
-        spec = grid.warp if renderer == "warp" else renderer
-        figures = film_latency(grid.latency_run(spec, triangles, predictors[renderer]), app_s, server_s, runs_dir / f"{renderer}-{triangles}")
-        measured = figures["latency_measured_ms"]
-        shown = f"{measured:.1f} ms measured, {figures['latency_true_ms']:.1f} ms true" if measured is not None else figures["latency_note"]
-        log(f"latency {renderer:6} {triangles:>9} triangles: {shown} ({time.perf_counter() - started:.0f} s)")
-        for row in rows:
-            if (row["renderer"], row["triangles"], (row["width"], row["height"])) == (renderer, triangles, grid.resolutions[0]):
-                row.update({name: figures[name] for name in LATENCY_FIELDS})
+    films = list(expected.items())
+    jobs = [
+        (grid.latency_run(grid.warp if renderer == "warp" else renderer, triangles, predictors[renderer]), app_s, server_s,
+         runs_dir / f"{renderer}-{triangles}")
+        for (renderer, triangles), (app_s, server_s) in films
+    ]  # fmt: skip
+    with executor(workers, scheduler) as run:
+        for index, figures in run(_film_latency, jobs):
+            (renderer, triangles), _ = films[index]
+            measured = figures["latency_measured_ms"]
+            shown = f"{measured:.1f} ms measured, {figures['latency_true_ms']:.1f} ms true" if measured is not None else figures["latency_note"]
+            log(f"latency {renderer:6} {triangles:>9} triangles: {shown}")
+            for row in rows:
+                if (row["renderer"], row["triangles"], (row["width"], row["height"])) == (renderer, triangles, grid.resolutions[0]):
+                    row.update({name: figures[name] for name in LATENCY_FIELDS})
     return rows

@@ -155,8 +155,7 @@ def add_batch_options(parser: argparse.ArgumentParser) -> None:
         "goes on), written as each finishes. Exit status 3 when any video failed or came with warnings.",
     )
     batch.add_argument("--summary", type=Path, metavar="FILE.csv", help="write the rows here, the same as JSON and a plot beside it")
-    batch.add_argument("--workers", type=options.positive_int, metavar="N", help="analyse on a local Dask cluster of N processes")
-    batch.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="analyse on an existing Dask cluster (its workers must reach the videos)")
+    options.add_executor_options(batch, "the batch")
     batch.add_argument(
         "--labels",
         type=Path,

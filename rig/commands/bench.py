@@ -59,7 +59,7 @@ def _run_analyser(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="rig-bench-analyser-") as scratch:
         folder = args.runs if args.runs is not None else Path(scratch)
-        report = analyser.run_bench(cases, folder, _log)
+        report = analyser.run_bench(cases, folder, _log, args.workers, args.scheduler)
     report["seconds"] = time.perf_counter() - started
     if args.json is not None:
         _write_json(args.json, report)
@@ -92,6 +92,7 @@ def _add_analyser(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--grid", choices=("all", "mixed", "hard"), default="all", help="which grid to run (default: %(default)s)")
     parser.add_argument("--cases", type=options.positive_int, default=analyser_grid.DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
     parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the simulated videos here (default: a temporary folder)")
+    options.add_executor_options(parser, "the grid")
     parser.set_defaults(func=_run_analyser)
 
 

@@ -114,7 +114,9 @@ def _run(args: argparse.Namespace) -> int:
             rows, text = _photon_residual(args, runs)
         else:
             predictor = args.predictor
-            rows = renderers.run_bench(_grid(args), {"direct": args.direct_predictor or predictor, "warp": predictor}, runs, _log)
+            rows = renderers.run_bench(
+                _grid(args), {"direct": args.direct_predictor or predictor, "warp": predictor}, runs, _log, args.workers, args.scheduler
+            )
             if args.plot is not None:
                 renderer_plots.plot_rows(rows, args.plot)
             text = renderer_report.table(rows)
@@ -158,4 +160,5 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--max-frame-s", type=options.positive_float, default=seed_table.SeedTableSpec().max_frame_s, help="--seed-table: the largest direct frame, in seconds, a scene may take (default: %(default)s)")
     parser.add_argument("--max-triangles", type=options.positive_int, metavar="N", help="--seed-table: the largest load (default: 20000000, 720 MB and the GL driver's copy)")
     parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the latency runs' videos here (default: a temporary folder)")
+    options.add_executor_options(parser, "the latency films")
     parser.set_defaults(func=_run)

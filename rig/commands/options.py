@@ -99,3 +99,9 @@ def app_frame_cost(text: str) -> float | None:
     if text == "measured":
         return None
     return positive_float(text)
+
+
+def add_executor_options(parser: argparse.ArgumentParser, what: str) -> None:
+    """--workers and --scheduler: where `what` runs (`rig.executor`; neither: here, serially)."""
+    parser.add_argument("--workers", type=positive_int, metavar="N", help=f"run {what} on a local Dask cluster of N processes")
+    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT", help=f"run {what} on an existing Dask cluster (its workers must reach the files)")

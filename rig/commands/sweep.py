@@ -36,7 +36,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("spec", type=Path, metavar="SPEC.toml", help="the sweep")
     parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="folder for the runs and the summary")
-    parser.add_argument("--workers", type=options.positive_int, help="run on a local Dask cluster of this many processes")
-    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on an existing Dask scheduler")
+    options.add_executor_options(parser, "the points")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON")
     parser.set_defaults(func=_run)

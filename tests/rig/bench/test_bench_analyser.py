@@ -99,3 +99,17 @@ def test_confidently_wrong_is_outside_by_more_than_half_a_millisecond_and_the_ha
     truth: float, latency: float, ci: tuple[float, float] | None, wrong: bool
 ) -> None:
     assert analyser.confidently_wrong(truth, latency, ci) is wrong
+
+
+def test_cases_that_share_a_film_simulate_it_once_and_rows_keep_the_cases_order(monkeypatch, tmp_path: Path) -> None:
+    cases = analyser_grid.quick_grid()
+    cases = [cases[0], cases[1], cases[0], cases[2], cases[1]]
+    simulated: list[Path] = []
+    monkeypatch.setattr(analyser, "simulate", lambda config, folder, overwrite: simulated.append(folder) or config)
+    monkeypatch.setattr(analyser, "run_case", lambda case, run, log: {"case": case.name, "film": repr(run), "group": case.group})
+    monkeypatch.setattr(analyser, "summarise", lambda rows: {})
+    monkeypatch.setattr(analyser, "targets_met", lambda summaries: {})
+    report = analyser.run_bench(cases, tmp_path, lambda message: None)
+    assert len(simulated) == len({repr(case.config) for case in cases})
+    assert [row["case"] for row in report["cases"]] == [case.name for case in cases]
+    assert [row["film"] for row in report["cases"]] == [repr(case.config) for case in cases]
