@@ -80,7 +80,7 @@ def _auto_models(images: Sequence[np.ndarray], led_side: str | None, warnings: l
         raise AnalysisError(
             f"found {len(regions)} moving bright region(s) in the first {len(images)} frames, expected 2 "
             "(the LED and the sphere); check that both are in view and swinging, "
-            "or give led_roi and sphere_roi"
+            "or give both regions (--led-roi and --sphere-roi)"
         )
     if len(regions) > 2:
         warnings.append(

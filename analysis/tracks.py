@@ -237,7 +237,7 @@ def _rois(
     video: FrameSource, led_roi: Sequence[float] | None, sphere_roi: Sequence[float] | None
 ) -> tuple[Roi, Roi] | None:
     if (led_roi is None) != (sphere_roi is None):
-        raise AnalysisError("give both led_roi and sphere_roi, or neither to find them automatically")
+        raise AnalysisError("give both regions, the LED's and the sphere's (--led-roi and --sphere-roi), or neither to find them automatically")
     if led_roi is None or sphere_roi is None:
         return None
     return Roi.parse(led_roi, video.frame_size, "LED"), Roi.parse(sphere_roi, video.frame_size, "sphere")

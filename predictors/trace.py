@@ -211,7 +211,7 @@ def _checked(name: str, t: np.ndarray, position: np.ndarray, orientation: np.nda
         row = int(np.argmax(bad))
         raise PredictorError(
             f"trace {name!r}, sample {row}: every value must be finite and the quaternion of unit norm "
-            f"(within {_NORM_TOLERANCE:g}), got t={t[row]!r}, norm {norm[row]!r}"
+            f"(within {_NORM_TOLERANCE:g}), got t={float(t[row])!r}, norm {float(norm[row])!r}"
         )
     return t, position, orientation / norm[:, None]
 

@@ -16,10 +16,11 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import signal
 import sys
 from types import FrameType
-from typing import Sequence
+from typing import NoReturn, Sequence
 
 from rig.compile_cache import keep_compiled_fits
 from rig.errors import RigError
@@ -51,6 +52,32 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM, handled as an interrupt: the command stops, keeping what it recorded."""
 
 
+class ListingFormatter(argparse.HelpFormatter):
+    """Wraps help text as argparse does, except a paragraph that lists choices (lines indented by
+    two spaces after its title), which keeps a line per choice."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        return "\n\n".join(
+            part if "\n  " in part else super(ListingFormatter, self)._fill_text(part, width, indent)
+            for part in text.split("\n\n")
+        )
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """The rig's parser: help that lists choices a line each, and a usage error in one line (the
+    option as typed, what was wrong, where the help is), exit status 2."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        kwargs.setdefault("formatter_class", ListingFormatter)
+        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+
+    def error(self, message: str) -> NoReturn:
+        option = re.match(r"argument (--[\w-]+).*: expected one argument", message)
+        if option is not None:
+            message += f" (write a value that starts with '-' as {option[1]}=VALUE)"
+        self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message}; see {self.prog} --help\n")
+
+
 def user_errors() -> tuple[type[Exception], ...]:
     """The error types a user can cause: the rig's and its two libraries'."""
     from analysis.errors import AnalysisError
@@ -62,7 +89,7 @@ def user_errors() -> tuple[type[Exception], ...]:
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The whole command line; or, when `argv` names a command, that command alone, so that a
     command starts without importing every other command's libraries."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="rig",
         description="Measure motion-to-photon latency with a pendulum, an LED and a camera; simulate the rig.",
     )

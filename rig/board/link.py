@@ -133,8 +133,9 @@ class SerialLink:
                 continue
             try:
                 data = port.read(max(1, port.in_waiting))
-            except (serial.SerialException, OSError, TypeError) as error:
-                # pyserial raises TypeError when close() takes the port away in the middle of a read.
+            except (serial.SerialException, OSError, TypeError, AttributeError) as error:
+                # pyserial raises TypeError (AttributeError for socket://) when close() takes the port
+                # away in the middle of a read.
                 if not self._stop.is_set():
                     self._lost(str(error))
                 continue

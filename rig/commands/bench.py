@@ -19,7 +19,7 @@ import predictors
 from predictors import read_trace
 from rig.bench import analyser, analyser_grid, batch
 from rig.bench import predictors as predictor_bench
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.commands.bench_live import add_live
 from rig.commands.bench_renderers import add_renderers
 from rig.errors import ConfigError, RigError
@@ -61,16 +61,18 @@ def _run_analyser(args: argparse.Namespace) -> int:
         folder = args.runs if args.runs is not None else Path(scratch)
         report = analyser.run_bench(cases, folder, _log, args.workers, args.scheduler)
     report["seconds"] = time.perf_counter() - started
+    writes = outputs.LateWrites()
     if args.json is not None:
-        _write_json(args.json, report)
+        writes.json(args.json, report)
     if args.plot is not None:
-        _plot(lambda: analyser.plot(report["summary"], report["cases"], args.plot), args.plot)
+        writes.write(args.plot, lambda: analyser.plot(report["summary"], report["cases"], args.plot))
     for group, summary in report["summaries"].items():
         print(f"{group} ({summary['sinefit']['cases']} cases):")
         print(analyser.table(summary))
     for target, met in report["targets_met"].items():
         print(f"{target}: {'met' if met else 'not met' if met is not None else 'n/a'}")
     print(f"{len(cases)} cases in {report['seconds'] / 60:.1f} minutes")
+    writes.check()
     return 0
 
 
@@ -86,12 +88,12 @@ def _add_analyser(benchmarks: argparse._SubParsersAction) -> None:
         "exposures, a dim LED or sphere, swapped sides, a second bright object, a partly hidden blob, decimated "
         "films. Both take about forty minutes on two cores; --quick runs three tiny cases.",
     )
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the summaries and every case as JSON")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot speed against error per method")
+    parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the summaries and every case as JSON")
+    parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="plot speed against error per method")
     parser.add_argument("--quick", action="store_true", help="three short cases (a smoke test)")
     parser.add_argument("--grid", choices=("all", "mixed", "hard"), default="all", help="which grid to run (default: %(default)s)")
     parser.add_argument("--cases", type=options.positive_int, default=analyser_grid.DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
-    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the simulated videos here (default: a temporary folder)")
+    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the simulated videos here (default: a temporary folder)")
     options.add_executor_options(parser, "the grid")
     parser.set_defaults(func=_run_analyser)
 
@@ -144,8 +146,9 @@ def _run_predictors(args: argparse.Namespace) -> int:
     if held:
         print(f"\nleave one trace out: tuned at {args.plot_horizon_ms:g} ms on the others, RMS error / constant velocity on the one held out:")
         print(predictor_bench.held_out_table(held))
+    writes = outputs.LateWrites()
     if args.json:
-        _write_json(args.json, {
+        writes.json(args.json, {
             "horizons_ms": list(horizons),
             "baseline": predictor_bench.BASELINE,
             "kalman_cv_over_desp_cost": costs,
@@ -154,7 +157,8 @@ def _run_predictors(args: argparse.Namespace) -> int:
             "results": [r.to_dict() for r in results],
         })
     if args.plot:
-        _plot(lambda: predictor_bench.plot(results, args.plot_horizon_ms, args.plot), args.plot)
+        writes.write(args.plot, lambda: predictor_bench.plot(results, args.plot_horizon_ms, args.plot))
+    writes.check()
     return 0
 
 
@@ -194,8 +198,8 @@ def _add_predictors(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the simulated traces (default: %(default)s)")
     parser.add_argument("--timing-repeats", type=options.non_negative_int, default=3,
                         help="timed replays per predictor and trace; the best counts (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write every score, ratio and held-out result as JSON")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="draw speed against error")
+    parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write every score, ratio and held-out result as JSON")
+    parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="draw speed against error")
     parser.set_defaults(func=_run_predictors)
 
 
@@ -241,15 +245,17 @@ def _run_trackers(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory(prefix="rig-bench-trackers-") as scratch:
         folder = args.runs if args.runs is not None else Path(scratch)
         report = trackers.run_bench(args.rate, duration, folder, _log)
+    writes = outputs.LateWrites()
     if args.json is not None:
-        _write_json(args.json, report["rows"])
+        writes.json(args.json, report["rows"])
     if args.plot is not None:
-        _plot(lambda: trackers.plot(report["rows"], args.plot), args.plot)
+        writes.write(args.plot, lambda: trackers.plot(report["rows"], args.plot))
     print(trackers.table(report["rows"]))
     for target, met in report["targets_met"].items():
         print(f"{target}: {'met' if met else 'not met'}")
     loads = [row["load_average_1min"] for row in report["rows"]]
     print(f"machine noise: {os.cpu_count()} CPUs, 1-minute load average {min(loads):.2f} to {max(loads):.2f} over the cases")
+    writes.check()
     return 0
 
 
@@ -262,12 +268,12 @@ def _add_trackers(benchmarks: argparse._SubParsersAction) -> None:
         "tracker source as `rig record-tracker` does, and report per case what was sent, recorded, missing, fabricated "
         "and counted corrupt, the CPU per sample, and the latency from the emulator's write to the recording loop.",
     )
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the rows as a JSON list")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot CPU per sample and latency per case")
+    parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the rows as a JSON list")
+    parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="plot CPU per sample and latency per case")
     parser.add_argument("--rate", type=options.positive_float, default=1000.0, help="records a second (default: %(default)s)")
     parser.add_argument("--duration", type=options.positive_float, default=10.0, help="seconds per case (default: %(default)s)")
     parser.add_argument("--quick", action="store_true", help="2 s per case (a smoke test)")
-    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the recordings and emulator logs here (default: a temporary folder)")
+    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the recordings and emulator logs here (default: a temporary folder)")
     parser.set_defaults(func=_run_trackers)
 
 

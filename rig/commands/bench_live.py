@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tempfile
 from pathlib import Path
 
-from rig.commands import options
+from rig.commands import options, outputs
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -17,12 +16,14 @@ def _run(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory(prefix="rig-bench-live-") as scratch:
         folder = args.runs if args.runs is not None else Path(scratch)
         report = live.run_bench(args.duration, folder, lambda message: print(message, file=sys.stderr, flush=True))
-        if args.json is not None:
-            args.json.write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
-        if args.plot is not None:
-            live.plot(report, args.plot)
+    writes = outputs.LateWrites()
+    if args.json is not None:
+        writes.json(args.json, report)
+    if args.plot is not None:
+        writes.write(args.plot, lambda: live.plot(report, args.plot))
     print(live.table(report))
     print(f"machine noise: {report['cpus']} CPUs, 1-minute load average {report['load_average_1min']:.2f}")
+    writes.check()
     return 0
 
 
@@ -36,7 +37,7 @@ def add_live(benchmarks: argparse._SubParsersAction) -> None:
         "to its logged row.",
     )
     parser.add_argument("--duration", type=options.positive_float, default=10.0, help="seconds of live run (default: %(default)s)")
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the figures as JSON")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot the figures")
-    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the run's files here (default: a temporary folder)")
+    parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the figures as JSON")
+    parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="plot the figures")
+    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the run's files here (default: a temporary folder)")
     parser.set_defaults(func=_run)

@@ -19,8 +19,7 @@ from typing import Iterator
 
 from rig.bench import photon_residual, renderer_plots, renderer_report, renderers, seed_table, warp_variants
 from rig.bench.renderers import QUICK_GRID, BenchGrid
-from rig.commands import options
-from rig.errors import ConfigError
+from rig.commands import options, outputs
 
 
 def _log(message: str) -> None:
@@ -102,9 +101,7 @@ def _photon_residual(args: argparse.Namespace, runs: Path) -> tuple[list[dict], 
 
 
 def _run(args: argparse.Namespace) -> int:
-    for path in (args.json, args.csv, args.plot):
-        if path is not None and not path.parent.exists():
-            raise ConfigError(f"cannot write {path}: folder {path.parent} does not exist")
+    writes = outputs.LateWrites()
     with _runs_folder(args.runs) as runs:
         if args.seed_table:
             rows, text = _seed_table(args, runs)
@@ -118,13 +115,14 @@ def _run(args: argparse.Namespace) -> int:
                 _grid(args), {"direct": args.direct_predictor or predictor, "warp": predictor}, runs, _log, args.workers, args.scheduler
             )
             if args.plot is not None:
-                renderer_plots.plot_rows(rows, args.plot)
+                writes.write(args.plot, lambda: renderer_plots.plot_rows(rows, args.plot))
             text = renderer_report.table(rows)
     if args.json is not None:
-        renderer_report.write_json(rows, args.json)
+        writes.write(args.json, lambda: renderer_report.write_json(rows, args.json))
     if args.csv is not None:
-        renderer_report.write_csv(rows, args.csv)
+        writes.write(args.csv, lambda: renderer_report.write_csv(rows, args.csv))
     print(text)
+    writes.check()
     return 0
 
 
@@ -144,9 +142,9 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     mode.add_argument("--seed-table", action="store_true", help="the seeds' Table 2 beside this machine's (see rig.bench.seed_table)")
     mode.add_argument("--variants", action="store_true", help="image error against latency saved for each warp variant and scene")
     mode.add_argument("--photon-residual", action="store_true", help="latency left by each predictor aimed at the photons and at scan-out")
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the rows as a JSON list")
-    parser.add_argument("--csv", type=Path, metavar="OUT", help="write the rows as CSV")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="plot the run (latency against N, error against latency saved, ...)")
+    parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the rows as a JSON list")
+    parser.add_argument("--csv", type=outputs.csv_file, metavar="OUT.csv", help="write the rows as CSV")
+    parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="plot the run (latency against N, error against latency saved, ...)")
     parser.add_argument("--quick", action="store_true", help="a tiny run (a smoke test, seconds not minutes)")
     parser.add_argument("--triangles", type=_int_list, metavar="N,N,...", help="load sizes (default 10000,100000,1000000,5000000; --variants 10000,200000)")
     parser.add_argument("--resolutions", type=_resolution_list, metavar="WxH,...", help="display sizes; the first is the latency runs' (default 320x240,640x480,1280x720)")
@@ -159,6 +157,6 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--server-ms", type=options.positive_float, metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
     parser.add_argument("--max-frame-s", type=options.positive_float, default=seed_table.SeedTableSpec().max_frame_s, help="--seed-table: the largest direct frame, in seconds, a scene may take (default: %(default)s)")
     parser.add_argument("--max-triangles", type=options.positive_int, metavar="N", help="--seed-table: the largest load (default: 20000000, 720 MB and the GL driver's copy)")
-    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the latency runs' videos here (default: a temporary folder)")
+    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the latency runs' videos here (default: a temporary folder)")
     options.add_executor_options(parser, "the latency films")
     parser.set_defaults(func=_run)

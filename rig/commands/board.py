@@ -28,6 +28,7 @@ from analysis.board.photodiode_latency import estimate_from_recording, plot_boar
 from rig.board.clock_sync import OffsetInterval
 from rig.board.microcontroller import Microcontroller
 from rig.board.recording import BoardRecorder
+from rig.commands import outputs
 from rig.commands.options import non_negative_float, non_negative_int, positive_float
 from rig.errors import RigError
 from rig.progress import ProgressBar
@@ -64,7 +65,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
     record = commands.add_parser("record", help="record encoder, photodiode and LED events as CSV files")
     _add_port(record)
-    record.add_argument("--out", type=Path, required=True, help="folder for the CSV files (must not hold a recording)")
+    record.add_argument("--out", type=outputs.output_folder, required=True, help="folder for the CSV files (must not hold a recording)")
     record.add_argument("--duration", type=positive_float, required=True, help="seconds to record")
     record.add_argument("--encoder-rate", type=non_negative_float, default=0.0, help="encoder reports per second; 0 (default) reports every edge")
     record.add_argument("--rise", type=non_negative_int, default=DEFAULT_RISE, help=f"photodiode rising threshold, ADC counts (default {DEFAULT_RISE})")
@@ -83,7 +84,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     blink = commands.add_parser("blink", help="play the LED blink code, to align a camera's video to the board's clock")
     _add_port(blink)
     _add_blink_options(blink)
-    blink.add_argument("--out", type=Path, help="also record the LED changes (led.csv) and the schedule (blink.json) here")
+    blink.add_argument("--out", type=outputs.output_folder, help="also record the LED changes (led.csv) and the schedule (blink.json) here")
     blink.add_argument("--json", action="store_true", help="print the schedule as one JSON object")
     blink.set_defaults(func=run_blink)
 
@@ -91,7 +92,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     latency.add_argument("recording", type=Path, help="a `rig board record` folder")
     latency.add_argument("--max-latency-ms", type=positive_float, help="largest latency to consider (default 0.45 pendulum periods)")
     latency.add_argument("--json", action="store_true", help="print one JSON object")
-    latency.add_argument("--plot", type=Path, help="also draw the fit into this PNG file")
+    latency.add_argument("--plot", type=outputs.plot_file, help="also draw the fit into this PNG file")
     latency.set_defaults(func=run_latency)
 
 

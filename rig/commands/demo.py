@@ -10,6 +10,7 @@ import argparse
 import json
 from pathlib import Path
 
+from rig.commands import outputs
 from rig.commands.formatting import summary_line
 from rig.commands.simulation_options import add_simulation_options, config_from_args
 from rig.progress import ProgressBar
@@ -84,7 +85,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "analyse the video it writes, and print the measured latency beside the true one. "
         f"Exits with {EXIT_MISMATCH} if they differ by more than {AGREEMENT_MS:g} ms.",
     )
-    parser.add_argument("--out", type=Path, default=Path("out/demo"), metavar="DIR", help="output folder (default: %(default)s)")
+    parser.add_argument("--out", type=outputs.output_folder, default="out/demo", metavar="DIR", help="output folder (default: %(default)s)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument(
         "--compare",

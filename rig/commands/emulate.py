@@ -16,7 +16,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.emulate import EmulatorConfig, make_sink, run_emulator
 from rig.emulate.faults import FaultPlan, parse_faults
 from rig.errors import ConfigError
@@ -68,7 +68,7 @@ def _common(parser: argparse.ArgumentParser) -> None:
                         help="faults such as corrupt=0.01,drop=0.001,garbage=2,burst=8,stall=3:0.5,disconnect=5:0.5 "
                         "(default: none)")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="seed of the faults (default: %(default)s)")
-    parser.add_argument("--log", type=Path, metavar="FILE.csv", help="write every record's seq, device time, write time and fate")
+    parser.add_argument("--log", type=outputs.csv_file, metavar="FILE.csv", help="write every record's seq, device time, write time and fate")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     parser.set_defaults(func=_run)
 

@@ -22,7 +22,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.commands.record import CAMERA_SPECS, add_camera_options
 from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
@@ -156,7 +156,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-lsl", action="store_true", help="publish nothing on LSL (the rig's own renderer only)")
     parser.add_argument("--guided", action="store_true", help="say what to do and check the first seconds of video first")
     parser.add_argument("--self-test", action="store_true", help="run the whole chain with stand-ins under an X display (xvfb-run)")
-    parser.add_argument("--out", type=Path, metavar="DIR", help="folder for the run, the video and the results")
+    parser.add_argument("--out", type=outputs.output_folder, metavar="DIR", help="folder for the run, the video and the results")
     parser.add_argument("--overwrite", action="store_true", help="replace a run already in DIR")
     parser.add_argument("--json", action="store_true", help="print the results as one JSON object")
     add_camera_options(parser)

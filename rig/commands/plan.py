@@ -11,9 +11,9 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 
-from rig.commands import options
+from rig.commands import options, outputs
+from rig.commands.simulation_options import amplitude_deg
 from rig.service import Plan, PlanRequest, plan
 from rig.sim.pendulum import PendulumConfig
 
@@ -98,11 +98,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--period-s", type=options.positive_float, default=1.0, help="the pendulum's period (default: %(default)s)")
     parser.add_argument(
-        "--amplitude-deg", type=options.positive_float, default=PendulumConfig().amplitude_deg, help="its swing (default: %(default)s)"
+        "--amplitude-deg", type=amplitude_deg, default=PendulumConfig().amplitude_deg, help="its swing (default: %(default)s)"
     )
     parser.add_argument(
         "--accuracy-ms", type=options.positive_float, default=1.0, help="the 95%% half-width wanted, in ms (default: %(default)s)"
     )
-    parser.add_argument("--runs", type=Path, metavar="DIR", help="keep the simulated films here (default: a temporary folder)")
+    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the simulated films here (default: a temporary folder)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=_run)

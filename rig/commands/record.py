@@ -10,9 +10,8 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.live.record import record_camera
 from rig.progress import ProgressBar
 
@@ -65,7 +64,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--camera", required=True, metavar="SPEC", help=f"the camera: {CAMERA_SPECS}")
     parser.add_argument("--duration", type=options.positive_float, required=True, metavar="S", help="seconds to film")
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="folder to write the video and frame table into")
+    parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder to write the video and frame table into")
     parser.add_argument("--preview", action="store_true", help="show the camera's frames with both regions of interest")
     parser.add_argument("--overwrite", action="store_true", help="replace a recording already in DIR")
     parser.add_argument("--json", action="store_true", help="print camera.json as one JSON object")

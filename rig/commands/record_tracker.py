@@ -10,9 +10,8 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.progress import ProgressBar
 from rig.service.record import record_tracker
 
@@ -58,7 +57,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--tracker", required=True, metavar="SPEC", help=f"the tracker: {SPECS}")
     parser.add_argument("--duration", type=options.positive_float, metavar="S", help="seconds to record (default: until Ctrl-C)")
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="folder to write tracker.csv and its sidecar into")
+    parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder to write tracker.csv and its sidecar into")
     parser.add_argument("--overwrite", action="store_true", help="replace a recording already in DIR")
     parser.add_argument("--json", action="store_true", help="print the sidecar as one JSON object")
     parser.set_defaults(func=_run)

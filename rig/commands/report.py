@@ -5,15 +5,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from rig.commands import outputs
 from rig.errors import ConfigError
-from rig.service.report import check_report_path, run_report, summary_report, write_report
+from rig.service.report import run_report, summary_report, write_report
 
 SUMMARY_SUFFIXES = (".csv", ".json")
 
 
 def _run(args: argparse.Namespace) -> int:
     source: Path = args.source
-    check_report_path(args.out)
+    outputs.checked(outputs.output_file(".html"), args.out, "--out")
     if not source.exists():
         raise ConfigError(f"{source} does not exist; give a video, a run folder or a summary (.csv or .json)")
     if source.is_file() and source.suffix.lower() in SUMMARY_SUFFIXES:

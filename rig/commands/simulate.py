@@ -4,16 +4,20 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
+from rig.commands import outputs
 from rig.commands.simulation_options import add_lab_options, add_simulation_options, config_from_args, with_lab_options
 from rig.progress import ProgressBar
 from rig.service import simulate
+from rig.service.run_plot import plot_run
 from rig.sim.board import BOARD_FOLDER
 
 
 def _run(args: argparse.Namespace) -> int:
     result = simulate(with_lab_options(config_from_args(args), args), args.out, ProgressBar("simulating"), args.overwrite)
+    writes = outputs.LateWrites()
+    if args.plot is not None:
+        writes.write(args.plot, lambda: plot_run(result.out_dir, result.truth.latency_ms, args.plot))
     if args.json:
         print(json.dumps(result.summary()))
     else:
@@ -25,6 +29,9 @@ def _run(args: argparse.Namespace) -> int:
             f"{d.mean:.2f} +/- {d.sd:.2f} ms)"
         )
         print(result.cost_line())
+        if args.plot is not None and not writes.failed:
+            print(f"plot of the tracked, predicted and displayed sphere and the delay per refresh: {args.plot}")
+    writes.check()
     return 0
 
 
@@ -36,9 +43,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "Writes DIR/video.avi, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and DIR/display_frames.csv, "
         f"and with --board the board's recording in DIR/{BOARD_FOLDER}/.",
     )
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
+    parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="output folder")
     parser.add_argument("--overwrite", action="store_true", help="replace a run already in DIR")
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
+    parser.add_argument(
+        "--plot",
+        type=outputs.plot_file,
+        metavar="FILE.png",
+        help="plot the run's truth: the sphere as tracked, predicted and displayed, and each refresh's delay from "
+        "the newest sample to its photons beside the true latency",
+    )
     add_simulation_options(parser)
     add_lab_options(parser)
     parser.set_defaults(func=_run)

@@ -14,7 +14,7 @@ from rig.session import PHOTON_TARGETS
 from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
-from rig.sim.pendulum import PendulumConfig
+from rig.sim.pendulum import MAX_AMPLITUDE_DEG, PendulumConfig
 from rig.sim.tracker import TrackerConfig
 
 
@@ -92,8 +92,16 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
         help="fixed tracker-to-host delay (default: %(default)s)",
     )
     group.add_argument("--period-s", type=options.positive_float, default=PendulumConfig().period_s, help="pendulum period (default: %(default)s)")
-    group.add_argument("--amplitude-deg", type=options.positive_float, default=PendulumConfig().amplitude_deg, help="swing amplitude, up to 45 (default: %(default)s)")
+    group.add_argument("--amplitude-deg", type=amplitude_deg, default=PendulumConfig().amplitude_deg, help="swing amplitude, up to 45 (default: %(default)s)")
     group.add_argument("--quality", type=options.positive_float, default=PendulumConfig().quality, help="pendulum quality factor Q (default: %(default)s)")
+
+
+def amplitude_deg(text: str) -> float:
+    """A pendulum's swing in degrees, as far as the simulated pendulum goes."""
+    value = options.positive_float(text)
+    if value > MAX_AMPLITUDE_DEG:
+        raise argparse.ArgumentTypeError(f"a swing is at most {MAX_AMPLITUDE_DEG:g} degrees, got {text}")
+    return value
 
 
 def _exposure_fraction(text: str) -> float:

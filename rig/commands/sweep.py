@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.progress import ProgressBar
 from rig.service.sweep import read_sweep, run_sweep
 
@@ -35,7 +35,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "as it finishes, with the truth and the error beside the measured latency.",
     )
     parser.add_argument("spec", type=Path, metavar="SPEC.toml", help="the sweep")
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="folder for the runs and the summary")
+    parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder for the runs and the summary")
     options.add_executor_options(parser, "the points")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON")
     parser.set_defaults(func=_run)

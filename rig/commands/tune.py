@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 from predictors import Trace, read_trace
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.progress import ProgressBar
 from rig.service import TuneReport, split_traces, tune
 from rig.service.tune import PARTS, in_time_order
@@ -62,15 +62,18 @@ def _run(args: argparse.Namespace) -> int:
     say(f"fitted {fitted}; training loss {fit.loss_before:.4g} -> {fit.loss_after:.4g} in {fit.iterations} iterations")
     say(_table(report))
     say(f"validation error of the tuned parameters over the defaults': {report.validation_loss:.4f} (the tuning loss; below 1 is better)")
-    written = report.beats_defaults or args.force
-    if written:
-        report.write(args.out)
-        say(f"wrote {args.out}" + ("" if report.beats_defaults else " (--force: they lose to the defaults on validation)"))
+    writes = outputs.LateWrites()
+    if report.beats_defaults or args.force:
+        writes.write(args.out, lambda: report.write(args.out))
+        if not writes.failed:
+            say(f"wrote {args.out}" + ("" if report.beats_defaults else " (--force: they lose to the defaults on validation)"))
     else:
         say(f"not written: the tuned parameters predict the validation part worse than {name}'s defaults; "
             "keep the defaults, tune on more motion, or pass --force to write them anyway")
+    written = (report.beats_defaults or args.force) and not writes.failed
     if args.json:
         print(json.dumps({**report.to_dict(), "out": str(args.out), "written": written}))
+    writes.check()
     return 0 if written else EXIT_NOT_WRITTEN
 
 
@@ -94,7 +97,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         help="prediction horizon after each sample's arrival to tune for")
     parser.add_argument("--max-iterations", type=options.non_negative_int, default=40,
                         help="optimiser iterations at most (default: %(default)s)")
-    parser.add_argument("--out", type=Path, required=True, metavar="FILE.json", help="parameter file to write")
+    parser.add_argument("--out", type=outputs.json_file, required=True, metavar="FILE.json", help="parameter file to write")
     parser.add_argument("--force", action="store_true", help="write the parameters even if they lose to the defaults on validation")
     parser.add_argument("--repair", action="store_true",
                         help="sort a trace that is out of time order and drop repeated times, instead of refusing it")

@@ -137,13 +137,15 @@ def read_summary(path: Path) -> list[dict[str, Any]]:
             return json.loads(path.read_text())["rows"]
         with open(path, newline="", encoding="utf-8") as stream:
             rows = list(csv.DictReader(stream))
+        if not isinstance(rows, list) or not all(isinstance(row, dict) and "video" in row for row in rows):
+            raise ValueError("every row needs a video column, as `rig analyse --summary` and `rig sweep` write")
+        numeric = ("latency_ms", "ci95_low_ms", "ci95_high_ms", "period_s", "frequency_hz", "seconds")
+        for row in rows:
+            for key in numeric:
+                if key in row:
+                    row[key] = float(row[key]) if row[key] not in ("", None) else None
     except (OSError, ValueError, KeyError, TypeError) as error:
         raise ConfigError(f"cannot read the summary {path}: {error}") from None
-    numeric = ("latency_ms", "ci95_low_ms", "ci95_high_ms", "period_s", "frequency_hz", "seconds")
-    for row in rows:
-        for key in numeric:
-            if key in row:
-                row[key] = float(row[key]) if row[key] not in ("", None) else None
     return rows
 
 

@@ -81,6 +81,15 @@ def _merged(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, 
     return {**_dotted(base), **_dotted(overrides)}
 
 
+def _checked_number(field: dataclasses.Field, value: Any, prefix: str) -> Any:
+    """`value`, unless the field holds a number and the sweep gives it something else."""
+    declared = str(field.type).split(" | ")
+    number = declared[0] in ("float", "int") and not isinstance(value, bool) and isinstance(value, (int, float))
+    if declared[0] in ("float", "int") and not number and not (value is None and "None" in declared):
+        raise ConfigError(f"the sweep sets {prefix}{field.name} to {value!r}; it takes a number")
+    return value
+
+
 def build(kind: type, settings: Mapping[str, Any], prefix: str = "") -> Any:
     """A config dataclass from dotted settings (`camera.fps`), every key checked against its fields."""
     fields = {f.name: f for f in dataclasses.fields(kind)}
@@ -93,7 +102,7 @@ def build(kind: type, settings: Mapping[str, Any], prefix: str = "") -> Any:
         if rest:
             nested.setdefault(head, {})[rest] = value
         else:
-            direct[head] = value
+            direct[head] = _checked_number(fields[head], value, prefix)
     for head, values in nested.items():
         default = getattr(kind(), head) if head not in _NESTED else None
         if isinstance(default, dict):

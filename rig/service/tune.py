@@ -47,8 +47,8 @@ def in_time_order(trace: Trace, repair: bool) -> tuple[Trace, str | None]:
     what = f"{backward} sample(s) earlier than the one before and {repeated} at the same time as the one before"
     if not repair:
         raise ConfigError(
-            f"trace {trace.name!r} is not in time order: {what} (first: sample {first}, t={trace.t[first]!r} s after "
-            f"{trace.t[first - 1]!r} s); sort it by time and drop repeated times, or pass --repair"
+            f"trace {trace.name!r} is not in time order: {what} (first: sample {first}, t={trace.t[first]:.9g} s after "
+            f"{trace.t[first - 1]:.9g} s); sort it by time and drop repeated times, or pass --repair"
         )
     repaired = trace.in_time_order()
     return repaired, f"{trace.name}: {what}; sorted by time, {len(trace) - len(repaired)} repeated time(s) dropped"
