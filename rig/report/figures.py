@@ -128,14 +128,24 @@ def summary_figure(rows: Sequence[dict[str, Any]], group: str | None) -> Figure:
         against = axes[1]
         for colour_index, (name, members) in enumerate(sorted(groups.items())):
             points = [rows[i] for i in members if rows[i].get("latency_ms") is not None]
-            against.plot([p["frequency_hz"] for p in points], [p["latency_ms"] for p in points], "o",
-                         color=f"C{colour_index}", label=name or None)  # fmt: skip
+            against.errorbar([p["frequency_hz"] for p in points], [p["latency_ms"] for p in points], yerr=_interval_bars(points),
+                             fmt="o", capsize=3, color=f"C{colour_index}", label=name or None)  # fmt: skip
         against.set_xlabel("pendulum swing frequency (Hz)")
-        against.set_ylabel("latency (ms)")
+        against.set_ylabel("latency (ms), bars: 95 % interval")
         against.set_title("latency against swing frequency")
         if group:
             against.legend(title=group, **LEGEND_BESIDE)
     return figure
+
+
+def _interval_bars(rows: Sequence[dict[str, Any]]) -> np.ndarray:
+    """Errorbar lengths below and above each row's latency (zero where it has no interval)."""
+    bars = [
+        (row["latency_ms"] - row["ci95_low_ms"], row["ci95_high_ms"] - row["latency_ms"])
+        if row.get("ci95_low_ms") is not None and row.get("ci95_high_ms") is not None else (0.0, 0.0)
+        for row in rows
+    ]  # fmt: skip
+    return np.array(bars, dtype=float).reshape(-1, 2).T
 
 
 def _short(path: str, keep: int = 40) -> str:
