@@ -14,10 +14,9 @@ import analysis
 from analysis.cycles import DEFAULT_LATENCY_RANGE_S
 from analysis.estimators.registry import DEFAULT_METHOD
 from rig.cli import EXIT_WARNINGS
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
 from rig.commands.formatting import board_line, summary_line
-from rig.errors import RigError
 from rig.progress import ProgressBar
 from rig.service import AnalysisRequest, analyse
 from rig.service.batch import find_videos
@@ -44,13 +43,6 @@ def _run(args: argparse.Namespace) -> int:
         return run_batch_command(args, request, videos)
     measurement = analyse(request, ProgressBar("analysing"))
     result, board = measurement.result, measurement.board
-    if args.plot is not None:
-        from analysis.plots import plot_tracks
-
-        try:
-            plot_tracks(result, args.plot)
-        except OSError as error:
-            raise RigError(f"cannot write the plot {args.plot}: {error}") from error
     if args.json:
         print(json.dumps(measurement.to_dict()))
     else:
@@ -63,6 +55,12 @@ def _run(args: argparse.Namespace) -> int:
                 print(f"  {name}: {estimate.latency_ms:.2f} ms{ci}")
         for warning in result.warnings:
             print(f"warning: {warning}")
+    if args.plot is not None:
+        from analysis.plots import plot_tracks
+
+        writes = outputs.LateWrites()
+        writes.write(args.plot, lambda: plot_tracks(result, args.plot))
+        writes.check()
     return EXIT_WARNINGS if result.warnings else 0
 
 
@@ -137,10 +135,10 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--seed", type=int, default=0, help="random seed of the bayes sampler (default: %(default)s)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--csv", type=Path, metavar="FILE", help="write both tracks as CSV, row by row as they are measured")
+    parser.add_argument("--csv", type=outputs.csv_file, metavar="FILE.csv", help="write both tracks as CSV, row by row as they are measured")
     parser.add_argument(
         "--plot",
-        type=Path,
+        type=outputs.plot_file,
         metavar="FILE.png",
         help="plot tracks, fits, residuals and latency over time (a batch: the summary's latencies, by default beside it)",
     )
@@ -154,7 +152,7 @@ def add_batch_options(parser: argparse.ArgumentParser) -> None:
         "Several videos, folders or globs make a batch: one row per video (a bad video is a failed row, the batch "
         "goes on), written as each finishes. Exit status 3 when any video failed or came with warnings.",
     )
-    batch.add_argument("--summary", type=Path, metavar="FILE.csv", help="write the rows here, the same as JSON and a plot beside it")
+    batch.add_argument("--summary", type=outputs.csv_file, metavar="FILE.csv", help="write the rows here, the same as JSON and a plot beside it")
     options.add_executor_options(batch, "the batch")
     batch.add_argument(
         "--labels",

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from rig.cli import EXIT_WARNINGS
+from rig.commands import outputs
 from rig.errors import ConfigError
 from rig.progress import ProgressBar
 from rig.service import AnalysisRequest
@@ -49,8 +50,6 @@ def run_batch_command(args: argparse.Namespace, template: AnalysisRequest, video
     progress = ProgressBar("analysing", unit="videos")
     rows = run_batch(items, args.summary, args.workers, args.scheduler, progress)
     plot = args.plot or (args.summary.with_suffix(".png") if args.summary is not None else None)
-    if plot is not None:
-        write_summary_plot(rows, plot, group)
     if args.json:
         print(json.dumps(rows))
     else:
@@ -60,4 +59,8 @@ def run_batch_command(args: argparse.Namespace, template: AnalysisRequest, video
         print(f"{len(rows)} videos: {counts['ok']} ok, {counts['warning']} with warnings, {counts['failed']} failed")
         if args.summary is not None:
             print(f"summary: {args.summary}, {args.summary.with_suffix('.json')} and the plot {plot}")
+    if plot is not None:
+        writes = outputs.LateWrites()
+        writes.write(plot, lambda: write_summary_plot(rows, plot, group))
+        writes.check()
     return 0 if all(row["status"] == "ok" for row in rows) else EXIT_WARNINGS

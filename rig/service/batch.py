@@ -207,8 +207,4 @@ def write_summary_plot(rows: Sequence[dict[str, Any]], path: Path, group: str | 
     against swing frequency where the videos' periods differ."""
     from rig.report.figures import summary_figure
 
-    figure = summary_figure(rows, group)
-    try:
-        figure.savefig(path, dpi=110)
-    except OSError as error:
-        raise RigError(f"cannot write the plot {path}: {error.strerror or error}") from None
+    summary_figure(rows, group).savefig(path, dpi=110)
