@@ -100,6 +100,9 @@ def record_camera(
                 window.show(frame.image)
             progress(min(now, end), end)
             clock.wait_until(min(end, clock.now() + PREVIEW_EVERY_S))
+    except KeyboardInterrupt:
+        camera.partial = True
+        raise
     finally:
         camera.close()
         if window is not None:

@@ -100,7 +100,7 @@ def record_tracker(
             sidecar = {
                 "spec": spec,
                 "duration_s": clock.now(),
-                "interrupted": interrupted,
+                "partial": interrupted,
                 "samples": samples,
                 "files": {"samples": TRACKER_FILE, "device": DEVICE_FILE},
                 **(tracker.report() if isinstance(tracker, TrackerStream) else {"tracker": spec}),

@@ -161,6 +161,8 @@ class OpenCvCamera:
         self.writer: FrameWriter | None = None
         self.failure: str | None = None
         self.finished = False
+        self.partial = False
+        """Set when the filming was stopped before its end (Ctrl-C): camera.json says so."""
         self._accept_refused = accept_refused
         self._overwrite = overwrite
         self._capture: Any = None
@@ -264,6 +266,7 @@ class OpenCvCamera:
             "stalls": writer.stalls if writer else 0,
             "measured_fps": writer.measured_fps() if writer else None,
             "failure": self.failure,
+            "partial": self.partial,
         }
 
     def close(self) -> None:
