@@ -1,4 +1,5 @@
-"""The four videos of the analyser's hard cases, made by the simulator: each must give a number whose
+"""The four videos of the analyser's hard cases, and the commonest lab setting (240 fps exposing half
+of each frame), made by the simulator: each must give a number whose
 95 % interval holds the truth, with a warning that names the cause where the camera's sampling of
 the display could bias it, or a clear refusal; never a tight interval around a wrong number.
 
@@ -21,11 +22,13 @@ SMALL = {"width": 320, "height": 240}
 DURATION_S = 4.0
 
 
-def _run(tmp_path: Path, fps: float, display_hz: float) -> tuple[np.ndarray, float]:
+def _run(tmp_path: Path, fps: float, display_hz: float, exposure: float = 1.0, phase: float = 0.0) -> tuple[np.ndarray, float]:
+    """The frames and true latency (ms) of a short run; ``exposure`` a fraction of the frame
+    interval, ``phase`` the display's refreshes against the camera's frames (of a refresh)."""
     config = SimulationConfig(
         duration_s=DURATION_S,
-        camera=CameraConfig(fps=fps, **SMALL),
-        display=DisplayConfig(refresh_hz=display_hz),
+        camera=CameraConfig(fps=fps, exposure_s=exposure / fps, **SMALL),
+        display=DisplayConfig(refresh_hz=display_hz, phase=phase),
         predictor="hold",
     )
     run = simulate(config, tmp_path)
@@ -80,3 +83,39 @@ def test_the_led_half_of_the_image_dimmed_to_35_percent(tmp_path: Path) -> None:
     assert result.latency_ms > 0
     assert "refresh steps +" in result.led_rule
     assert result.led_roi.x + result.led_roi.width / 2 < half < result.sphere_roi.x + result.sphere_roi.width / 2
+
+
+# The commonest lab setting, which read about 1 ms short with an interval of +-0.02 ms: 240 fps
+# exposing half of each frame visits four phases of each 60 Hz refresh (two of a 120 Hz one) and
+# does not tile it. The interval must hold the truth, with a warning that names the cause.
+HALF_FRAME = 0.5
+OFF_STEP_PHASE = 0.37
+
+
+@pytest.mark.parametrize("display_hz", [60.0, 120.0])
+def test_a_240_fps_camera_exposing_half_of_each_frame_the_settings_unknown(tmp_path: Path, display_hz: float) -> None:
+    frames, truth = _run(tmp_path, 240.0, display_hz, exposure=HALF_FRAME, phase=OFF_STEP_PHASE)
+    result = analysis.analyse(frames, fps=240.0)
+    _holds_truth(result, truth)
+    assert any(warning.startswith("the camera (240 fps") for warning in result.warnings)
+
+
+@pytest.mark.parametrize(
+    "display_hz",
+    [
+        pytest.param(
+            60.0,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="known defect: told the display and exposure, the analyser places the refreshes and corrects "
+                "a bias of +0.94 ms where the film's is about +0.46, and the interval misses the truth by 0.3 ms",
+            ),
+        ),
+        120.0,
+    ],
+)
+def test_a_240_fps_camera_exposing_half_of_each_frame_the_settings_given(tmp_path: Path, display_hz: float) -> None:
+    frames, truth = _run(tmp_path, 240.0, display_hz, exposure=HALF_FRAME, phase=OFF_STEP_PHASE)
+    result = analysis.analyse(frames, fps=240.0, refresh_hz=display_hz, exposure_ms=HALF_FRAME / 240.0 * 1e3)
+    _holds_truth(result, truth)
+    assert any(warning.startswith("the camera (240 fps") for warning in result.warnings)
