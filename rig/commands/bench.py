@@ -19,7 +19,7 @@ import predictors
 from predictors import read_trace
 from rig.bench import analyser, analyser_grid, batch
 from rig.bench import predictors as predictor_bench
-from rig.commands import options, outputs
+from rig.commands import choices, options, outputs
 from rig.commands.bench_live import add_live
 from rig.commands.bench_renderers import add_renderers
 from rig.errors import ConfigError, RigError
@@ -176,6 +176,7 @@ def _add_predictors(benchmarks: argparse._SubParsersAction) -> None:
         help="score every predictor on traces: error against constant velocity at several horizons, and cost per update",
         description=predictor_bench.__doc__.split("\n\n")[0] + " With no --trace or --stress, runs the simulated "
         "pendulum, the synthetic head and the two recordings in data/traces.",
+        epilog=choices.predictors_listing(),
     )
     parser.add_argument("--trace", type=Path, action="append", metavar="FILE",
                         help="trace CSV (t_sensor,t_arrival,px,py,pz,qw,qx,qy,qz, or t instead of t_sensor); repeat "
@@ -183,8 +184,8 @@ def _add_predictors(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--stress", action="store_true",
                         help="run the synthetic stress streams (30-1000 Hz, noise, jitter, repeats, sudden stops) too")  # fmt: skip
     parser.add_argument("--predictor", type=options.predictor_spec, action="append", metavar="NAME[:key=value,...]",
-                        help="predictor and parameters, or NAME:FILE.json; repeat for several (default: every predictor: "
-                        f"{', '.join(predictors.names())}); {predictor_bench.BASELINE}, the baseline, is always run")  # fmt: skip
+                        help="predictor (listed below) and parameters, or NAME:FILE.json; repeat for several (default: every "
+                        f"predictor); {predictor_bench.BASELINE}, the baseline, is always run")  # fmt: skip
     parser.add_argument("--horizons-ms", type=_horizons_ms, default=predictor_bench.DEFAULT_HORIZONS_MS, metavar="H,H,...",
                         help="prediction horizons after each sample's arrival (default: 0,10,20,50,100)")  # fmt: skip
     parser.add_argument("--plot-horizon-ms", type=options.non_negative_float, default=50.0,

@@ -22,7 +22,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from rig.commands import options, outputs
+from rig.commands import choices, options, outputs
 from rig.commands.record import CAMERA_SPECS, add_camera_options
 from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
@@ -132,14 +132,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "measure",
         help="measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[2].replace("\n", " "),
+        epilog="\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
     )
-    parser.add_argument("--tracker", metavar="SPEC", help="the tracker on the pendulum (as rig record-tracker takes it)")
+    parser.add_argument("--tracker", metavar="SPEC", help="the tracker on the pendulum (listed below)")
     parser.add_argument("--camera", metavar="SPEC", help=f"the camera filming the LED and the screen: {CAMERA_SPECS}")
     parser.add_argument("--renderer", default="warp", metavar="NAME",
-                        help="the rig's renderer (warp, direct, warp:options, a plug-in) (default: %(default)s)")  # fmt: skip
+                        help="the rig's renderer (listed below), with options as warp:OPTIONS (default: %(default)s)")  # fmt: skip
     parser.add_argument("--external", action="store_true", help="measure an external renderer over LSL instead (see README)")
     parser.add_argument("--predictor", type=options.predictor_spec, default=("default", {}), metavar="NAME[:key=value,...]",
-                        help="the pose predictor, with parameters or a `rig tune` file (default: default)")  # fmt: skip
+                        help="the pose predictor (listed below), with parameters or a `rig tune` file (default: default)")  # fmt: skip
     parser.add_argument("--display", default="window", metavar="SPEC",
                         help="the window: window[:MONITOR][?fullscreen=1&size=WxH&pos=X,Y&scanout=F] (default: %(default)s)")  # fmt: skip
     parser.add_argument("--duration", type=options.positive_float, metavar="S", help="seconds to run (default: 60; self-test 20)")

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 import math
+import re
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 
 def positive_float(text: str) -> float:
@@ -105,3 +107,15 @@ def add_executor_options(parser: argparse.ArgumentParser, what: str) -> None:
     """--workers and --scheduler: where `what` runs (`rig.executor`; neither: here, serially)."""
     parser.add_argument("--workers", type=positive_int, metavar="N", help=f"run {what} on a local Dask cluster of N processes")
     parser.add_argument("--scheduler", metavar="tcp://HOST:PORT", help=f"run {what} on an existing Dask cluster (its workers must reach the files)")
+
+
+def first_sentence(obj: object) -> str:
+    """The first sentence of an object's docstring, on one line."""
+    paragraph = " ".join((inspect.getdoc(obj) or "").split("\n\n")[0].split())
+    return re.split(r"\.\s+(?=[A-Z])", paragraph)[0].rstrip(".")
+
+
+def choices_listing(title: str, choices: Mapping[str, str]) -> str:
+    """A help paragraph listing `choices` a line each (name, then what it is), for an epilog."""
+    width = max(map(len, choices)) + 2
+    return f"{title}:\n" + "\n".join(f"  {name:<{width}}{text}" for name, text in choices.items())

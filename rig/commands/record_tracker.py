@@ -11,15 +11,9 @@ from __future__ import annotations
 import argparse
 import json
 
-from rig.commands import options, outputs
+from rig.commands import choices, options, outputs
 from rig.progress import ProgressBar
 from rig.service.record import record_tracker
-
-SPECS = (
-    "serial:URL[?profile=NAME&baud=N] (a /dev/tty path, socket://HOST:PORT, rfc2217://HOST:PORT, loop://), "
-    "hid:VID:PID[:PROFILE], lsl:NAME"
-)
-
 
 def _summary(sidecar: dict) -> str:
     counters = sidecar.get("counters", {})
@@ -54,8 +48,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "record-tracker",
         help="record a serial, HID or LSL tracker's samples on the host's clock, as they arrive",
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[1].replace("\n", " "),
+        epilog=choices.trackers_listing(),
     )
-    parser.add_argument("--tracker", required=True, metavar="SPEC", help=f"the tracker: {SPECS}")
+    parser.add_argument("--tracker", required=True, metavar="SPEC", help="the tracker (listed below)")
     parser.add_argument("--duration", type=options.positive_float, metavar="S", help="seconds to record (default: until Ctrl-C)")
     parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder to write tracker.csv and its sidecar into")
     parser.add_argument("--overwrite", action="store_true", help="replace a recording already in DIR")

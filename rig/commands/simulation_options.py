@@ -6,9 +6,8 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 
-import predictors
 from rig.commands import options
-from rig.render import renderer_names
+from rig.commands.choices import predictors_listing, renderers_listing
 from rig.service import SimulationConfig
 from rig.session import PHOTON_TARGETS
 from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
@@ -21,20 +20,20 @@ from rig.sim.tracker import TrackerConfig
 def add_simulation_options(parser: argparse.ArgumentParser) -> None:
     """The options that describe a simulated rig (shared by `simulate` and `demo`)."""
     defaults = SimulationConfig()
+    parser.epilog = "\n\n".join((renderers_listing(), predictors_listing()))
     group = parser.add_argument_group("simulated rig")
     group.add_argument(
         "--renderer",
         default=defaults.renderer,
         metavar="NAME[:key=value,...]",
-        help=f"renderer under test ({', '.join(renderer_names())}) and its options, e.g. warp:views=2,recon=grid,holes=1 "
-        "(default: %(default)s)",
+        help="renderer under test (listed below) and its options, e.g. warp:views=2,recon=grid,holes=1 (default: %(default)s)",
     )
     group.add_argument(
         "--predictor",
         type=options.predictor_spec,
         default=(defaults.predictor, {}),
         metavar="NAME[:key=value,...]",
-        help=f"pose predictor ({', '.join(predictors.names())}) and its parameters, or NAME:FILE.json (default: default, the adaptive predictor)",
+        help="pose predictor (listed below) and its parameters, or NAME:FILE.json (default: default, the adaptive predictor)",
     )
     group.add_argument("--display-hz", type=options.positive_float, default=DisplayConfig().refresh_hz, help="display refresh rate (default: %(default)s)")
     group.add_argument("--tracker-hz", type=options.positive_float, default=TrackerConfig().rate_hz, help="tracker sample rate (default: %(default)s)")

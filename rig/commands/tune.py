@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 from predictors import Trace, read_trace
-from rig.commands import options, outputs
+from rig.commands import choices, options, outputs
 from rig.progress import ProgressBar
 from rig.service import TuneReport, split_traces, tune
 from rig.service.tune import PARTS, in_time_order
@@ -83,7 +83,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "tune",
         help="fit a predictor's parameters (Kalman noise ratios and damping, DESP's smoothing, auto's "
         "choice) to recorded motion; keep them only if they beat the defaults on motion held out",
-        description=__doc__.split("\n\n")[0] + " Tunable: kalman-cv, kalman-ca, desp, auto.",
+        description=__doc__.split("\n\n")[0],
+        epilog=choices.tunable_listing(),
     )
     parser.add_argument("predictor", type=options.predictor_spec, metavar="PREDICTOR[:key=value,...]",
                         help="predictor to tune, with starting or fixed parameters (e.g. the tracker's noise)")
