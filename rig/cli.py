@@ -8,7 +8,9 @@ Exit statuses: 0 a clean result; EXIT_WARNINGS (3) measured, but read the warnin
 an interval widened or corrected for how the camera samples the display, a model misfit, missing
 frames; the number stands, with its caveats printed); EXIT_USER_ERROR (2) bad input, or a video
 that cannot be measured; EXIT_INTERRUPTED (130) and EXIT_TERMINATED (143) a run stopped, its
-records kept. A few commands add their own (`rig demo` and `rig measure`: 1 for a disagreement).
+records kept; EXIT_FAULT (1) a fault of the rig's own, printed with its traceback. A few commands
+give 1 a meaning of their own: `rig demo` and `rig measure` a disagreement, `rig tune` parameters
+not written, `rig plan` no setting that reaches the accuracy.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import os
 import re
 import signal
 import sys
+import traceback
 from types import FrameType
 from typing import NoReturn, Sequence
 
@@ -42,6 +45,12 @@ COMMANDS = {
     "measure": "measure",
 }
 """Each command and its module in rig.commands, in the order `rig --help` lists them."""
+EXIT_FAULT = 1
+"""A fault of the rig's own (not of the input): its traceback is printed, with REPORT_A_FAULT."""
+REPORT_A_FAULT = (
+    "this is a fault in the rig itself, not in what you asked for; please report it to the rig's maintainers "
+    "with the command line and the traceback above"
+)
 EXIT_USER_ERROR = 2
 EXIT_WARNINGS = 3
 EXIT_INTERRUPTED = 130
@@ -139,6 +148,10 @@ def run() -> None:
         code = exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else EXIT_USER_ERROR)
         if exit_.code is not None and not isinstance(exit_.code, int):
             print(exit_.code, file=sys.stderr)
+    except Exception:
+        traceback.print_exc()
+        print(f"rig: {REPORT_A_FAULT}", file=sys.stderr)
+        code = EXIT_FAULT
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(code)
