@@ -172,6 +172,10 @@ CASES = [
     ("analyse-one-roi-only", "analyse {lab}/blob.avi --led-roi 0,0,10,10", "--sphere-roi"),
     ("analyse-unknown-method", "analyse {lab}/blob.avi --method astrology", "--method"),
     ("analyse-latency-range-backwards", "analyse {lab}/blob.avi --latency-range 50,1", "--latency-range"),
+    ("analyse-plot-unknown-format", "analyse {lab}/blob.avi --plot {lab}/tracks.jpgx", "--plot"),
+    ("analyse-plot-is-a-folder", "analyse {lab}/blob.avi --plot {lab}/mixed", "is a folder"),
+    ("analyse-csv-folder-missing", "analyse {lab}/blob.avi --csv {lab}/nowhere/tracks.csv", "does not exist"),
+    ("analyse-summary-over-a-file", "analyse {lab}/blob.avi {lab}/grey.avi --summary {lab}/a-file", "--summary"),
     # tune: traces and where the parameters go
     ("tune-trace-with-nan", "tune kalman-cv --trace {lab}/nan.csv --horizon-ms 20 --out {lab}/p.json", "finite"),
     ("tune-trace-missing-column", "tune kalman-cv --trace {lab}/missing-column.csv --horizon-ms 20 --out {lab}/p.json", "pz"),
