@@ -13,7 +13,7 @@ from rig.service.sweep import read_sweep, run_sweep
 
 def _run(args: argparse.Namespace) -> int:
     sweep = read_sweep(args.spec)
-    rows, summary = run_sweep(sweep, args.out, args.workers, args.scheduler, ProgressBar("sweeping", unit="points"))
+    rows, summary = run_sweep(sweep, args.out, args.workers, args.scheduler, ProgressBar("sweeping", unit="points"), args.overwrite)
     if args.json:
         print(json.dumps(rows))
     else:
@@ -37,5 +37,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("spec", type=Path, metavar="SPEC.toml", help="the sweep")
     parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder for the runs and the summary")
     options.add_executor_options(parser, "the points")
+    parser.add_argument("--overwrite", action="store_true", help="replace a sweep already in DIR")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON")
     parser.set_defaults(func=_run)

@@ -158,11 +158,17 @@ def run_sweep(
     workers: int | None = None,
     scheduler: str | None = None,
     progress: Callable[[float, float], object] | None = None,
+    overwrite: bool = False,
 ) -> tuple[list[dict[str, Any]], Path]:
-    """Every point of the sweep into out/pointNNN, and the summary out/summary.csv (and .json)."""
+    """Every point of the sweep into out/pointNNN, and the summary out/summary.csv (and .json); a
+    folder that holds a sweep already is refused unless `overwrite`."""
     points = sweep.points(Path(out))
-    Path(out).mkdir(parents=True, exist_ok=True)
     summary = Path(out) / "summary.csv"
+    held = [path.name for path in (summary, *(point.out_dir for point in points)) if path.exists()]
+    if held and not overwrite:
+        raise ConfigError(f"{out} already holds a sweep ({', '.join(held[:3])}{', ...' if len(held) > 3 else ''}); "
+                          "choose another folder or pass --overwrite")  # fmt: skip
+    Path(out).mkdir(parents=True, exist_ok=True)
     run = BatchRun(summary, (*SUMMARY_COLUMNS, "truth_ms", "error_ms", *sweep.grid))
     run.open()
     try:

@@ -82,6 +82,9 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (lab / "wrong-type.toml").write_text('[base]\nduration_s = "two"\n[grid]\n"camera.fps" = [120]\n')
     (lab / "out-of-range.toml").write_text('[base]\nduration_s = 2\n[grid]\n"pendulum.amplitude_deg" = [90]\n')
     (lab / "not.toml").write_text("this is = not toml [")
+    (lab / "good.toml").write_text('[base]\nduration_s = 3\n[grid]\n"camera.fps" = [120]\n')
+    (lab / "old-sweep").mkdir()
+    (lab / "old-sweep" / "summary.csv").write_text("the user's summary")
     (lab / "a-file").write_text("precious")
     (lab / "no-video-column.csv").write_text("name,latency_ms\na,1.0\n")
     run = lab / "old-run"
@@ -204,6 +207,7 @@ CASES = [
     ("sweep-not-toml", "sweep {lab}/not.toml --out {lab}/sweep", "TOML"),
     ("sweep-missing-spec", "sweep {lab}/nothing.toml --out {lab}/sweep", "nothing.toml"),
     ("sweep-out-is-a-file", "sweep {lab}/unknown-key.toml --out {lab}/a-file", "is a file"),
+    ("sweep-out-holds-a-sweep", "sweep {lab}/good.toml --out {lab}/old-sweep", "--overwrite"),
     # report
     ("report-missing-source", "report {lab}/nothing --out {lab}/r.html", "does not exist"),
     ("report-out-not-html", "report {lab}/old-run --out {lab}/r.htm", ".html"),
