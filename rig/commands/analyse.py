@@ -15,6 +15,7 @@ from analysis.cycles import DEFAULT_LATENCY_RANGE_S
 from analysis.estimators.registry import DEFAULT_METHOD
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options, outputs
+from rig.commands.choices import methods_listing
 from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
 from rig.commands.formatting import board_line, summary_line
 from rig.progress import ProgressBar
@@ -105,9 +106,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "Without ROIs the two moving blobs are found and told apart by physical evidence (the display's refresh "
         "steps, the LED's saturation, size, side); when that does not decide, the command stops and asks for the "
         "ROIs. The interval allows for the camera's sampling of the display and for model misfit. Exit status: 0 "
-        "clean, 3 measured with warnings (read them), 2 user error. Methods: fft (Steed's phase "
-        "method), xcorr (cross-correlation), sinefit (joint least-squares fit, the default), bayes (posterior "
-        "by MCMC), all. Fits compile once per process; set JAX_COMPILATION_CACHE_DIR to keep them between runs.",
+        "clean, 3 measured with warnings (read them), 2 user error. Compiled fits are kept between runs "
+        "(JAX_COMPILATION_CACHE_DIR chooses the folder).",
+        epilog=methods_listing(),
     )
     parser.add_argument(
         "videos",
