@@ -15,8 +15,8 @@ from analysis.cycles import DEFAULT_LATENCY_RANGE_S
 from analysis.estimators.registry import DEFAULT_METHOD
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options, outputs
-from rig.commands.choices import methods_listing
 from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
+from rig.commands.choices import methods_listing
 from rig.commands.formatting import board_line, summary_line
 from rig.progress import ProgressBar
 from rig.service import AnalysisRequest, analyse
