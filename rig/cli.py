@@ -1,8 +1,9 @@
 """The `rig` command line. Every user error ends in one line on stderr and exit status 2.
 
-This module imports only the standard library and the rig's error types, so that an interrupt or a
-signal at any moment, imports included, ends in the rig's own message and exit status: the command
-modules (and numpy, OpenCV, JAX behind them) are imported once the handlers are in place.
+This module imports only the standard library, the rig's error types and its interrupt handling
+(`rig.interrupts`), so that an interrupt or a signal at any moment, imports included, ends in the
+rig's own message and exit status: the command modules (and numpy, OpenCV, JAX behind them) are
+imported once the handlers are in place.
 
 Exit statuses: 0 a clean result; EXIT_WARNINGS (3) measured, but read the warnings (`rig analyse`:
 an interval widened or corrected for how the camera samples the display, a model misfit, missing
@@ -19,14 +20,14 @@ import argparse
 import importlib
 import os
 import re
-import signal
 import sys
 import traceback
-from types import FrameType
 from typing import NoReturn, Sequence
 
+from rig import interrupts
 from rig.compile_cache import keep_compiled_fits
 from rig.errors import RigError
+from rig.interrupts import Terminated
 
 COMMANDS = {
     "demo": "demo",
@@ -55,10 +56,6 @@ EXIT_USER_ERROR = 2
 EXIT_WARNINGS = 3
 EXIT_INTERRUPTED = 130
 EXIT_TERMINATED = 143
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, handled as an interrupt: the command stops, keeping what it recorded."""
 
 
 class ListingFormatter(argparse.HelpFormatter):
@@ -111,23 +108,25 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = build_parser(argv).parse_args(argv)
+    with interrupts.deferred():  # the commands' imports load native extensions
+        args = build_parser(argv).parse_args(argv)
     try:
         return args.func(args)
     except user_errors() as error:
         print(f"rig {args.command}: error: {error}", file=sys.stderr)
         return EXIT_USER_ERROR
     except KeyboardInterrupt as interrupt:
-        print(f"\nrig {args.command}: {_stopped(interrupt)}; everything recorded so far is on disk", file=sys.stderr)
-        return EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
+        interrupts.handled()
+        print(f"\nrig {args.command}: {_stopped(type(interrupt))}; everything recorded so far is on disk", file=sys.stderr)
+        return _interrupted_status(type(interrupt))
 
 
-def _stopped(interrupt: KeyboardInterrupt) -> str:
-    return "terminated" if isinstance(interrupt, Terminated) else "interrupted"
+def _stopped(kind: type[KeyboardInterrupt]) -> str:
+    return "terminated" if issubclass(kind, Terminated) else "interrupted"
 
 
-def _terminate(signum: int, frame: FrameType | None) -> None:
-    raise Terminated()
+def _interrupted_status(kind: type[KeyboardInterrupt]) -> int:
+    return EXIT_TERMINATED if issubclass(kind, Terminated) else EXIT_INTERRUPTED
 
 
 def run() -> None:
@@ -137,21 +136,32 @@ def run() -> None:
     code (XLA, OpenCV, OpenGL) runs its own exit handlers or threads could otherwise crash or hang
     the interpreter's teardown after the work is safely on disk.
     """
-    signal.signal(signal.SIGTERM, _terminate)
+    interrupts.install()
     try:
         keep_compiled_fits()
         code = main()
+        late = interrupts.pending()
+        if late is not None:
+            # Swallowed where it landed and never raised again: the work ran to its end.
+            print(f"\nrig: {_stopped(late)} as it finished; its results are complete", file=sys.stderr)
+            code = _interrupted_status(late)
     except KeyboardInterrupt as interrupt:
-        print(f"\nrig: {_stopped(interrupt)} while starting; nothing was done", file=sys.stderr)
-        code = EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
+        print(f"\nrig: {_stopped(type(interrupt))} while starting; nothing was done", file=sys.stderr)
+        code = _interrupted_status(type(interrupt))
     except SystemExit as exit_:
         code = exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else EXIT_USER_ERROR)
         if exit_.code is not None and not isinstance(exit_.code, int):
             print(exit_.code, file=sys.stderr)
     except Exception:
-        traceback.print_exc()
-        print(f"rig: {REPORT_A_FAULT}", file=sys.stderr)
-        code = EXIT_FAULT
+        late = interrupts.pending()
+        if late is not None:
+            # A library that turned the interrupt into an error of its own (an extension's import does).
+            print(f"\nrig: {_stopped(late)}; everything recorded so far is on disk", file=sys.stderr)
+            code = _interrupted_status(late)
+        else:
+            traceback.print_exc()
+            print(f"rig: {REPORT_A_FAULT}", file=sys.stderr)
+            code = EXIT_FAULT
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(code)

@@ -6,6 +6,8 @@ import sys
 import time
 from typing import Callable, TextIO
 
+from rig import interrupts
+
 _WIDTH = 30
 
 
@@ -33,6 +35,7 @@ class ProgressBar:
         self._shown = -1
 
     def __call__(self, done: float, total: float) -> None:
+        interrupts.raise_pending()
         if not self.enabled or total <= 0:
             return
         percent = int(100 * min(max(done / total, 0.0), 1.0))

@@ -19,7 +19,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from collections import Counter
 from pathlib import Path
 from typing import Iterator
@@ -46,9 +46,9 @@ def _trace(folder: Path) -> Path:
 
 
 @contextmanager
-def _emulated_tracker(folder: Path) -> Iterator[Path]:
-    """A serial tracker streaming on a pseudo-terminal for as long as the storm lasts."""
-    link = folder / "tty"
+def _emulated_tracker(link: Path) -> Iterator[Path]:
+    """A serial tracker streaming on a pseudo-terminal at `link` (one per try: the emulator ends
+    when its reader goes)."""
     emulator = subprocess.Popen([str(RIG), "emulate-tracker", "serial", "--pty", str(link), "--rate", "500"],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
     try:
@@ -60,7 +60,7 @@ def _emulated_tracker(folder: Path) -> Iterator[Path]:
         emulator.wait(timeout=STOP_LIMIT_S)
 
 
-def _commands(folder: Path, tracker: Path) -> dict[str, tuple[float, object]]:
+def _commands(folder: Path) -> dict[str, tuple[float, object]]:
     """Name: (the longest wait before the signal, argv for an output folder)."""
     video, trace = _film(folder), _trace(folder)
     spec = folder / "sweep.toml"
@@ -73,7 +73,7 @@ def _commands(folder: Path, tracker: Path) -> dict[str, tuple[float, object]]:
                                    "400", "--out", str(out / "params.json")]),  # fmt: skip
         "bench": (6.0, lambda out: ["bench", "predictors", "--duration", "10", "--json", str(out / "bench.json")]),
         "sweep": (10.0, lambda out: ["sweep", str(spec), "--out", str(out)]),
-        "record-tracker": (3.0, lambda out: ["record-tracker", "--tracker", f"serial:{tracker}?profile=binary-pose", "--out", str(out)]),
+        "record-tracker": (3.0, lambda out: ["record-tracker", "--tracker", f"serial:{out}.tty?profile=binary-pose", "--out", str(out)]),
         "record": (4.0, lambda out: ["record", "--camera", f"camera:{video}", "--duration", "30", "--out", str(out)]),
     }
 
@@ -84,23 +84,27 @@ def _storm(name: str, longest_s: float, argv, tries: int, folder: Path, rng: ran
     for i in range(tries):
         out = folder / f"{name}{i:02d}"
         sig = signal.SIGTERM if i % 4 == 3 else signal.SIGINT
-        run = Run(argv(out), out)
-        if not run.wait_for(after(rng.uniform(0.0, longest_s))):
-            counts["finished first"] += 1
-        try:
-            code, took = run.stop(sig)
-        except AssertionError:
-            counts["hangs"] += 1
-            continue
+        with _emulated_tracker(Path(f"{out}.tty")) if name == "record-tracker" else nullcontext():
+            run = Run(argv(out), out)
+            finished_first = not run.wait_for(after(rng.uniform(0.0, longest_s)))
+            try:
+                code, took = run.stop(sig)
+            except AssertionError:
+                counts["hangs"] += 1
+                print(f"{name} try {i}: hung after {sig.name}; its stderr ends:\n{run.stderr[-3000:]}", file=sys.stderr)
+                continue
+        counts["finished first"] += finished_first
         slowest = max(slowest, took)
         if code == EXIT_FOR[sig]:
             counts["stopped"] += 1
         elif code < 0:
             counts[f"killed by {signal.Signals(-code).name}"] += 1
-        elif code != 0:
-            counts[f"exit {code}"] += 1
+        elif code != 0 or not finished_first:
+            counts[f"exit {code}" + ("" if finished_first else " after the signal")] += 1
         if "Traceback" in run.stderr or "Fatal Python error" in run.stderr:
             counts["tracebacks"] += 1
+        if code != (0 if finished_first else EXIT_FOR[sig]) or "Traceback" in run.stderr or "Fatal Python error" in run.stderr:
+            print(f"{name} try {i}: exit {code} after {sig.name}; its stderr ends:\n{run.stderr[-3000:]}", file=sys.stderr)
         problems = unreadable(out)
         if problems:
             counts["unreadable outputs"] += 1
@@ -115,9 +119,9 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     rng = random.Random(args.seed)
-    with tempfile.TemporaryDirectory(prefix="rig-interrupt-storm-") as scratch, _emulated_tracker(Path(scratch)) as tracker:
+    with tempfile.TemporaryDirectory(prefix="rig-interrupt-storm-") as scratch:
         folder = Path(scratch)
-        for name, (longest_s, argv) in _commands(folder, tracker).items():
+        for name, (longest_s, argv) in _commands(folder).items():
             if args.only and name not in args.only:
                 continue
             print(json.dumps(_storm(name, longest_s, argv, args.tries, folder, rng)), flush=True)
