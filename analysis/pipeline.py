@@ -64,8 +64,11 @@ def analyse(
         tracks = track(
             source, fps=fps, led_roi=led_roi, sphere_roi=sphere_roi, led_side=led_side, progress=progress, tracks_csv=tracks_csv
         )
-    finally:
-        preparing.join()
+    except BaseException as error:
+        if not isinstance(error, KeyboardInterrupt):  # an interrupt stops at once; the imports end on their own
+            preparing.join()
+        raise
+    preparing.join()
     return estimate(
         tracks,
         method,
