@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import socket
+import time
 from typing import Any, Callable, Iterator, Sequence
 
 from rig.errors import ConfigError, RigError
@@ -42,19 +43,24 @@ def _on_dask(client: Any) -> Jobs:
     return run
 
 
-def _check_reachable(scheduler: str, timeout_s: float = 5.0) -> None:
+def _check_reachable(scheduler: str, patience_s: float = 5.0) -> None:
     """Refuse a tcp:// scheduler nobody listens at before a Dask client is made (a client that
-    fails to connect leaves its event loop's thread behind)."""
+    fails to connect leaves its event loop's thread behind); one still starting gets `patience_s`."""
     scheme, _, where = scheduler.partition("://")
     if scheme != "tcp":
         return
     host, _, port = where.rpartition(":")
     if not host or not port.isdigit():
         raise ConfigError(f"--scheduler must be tcp://HOST:PORT, got {scheduler}")
-    try:
-        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout_s).close()
-    except OSError as error:
-        raise RigError(f"cannot reach the Dask scheduler at {scheduler}: {error.strerror or error}") from None
+    deadline = time.monotonic() + patience_s
+    while True:
+        try:
+            socket.create_connection((host.strip("[]"), int(port)), timeout=patience_s).close()
+            return
+        except OSError as error:
+            if time.monotonic() >= deadline:
+                raise RigError(f"cannot reach the Dask scheduler at {scheduler}: {error.strerror or error}") from None
+            time.sleep(0.25)
 
 
 @contextlib.contextmanager

@@ -81,7 +81,7 @@ def _add_analyser(benchmarks: argparse._SubParsersAction) -> None:
         "analyser",
         help="error, interval coverage, confidently wrong answers and speed of each latency estimator on simulated videos",
         description="Simulate videos of known latency over two grids, analyse each with every method, and report "
-        "per method the median and worst error, the coverage of the 95%% intervals, the confidently wrong answers "
+        "per method the median and worst error, the coverage of the 95 % intervals, the confidently wrong answers "
         "(truth outside the interval by more than max(0.5 ms, its half-width)), the refusals and the speed against "
         "decoding alone. The mixed grid spans periods, frame rates, refresh rates, swings, damping and "
         "impairments; the hard grid, what goes wrong in a lab: camera rates that lock to the display's, short "

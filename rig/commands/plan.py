@@ -81,7 +81,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "plan",
         help="recommend the camera setting, film length and layout that reach a latency accuracy",
         description="Simulate each camera frame rate and exposure on offer filming the display, analyse each as a "
-        "lab would (the settings given), and recommend the one that reaches the wanted 95%% half-width with the "
+        "lab would (the settings given), and recommend the one that reaches the wanted 95 % half-width with the "
         "shortest film, checked by a simulation; print every setting's expected half-width and the bias a "
         "phase-locked camera could have. Exit status 0 with a recommendation, 1 when none reaches the accuracy.",
     )

@@ -7,8 +7,10 @@ import csv
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -69,6 +71,19 @@ def test_two_local_workers_give_the_serial_summary_row_for_row(small_runs, tmp_p
     assert [{k: r[k] for k in keep} for r in parallel] == [{k: r[k] for k in keep} for r in serial]
 
 
+def _wait_until_listening(port: int, process: subprocess.Popen, patience_s: float = 60.0) -> None:
+    """A lab's scheduler is up before a batch is sent to it; this one may take a while to start on
+    a loaded machine."""
+    deadline = time.monotonic() + patience_s
+    while time.monotonic() < deadline and process.poll() is None:
+        try:
+            socket.create_connection(("127.0.0.1", port), timeout=1.0).close()
+            return
+        except OSError:
+            time.sleep(0.2)
+    pytest.fail(f"the Dask scheduler did not listen on port {port} within {patience_s:.0f} s")
+
+
 def test_a_batch_on_an_existing_scheduler_gives_the_serial_summary(small_runs, tmp_path: Path) -> None:
     """A Dask scheduler and a worker started as separate processes, as on a lab's cluster."""
     port = 8700 + os.getpid() % 200
@@ -79,6 +94,7 @@ def test_a_batch_on_an_existing_scheduler_gives_the_serial_summary(small_runs, t
     worker = subprocess.Popen([bin_dir / "dask", "worker", address, "--nthreads", "1", "--no-dashboard"],
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
     try:
+        _wait_until_listening(port, scheduler)
         items = [BatchItem(AnalysisRequest(small_runs[name])) for name in ("slow", "broken")]
         remote = run_batch(items, tmp_path / "remote.csv", scheduler=address)
         serial = run_batch(items, tmp_path / "serial.csv")
