@@ -49,6 +49,6 @@ def test_bench_predictors_lists_every_predictor(capsys: pytest.CaptureFixture[st
     assert all(_listed(text, name) for name in predictors.names())
 
 
-def test_the_methods_listing_holds_every_estimator() -> None:
-    text = methods_listing()
-    assert all(_listed(text, name) for name in (*analysis.methods(), "all"))
+def test_analyse_lists_every_estimator(capsys: pytest.CaptureFixture[str]) -> None:
+    for text in (methods_listing(), _help(capsys, "analyse")):
+        assert all(_listed(text, name) for name in (*analysis.methods(), "all"))
