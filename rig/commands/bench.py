@@ -6,14 +6,13 @@ The subjects are the modules of `rig.bench`, each registered here with its optio
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
 import predictors
 from predictors import read_trace
@@ -22,26 +21,12 @@ from rig.bench import predictors as predictor_bench
 from rig.commands import choices, options, outputs
 from rig.commands.bench_live import add_live
 from rig.commands.bench_renderers import add_renderers
-from rig.errors import ConfigError, RigError
+from rig.errors import ConfigError
 from rig.progress import ProgressBar
 
 
 def _log(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
-
-
-def _write_json(path: Path, record: Any) -> None:
-    try:
-        path.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8")
-    except OSError as error:
-        raise RigError(f"cannot write {path}: {error}") from error
-
-
-def _plot(draw: Callable[[], None], path: Path) -> None:
-    try:
-        draw()
-    except OSError as error:
-        raise RigError(f"cannot write the plot {path}: {error}") from error
 
 
 # -- analyser ------------------------------------------------------------------------------------
@@ -208,16 +193,15 @@ def _add_predictors(benchmarks: argparse._SubParsersAction) -> None:
 
 
 def _run_batch(args: argparse.Namespace) -> int:
-    for path in (args.json, args.plot):
-        if path is not None and not path.parent.is_dir():
-            raise ConfigError(f"cannot write {path}: folder {path.parent} does not exist")
     with tempfile.TemporaryDirectory(prefix="rig-bench-batch-") as scratch:
         report = batch.run_bench(Path(scratch), args.videos, args.duration, args.clip_duration, args.workers, _log)
+    writes = outputs.LateWrites()
     if args.json is not None:
-        _write_json(args.json, report)
+        writes.json(args.json, report)
     if args.plot is not None:
-        _plot(lambda: batch.plot(report, args.plot), args.plot)
+        writes.write(args.plot, lambda: batch.plot(report, args.plot))
     print(batch.table(report))
+    writes.check()
     return 0
 
 
@@ -231,8 +215,8 @@ def _add_batch(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--duration", type=options.positive_float, default=6.0, help="seconds per batch video (default: %(default)s)")
     parser.add_argument("--clip-duration", type=options.positive_float, default=20.0, help="seconds of the fixed-cost clip (default: %(default)s)")
     parser.add_argument("--workers", type=options.positive_int, default=2, help="Dask worker processes (default: %(default)s)")
-    parser.add_argument("--json", type=Path, metavar="OUT", help="write the figures as JSON")
-    parser.add_argument("--plot", type=Path, metavar="OUT.png", help="draw the wall times")
+    parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the figures as JSON")
+    parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="draw the wall times")
     parser.set_defaults(func=_run_batch)
 
 
