@@ -19,7 +19,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 import cv2
 import pytest
@@ -29,6 +29,17 @@ EXIT_FOR = {signal.SIGINT: 130, signal.SIGTERM: 143}
 STOP_LIMIT_S = 30.0
 """A command still running this long after the signal hangs (generous: the CI machine is shared)."""
 START_LIMIT_S = 120.0
+
+
+_STARTED: list[Run] = []
+
+
+@pytest.fixture(autouse=True)
+def _no_command_left_running() -> Iterator[None]:
+    """A test that fails before stopping its command must not leave it running (recording for ever)."""
+    yield
+    while _STARTED:
+        _STARTED.pop().kill()
 
 
 @dataclass
@@ -45,6 +56,15 @@ class Run:
         self._err = open(self.folder.parent / f"{self.folder.name}.stderr", "w")
         env = {**os.environ, "PYTHONFAULTHANDLER": "1"}
         self.process = subprocess.Popen([str(RIG), *self.argv], stdout=self._out, stderr=self._err, env=env)
+        _STARTED.append(self)
+
+    def kill(self) -> None:
+        """End the command if a failed test left it running."""
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+        self._out.close()
+        self._err.close()
 
     def wait_for(self, moment: Callable[[], bool], limit_s: float = START_LIMIT_S) -> bool:
         """True once `moment` holds while the command runs; False if it ended first."""
