@@ -27,11 +27,21 @@ csv_like = st.builds(
 
 
 def _read_both(path: Path) -> None:
-    for read in (read_trace, read_samples):
-        try:
-            read(path)
-        except PredictorError:
-            pass
+    """Each reader refuses with PredictorError or gives what it promises: a trace of finite,
+    time-ordered samples; samples of nine numbers each."""
+    try:
+        trace = read_trace(path)
+    except PredictorError:
+        pass
+    else:
+        assert trace.t.size > 0 and np.isfinite(trace.t).all() and (np.diff(trace.t) >= 0).all()
+        assert np.isfinite(trace.position).all() and np.isfinite(trace.orientation).all()
+    try:
+        samples = read_samples(path)
+    except PredictorError:
+        pass
+    else:
+        assert all(sample.position.shape == (3,) and sample.orientation.shape == (4,) for sample in samples)
 
 
 @settings(max_examples=150)
