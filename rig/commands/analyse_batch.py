@@ -18,6 +18,7 @@ from rig.service.batch import BatchItem, check_summary_path, labels_from, run_ba
 
 
 def is_batch(args: argparse.Namespace, videos: list[Path]) -> bool:
+    """Many videos, or any option that only a batch has."""
     return len(videos) > 1 or any(value is not None for value in (args.summary, args.workers, args.scheduler))
 
 
@@ -43,9 +44,10 @@ def _line(row: dict[str, Any]) -> str:
 def run_batch_command(args: argparse.Namespace, template: AnalysisRequest, videos: list[Path]) -> int:
     """Exit 0 when every video measured cleanly, 3 when any failed or came with warnings."""
     labels = labels_from(args.labels, videos)
-    group = args.group or next(iter(next(iter(labels.values()), {})), None)
-    if group is not None and args.group is not None and not any(group in values for values in labels.values()):
-        raise ConfigError(f"--group {group}: no such label (labels: {', '.join(sorted({k for v in labels.values() for k in v}))})")
+    names = list(dict.fromkeys(name for values in labels.values() for name in values))
+    if args.group is not None and args.group not in names:
+        raise ConfigError(f"--group {args.group}: no such label (labels: {', '.join(names) or 'none'})")
+    group = args.group or next(iter(names), None)
     items = [BatchItem(replace(template, video=video), labels[video]) for video in videos]
     progress = ProgressBar("analysing", unit="videos")
     rows = run_batch(items, args.summary, args.workers, args.scheduler, progress)
