@@ -15,6 +15,7 @@ aborts the process (importing jaxlib's extensions does that).
 from __future__ import annotations
 
 import signal
+import sys
 from contextlib import contextmanager
 from types import FrameType
 from typing import Iterator
@@ -34,10 +35,19 @@ def _interrupt(signum: int, frame: FrameType | None) -> None:
         raise _pending()
 
 
+def _unraisable(unraisable: sys.UnraisableHookArgs) -> None:
+    """Python's report of an exception it had to drop, except an interrupt: that one is remembered
+    and raised again, so its "Exception ignored" traceback would only alarm the user."""
+    if isinstance(unraisable.exc_value, KeyboardInterrupt):
+        return
+    sys.__unraisablehook__(unraisable)
+
+
 def install() -> None:
     """Handle SIGINT and SIGTERM in this process (the main thread) from now on."""
     signal.signal(signal.SIGINT, _interrupt)
     signal.signal(signal.SIGTERM, _interrupt)
+    sys.unraisablehook = _unraisable
 
 
 def pending() -> type[KeyboardInterrupt] | None:

@@ -17,9 +17,11 @@ from rig.progress import ProgressBar
 @pytest.fixture
 def handlers() -> Iterator[None]:
     saved = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+    hook = sys.unraisablehook
     interrupts.install()
     yield
     interrupts.handled()
+    sys.unraisablehook = hook
     for sig, handler in saved.items():
         signal.signal(sig, handler)
 
@@ -53,6 +55,22 @@ def test_an_interrupt_raised_in_a_gc_callback_is_kept(handlers: None, monkeypatc
     gc.collect()
     assert [type(report.exc_value) for report in dropped] == [KeyboardInterrupt]
     assert interrupts.pending() is KeyboardInterrupt
+
+
+def test_python_reports_a_dropped_error_but_not_a_dropped_interrupt(handlers: None, capsys: pytest.CaptureFixture[str]) -> None:
+    def report(kind: type[BaseException]) -> None:
+        def failing(phase: str, info: dict) -> None:
+            if phase == "start":
+                gc.callbacks.remove(failing)
+                raise kind("from a gc callback")
+
+        gc.callbacks.append(failing)
+        gc.collect()
+
+    report(KeyboardInterrupt)
+    assert capsys.readouterr().err == ""
+    report(ValueError)
+    assert "ValueError: from a gc callback" in capsys.readouterr().err
 
 
 def test_a_handled_interrupt_is_not_raised_again(handlers: None) -> None:
