@@ -128,8 +128,17 @@ def sample_posterior(fit: SineFit, seed: int, steps: int = STEPS, burn_in: int =
         fit.problem.data,
     )
 
+    interrupted: list[KeyboardInterrupt] = []
+
     def log_probability(walkers: np.ndarray) -> np.ndarray:
-        return np.asarray(_log_posterior(jnp.asarray(walkers), *arguments))
+        # emcee prints a traceback of anything raised here before passing it on: an interrupt is
+        # kept instead, and raised once the step ends.
+        if not interrupted:
+            try:
+                return np.asarray(_log_posterior(jnp.asarray(walkers), *arguments))
+            except KeyboardInterrupt as interrupt:
+                interrupted.append(interrupt)
+        return np.full(len(walkers), -np.inf)
 
     rng = np.random.default_rng(seed)
     start = np.tile(centre, (WALKERS, 1))
@@ -141,7 +150,9 @@ def sample_posterior(fit: SineFit, seed: int, steps: int = STEPS, burn_in: int =
     # The moves evaluate half the walkers at a time; so does the start, so one compilation serves.
     half = WALKERS // 2
     first = np.concatenate([log_probability(start[:half]), log_probability(start[half:])])
-    sampler.run_mcmc(emcee.State(start, log_prob=first), burn_in + steps, progress=False)
+    for _ in sampler.sample(emcee.State(start, log_prob=first), iterations=burn_in + steps, progress=False):
+        if interrupted:
+            raise interrupted[0]
     chain = sampler.get_chain(discard=burn_in, flat=True)
     latency = chain[:, lag] * fit.problem.scales[model.PHASE_LAG]
     # tol=0: report the estimate without emcee's log message for short chains ("converged" says it).

@@ -125,6 +125,27 @@ def test_posterior_agrees_with_the_fit_and_reports_its_sampler():
     assert sample_posterior(fit, seed=1, steps=300, burn_in=100).median_s == posterior.median_s
 
 
+def test_an_interrupt_in_the_likelihood_ends_the_sampling_without_emcees_traceback(monkeypatch, capsys):
+    from analysis.fit import posterior
+
+    fit = fit_sine(swing(0.06, decay=0.1, noise=(0.3, 0.5), seed=3), (0.3, 0.5), guess(0.06))
+    calls = []
+    likelihood = posterior._log_posterior
+
+    def interrupted_on_the_fifth_call(*arguments):
+        calls.append(1)
+        if len(calls) == 5:
+            raise KeyboardInterrupt
+        return likelihood(*arguments)
+
+    monkeypatch.setattr(posterior, "_log_posterior", interrupted_on_the_fifth_call)
+    with pytest.raises(KeyboardInterrupt):
+        posterior.sample_posterior(fit, seed=1, steps=300, burn_in=100)
+    assert len(calls) == 5
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err and "emcee" not in captured.out
+
+
 def test_the_fit_is_64_bit_in_a_process_whose_jax_is_32_bit():
     import jax
 
