@@ -13,7 +13,9 @@ import json
 
 from rig.commands import choices, options, outputs
 from rig.progress import ProgressBar
+from rig.errors import RigError
 from rig.service.record import record_tracker
+
 
 def _summary(sidecar: dict) -> str:
     counters = sidecar.get("counters", {})
@@ -39,6 +41,11 @@ def _run(args: argparse.Namespace) -> int:
     else:
         print(_summary(recording.sidecar))
         print(f"wrote {args.out}")
+    if recording.sidecar["samples"] == 0:
+        raise RigError(
+            f"no sample arrived from {args.tracker} in {recording.sidecar['duration_s']:.1f} s: is the tracker on and "
+            "streaming, and does the profile match its records? (the empty recording is in the folder, for its link log)"
+        )
     return 0
 
 
