@@ -128,6 +128,7 @@ class WarpRenderer:
         self.server_size = (int(setup.width), int(setup.height))
         border = tuple(int(math.ceil(options.border * s)) for s in self.server_size)
         self.client_size = (self.server_size[0] + 2 * border[0], self.server_size[1] + 2 * border[1])
+        self._grid_motion_px = float(max(1, *border))  # the border: the largest image motion a client frame is drawn for
         self._client_view = ClientView(widened_projection(world_to_clip, self.server_size, border))
         self._world_to_clip = world_to_clip
         self._load_mesh_to_body = np.linalg.inv(world_to_clip)
@@ -277,7 +278,7 @@ class WarpRenderer:
 
     def _new_target(self) -> ClientTarget:
         with self._ctx:
-            return ClientTarget(self._ctx, self.client_size, grid=self.reconstruction == "grid")
+            return ClientTarget(self._ctx, self.client_size, self._grid_motion_px if self.reconstruction == "grid" else None)
 
     def _switch_to(self, index: int) -> _ClientFrame:
         """The client frame `index`, releasing older ones the first time it is shown."""

@@ -33,17 +33,22 @@ BACKGROUND_ID = 0
 SPHERE_ID = 1
 LOAD_ID = 2
 OBJECT_COUNT = 3
+OBJECT_FAR_NDC = (1.0, 0.0, 1.0)
+"""Per object ID, the far end of its NDC depth range (`grid_cells`): the far plane, and for the
+sphere the back of the front half it is squeezed into (`rig.render.gl`)."""
 
 
 class ClientTarget:
     """One client view's images: RGBA8 colour, R16 object ID (id / ID_SCALE) and depth textures,
     the RGBA32F surface texture the warp reads (see `ClientScene.prepare_surface`), and with
-    `grid` the buffer of its adaptive grid's cells (`grid_count` of them) and the server's vertex
-    array over it (`grid_vao`, made by the server)."""
+    `grid_motion_px` (the largest image motion its frame is warped over, see `grid_cells`) the
+    buffer of its adaptive grid's cells (`grid_count` of them) and the server's vertex array over
+    it (`grid_vao`, made by the server)."""
 
-    def __init__(self, ctx: moderngl.Context, size: tuple[int, int], grid: bool = False) -> None:
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int], grid_motion_px: float | None = None) -> None:
         self.size = size
-        self.grid_buffer = ctx.buffer(reserve=size[0] * size[1] * 12) if grid else None
+        self.grid_motion_px = grid_motion_px
+        self.grid_buffer = ctx.buffer(reserve=size[0] * size[1] * 12) if grid_motion_px is not None else None
         self.grid_count = 0
         self.grid_vao: moderngl.VertexArray | None = None
         self.colour = ctx.texture(size, 4)
@@ -171,7 +176,7 @@ class ClientScene:
         target.depth.use(1)
         self._surface_vao.render(moderngl.TRIANGLES, vertices=3)
         if target.grid_buffer is not None:
-            cells = grid_cells(target.read_surface())
+            cells = grid_cells(target.read_surface(), target.grid_motion_px, OBJECT_FAR_NDC)
             target.grid_buffer.write(cells.tobytes())
             target.grid_count = len(cells)
 
