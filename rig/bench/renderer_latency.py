@@ -36,8 +36,9 @@ BASE_LATENCY_S = 0.1
 
 @dataclass(frozen=True)
 class LatencyRun:
-    """One filmed run: a renderer spec on a load of `triangles`, a display of `size` at `refresh_hz`,
-    a predictor and photon target, and its costs (ms, modelled; None: measured)."""
+    """One filmed run: a renderer spec on a load of `triangles` (shaped as `load` says,
+    `rig.render.gl.LOAD_SHAPES`), a display of `size` at `refresh_hz`, a predictor and photon
+    target, and its costs (ms, modelled; None: measured)."""
 
     renderer: str
     triangles: int
@@ -51,6 +52,7 @@ class LatencyRun:
     camera: CameraConfig = CameraConfig()
     min_duration_s: float = 6.0
     max_period_s: float = 8.0
+    load: str = "soup"
 
     @property
     def composes(self) -> bool:
@@ -95,6 +97,7 @@ def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: 
         predictor=run.predictor,
         predictor_params=dict(run.predictor_params),
         scene_triangles=run.triangles,
+        scene_load=run.load,
         app_frame_ms=run.app_frame_ms,
         warp_ms=run.server_ms,
         photon_target=run.photon_target,

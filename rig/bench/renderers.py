@@ -89,13 +89,15 @@ class BenchGrid:
     server_ms: float | None = None
     """the warp server's modelled cost in the latency runs (ms), None: measured"""
 
-    def latency_run(self, renderer: str, triangles: int, predictor: str, photon_target: str = "photons") -> LatencyRun:
-        """The filmed run of `renderer` on `triangles` at the first resolution, costs measured
-        (the server's modelled if `server_ms` says)."""
+    def latency_run(
+        self, renderer: str, triangles: int, predictor: str, photon_target: str = "photons", load: str = "soup"
+    ) -> LatencyRun:
+        """The filmed run of `renderer` on `triangles` (shaped as `load` says) at the first
+        resolution, costs measured (the server's modelled if `server_ms` says)."""
         return LatencyRun(
             renderer, triangles, self.resolutions[0], predictor, server_ms=self.server_ms, photon_target=photon_target,
             refresh_hz=self.refresh_hz, camera=self.latency_camera, min_duration_s=self.latency_duration_s,
-            max_period_s=self.max_period_s,
+            max_period_s=self.max_period_s, load=load,
         )  # fmt: skip
 
 
@@ -138,11 +140,12 @@ def machine_name() -> str:
     return f"{cpu}, {os.cpu_count()} cores, {gl_name}"
 
 
-def scene_setup(width: int, height: int, triangles: int, refresh_hz: float) -> tuple[RenderSetup, Pendulum]:
-    """The session's view of the default pendulum at this display size, costs measured."""
+def scene_setup(width: int, height: int, triangles: int, refresh_hz: float, load: str = "soup") -> tuple[RenderSetup, Pendulum]:
+    """The session's view of the default pendulum at this display size, costs measured, with a
+    load of `triangles` shaped as `load` says (`rig.render.gl.LOAD_SHAPES`)."""
     pendulum = Pendulum(PendulumConfig(), t_end=3.0)
     layout = make_layout(pendulum, CameraConfig(), DisplayConfig(refresh_hz=refresh_hz, width=width, height=height))
-    setup = RenderSetup(width, height, layout.world_to_clip, layout.sphere_radius_m, scene_triangles=triangles)
+    setup = RenderSetup(width, height, layout.world_to_clip, layout.sphere_radius_m, scene_triangles=triangles, scene_load=load)
     return setup, pendulum
 
 

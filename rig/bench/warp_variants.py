@@ -42,11 +42,14 @@ Log = Callable[[str], None]
 
 @dataclass(frozen=True)
 class VariantSpec:
-    """What `--variants` measures: load sizes, variants, the display, the rate ratio of the image
-    error, the latency runs' predictor and costs."""
+    """What `--variants` measures: load sizes and shape, variants, the display, the rate ratio of
+    the image error, the latency runs' predictor and costs."""
 
     triangles: tuple[int, ...] = (10_000, 200_000)
     """a cheap scene and one whose direct frames take several refreshes, still within what filming measures"""
+    load: str = "soup"
+    """what the load's triangles make (`rig.render.gl.LOAD_SHAPES`): the soup is the stress case of
+    the warp's reconstructions (visible fragments a few pixels wide), meshes what real scenes are"""
     variants: tuple[str, ...] = DEFAULT_VARIANTS
     grid: BenchGrid = BenchGrid(resolutions=((320, 240),), ratios=(5,), phases=2, warp_rounds=8, direct_frames=3, direct_budget_s=2.0)
     predictor: str = "hold"
@@ -58,14 +61,15 @@ QUICK_SPEC = VariantSpec(triangles=(1_000,), variants=("warp", "warp:views=2,rec
 def run_variants(spec: VariantSpec, runs_dir: Path, log: Log) -> list[dict[str, Any]]:
     """A row per variant and load size (see the module docstring)."""
     machine = machine_name()
-    log(f"machine: {machine}")
+    log(f"machine: {machine}; load: {spec.load}")
     grid = spec.grid
     size, ratio = grid.resolutions[0], grid.ratios[0]
     rows: list[dict[str, Any]] = []
     for triangles in spec.triangles:
-        setup, pendulum = scene_setup(*size, triangles, grid.refresh_hz)
+        setup, pendulum = scene_setup(*size, triangles, grid.refresh_hz, spec.load)
         direct_s = float(np.median(time_direct(setup, grid)[0]))
-        direct = film_latency(grid.latency_run("direct", triangles, spec.predictor), direct_s, 0.0, runs_dir / f"variants-direct-{triangles}")
+        direct_run = grid.latency_run("direct", triangles, spec.predictor, load=spec.load)
+        direct = film_latency(direct_run, direct_s, 0.0, runs_dir / f"variants-direct-{triangles}")
         log(f"{triangles:>9} triangles: direct latency {direct['latency_measured_ms'] or float('nan'):.1f} ms")
         for variant in spec.variants:
             started = time.perf_counter()
@@ -76,11 +80,11 @@ def run_variants(spec: VariantSpec, runs_dir: Path, log: Log) -> list[dict[str, 
             finally:
                 m.renderer.close()
             client_s, server_s = float(np.median(m.client_s)), float(np.median(m.wall_s))
-            run = grid.latency_run(variant, triangles, spec.predictor)
+            run = grid.latency_run(variant, triangles, spec.predictor, load=spec.load)
             figures = film_latency(run, client_s, server_s, runs_dir / f"variants-{variant.replace(':', '_').replace(',', '_')}-{triangles}")
             warp_ms, direct_ms = figures["latency_measured_ms"], direct["latency_measured_ms"]
             rows.append({
-                **figures, **m.quality(ratio), "spec": variant, "renderer": "warp", "rate_ratio": ratio,
+                **figures, **m.quality(ratio), "spec": variant, "renderer": "warp", "rate_ratio": ratio, "load": spec.load,
                 "server_ms_median": server_s * 1e3, "client_ms_median": client_s * 1e3,
                 "direct_latency_ms": direct_ms,
                 "latency_saved_ms": direct_ms - warp_ms if warp_ms is not None and direct_ms is not None else None,

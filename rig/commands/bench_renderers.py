@@ -20,6 +20,7 @@ from typing import Iterator
 from rig.bench import photon_residual, renderer_plots, renderer_report, renderers, seed_table, warp_variants
 from rig.bench.renderers import QUICK_GRID, BenchGrid
 from rig.commands import options, outputs
+from rig.render.gl import LOAD_SHAPES
 
 
 def _log(message: str) -> None:
@@ -87,7 +88,7 @@ def _variants(args: argparse.Namespace, runs: Path) -> tuple[list[dict], str]:
     spec = warp_variants.QUICK_SPEC if args.quick else warp_variants.VariantSpec()
     grid = replace(spec.grid, server_ms=args.server_ms, **({"resolutions": args.resolutions[:1]} if args.resolutions else {}))
     spec = replace(spec, grid=grid, predictor=args.predictor, **({"variants": tuple(args.variant)} if args.variant else {}),
-                   **({"triangles": args.triangles} if args.triangles else {}))  # fmt: skip
+                   **({"triangles": args.triangles} if args.triangles else {}), **({"load": args.load} if args.load else {}))  # fmt: skip
     rows = warp_variants.run_variants(spec, runs, _log)
     if args.plot is not None:
         renderer_plots.plot_variants(rows, args.plot)
@@ -150,6 +151,7 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--resolutions", type=_resolution_list, metavar="WxH,...", help="display sizes; the first is the latency runs' (default 320x240,640x480,1280x720)")
     parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
     parser.add_argument("--warp", metavar="SPEC", help="the warp renderer and its options, e.g. warp:recon=grid,views=2 (default: warp)")
+    parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
     parser.add_argument("--variant", action="append", metavar="SPEC", help="a warp variant for --variants; repeat for several (default: the seeds' features one by one)")
     parser.add_argument("--predictor", default="hold", help="the predictor of every latency run, both renderers alike (default: %(default)s, as the seeds' Table 2)")
     parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")

@@ -136,7 +136,7 @@ def _build(scene: _Scene, setup: RenderSetup) -> None:
     )
 
     if setup.scene_triangles > 0:
-        triangles = gl.load_triangles(setup.scene_triangles, setup.seed)
+        triangles = gl.load_triangles(setup.scene_triangles, setup.seed, setup.scene_load)
         scene.load_vao = scene.keep(
             ctx.vertex_array(
                 scene.keep(gl.load_program(ctx)),

@@ -25,6 +25,16 @@ LOAD_TRIANGLE_HALF_SIZE = 0.04
 LOAD_DEPTH_RANGE = (0.2, 0.95)
 """NDC depth of the load triangles: inside the back half of the range, which the sphere never uses."""
 
+LOAD_SHAPES = ("soup", "meshes")
+"""What the load's triangles make (`load_triangles`): a soup of small random triangles (the stress
+case: every visible fragment a few pixels wide) or a few solid objects tessellated into them (what a
+real scene's triangles are)."""
+
+LOAD_MESH_OBJECTS = 6
+LOAD_MESH_RADIUS = (0.2, 0.45)
+"""Range of the meshes' radii across the screen (NDC units); their depth radius is LOAD_MESH_DEPTH_RADIUS."""
+LOAD_MESH_DEPTH_RADIUS = 0.15
+
 LOAD_MAX_INTENSITY = 0.1
 """Brightest a load triangle gets (the farthest are darkest): dim beside the sphere's >= 0.6."""
 
@@ -79,6 +89,8 @@ def check_setup(setup: RenderSetup, ctx: moderngl.Context) -> None:
         raise ConfigError(
             f"scene_triangles must be a whole number >= 0, got {setup.scene_triangles!r}"
         )
+    if setup.scene_load not in LOAD_SHAPES:
+        raise ConfigError(f"scene_load must be one of {', '.join(LOAD_SHAPES)}, got {setup.scene_load!r}")
 
 
 @dataclass(frozen=True)
@@ -114,18 +126,26 @@ def sphere_mesh(radius: float, stacks: int = 32, slices: int = 64) -> Mesh:
     )
 
 
-def load_triangles(count: int, seed: int) -> np.ndarray:
-    """`count` small random triangles in NDC, shape (count, 3, 3) float32, deterministic for `seed`.
+def load_triangles(count: int, seed: int, shape: str = "soup") -> np.ndarray:
+    """`count` load triangles in NDC, shape (count, 3, 3) float32, deterministic for `seed`, far to
+    near; `shape` (LOAD_SHAPES) says what they make.
 
-    Centres are uniform over the screen, vertices within LOAD_TRIANGLE_HALF_SIZE of their centre,
-    and each triangle is flat at a depth drawn from LOAD_DEPTH_RANGE. Triangles come far to near,
-    so every fragment passes the depth test and is shaded and written: the GL cost grows linearly
-    with `count` instead of levelling off as early depth rejection would make it. Memory is 36
-    bytes a triangle (5 million: 180 MB, plus the GL driver's copy).
+    Triangles come far to near, so (in the soup) every fragment passes the depth test and is shaded
+    and written: the GL cost grows linearly with `count` instead of levelling off as early depth
+    rejection would make it. Memory is 36 bytes a triangle (5 million: 180 MB, plus the GL driver's
+    copy).
     """
     if count < 0:
         raise ConfigError(f"the load triangle count must be >= 0, got {count}")
+    if shape not in LOAD_SHAPES:
+        raise ConfigError(f"the load's shape must be one of {', '.join(LOAD_SHAPES)}, got {shape!r}")
     rng = np.random.default_rng(seed)
+    return _soup(count, rng) if shape == "soup" else _meshes(count, rng)
+
+
+def _soup(count: int, rng: np.random.Generator) -> np.ndarray:
+    """Small random triangles, far to near: centres uniform over the screen, vertices within
+    LOAD_TRIANGLE_HALF_SIZE of their centre, each flat at a depth drawn from LOAD_DEPTH_RANGE."""
     triangles = np.empty((count, 3, 3), dtype=np.float32)
     centres = rng.uniform(-1.0, 1.0, size=(count, 1, 2)).astype(np.float32)
     offsets = rng.uniform(-LOAD_TRIANGLE_HALF_SIZE, LOAD_TRIANGLE_HALF_SIZE, size=(count, 3, 2)).astype(np.float32)
@@ -133,6 +153,29 @@ def load_triangles(count: int, seed: int) -> np.ndarray:
     depth = np.sort(rng.uniform(*LOAD_DEPTH_RANGE, size=count).astype(np.float32))[::-1]
     triangles[:, :, 2] = depth[:, np.newaxis]
     return triangles
+
+
+def _meshes(count: int, rng: np.random.Generator) -> np.ndarray:
+    """LOAD_MESH_OBJECTS ellipsoids, randomly turned, placed and sized, each a UV sphere
+    (`sphere_mesh`) tessellated into its share of `count`; a share that is not a whole tessellation
+    draws its first triangles twice (they cost as much and show nothing new). Far to near by the
+    triangles' mean depth."""
+    objects = min(LOAD_MESH_OBJECTS, count)
+    near, far = LOAD_DEPTH_RANGE
+    parts = []
+    for share in np.diff(np.linspace(0, count, objects + 1).astype(int)):
+        stacks = max(2, int(np.sqrt(share / 4)))
+        mesh = sphere_mesh(1.0, stacks, max(3, share // (2 * stacks)))
+        turn, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        radius = rng.uniform(*LOAD_MESH_RADIUS)
+        scale = np.array([radius, radius, LOAD_MESH_DEPTH_RADIUS])
+        centre = np.r_[rng.uniform(-0.7, 0.7, 2), rng.uniform(near + LOAD_MESH_DEPTH_RADIUS, far - LOAD_MESH_DEPTH_RADIUS)]
+        vertices = (mesh.vertices @ turn.T) * scale + centre
+        parts.append(np.resize(vertices[mesh.indices], (share, 3, 3)))
+    if not parts:
+        return np.empty((0, 3, 3), dtype=np.float32)
+    triangles = np.concatenate(parts).astype(np.float32)
+    return triangles[np.argsort(-triangles[:, :, 2].mean(axis=1), kind="stable")]
 
 
 def headlight_direction(world_to_clip: np.ndarray) -> np.ndarray:

@@ -51,6 +51,8 @@ class RenderSetup:
     world_to_clip: np.ndarray
     sphere_radius_m: float
     scene_triangles: int = 0
+    scene_load: str = "soup"
+    """what the load triangles make (`rig.render.gl.LOAD_SHAPES`)"""
     wait_for_gpu: bool = True
     seed: int = 0
 

@@ -133,7 +133,7 @@ class WarpRenderer:
         self._world_to_clip = world_to_clip
         self._load_mesh_to_body = np.linalg.inv(world_to_clip)
         self._spin_centre, self._spin_axis = _view_axis(world_to_clip)
-        triangles = gl.load_triangles(setup.scene_triangles, setup.seed)
+        triangles = gl.load_triangles(setup.scene_triangles, setup.seed, setup.scene_load)
         self._leaves = build_leaves(triangles) if options.holes >= 1 else None
         self._scene = ClientScene(ctx, setup.sphere_radius_m, triangles, self._leaves.order if self._leaves else None)
         self._resources.append(self._scene)

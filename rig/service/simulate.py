@@ -109,6 +109,7 @@ def simulate(
         world_to_clip=world.layout.world_to_clip,
         sphere_radius_m=world.layout.sphere_radius_m,
         scene_triangles=config.scene_triangles,
+        scene_load=config.scene_load,
         wait_for_gpu=config.app_frame_ms is None,
         seed=config.seed,
     )

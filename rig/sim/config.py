@@ -26,6 +26,8 @@ class SimulationConfig:
     virtual clock, in ms (modelled), or None for what they take on this machine (measured).
     photon_target, persistence: the instant each frame's pose is predicted for
     (`rig.session.PhotonTarget`).
+    scene_load: what the load's scene_triangles make (`rig.render.gl.LOAD_SHAPES`; the renderer
+    checks it when it opens).
     """
 
     duration_s: float = 10.0
@@ -38,6 +40,7 @@ class SimulationConfig:
     predictor: str = "default"
     predictor_params: dict[str, Any] = field(default_factory=dict)
     scene_triangles: int = 0
+    scene_load: str = "soup"
     app_frame_ms: float | None = 5.0
     warp_ms: float | None = DEFAULT_SERVER_MS
     photon_target: str = "photons"

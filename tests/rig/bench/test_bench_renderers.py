@@ -103,10 +103,12 @@ def test_the_seed_table_films_both_renderers_alike_and_sets_the_seeds_figures_be
 
 
 @pytest.mark.slow
-def test_the_variants_plot_image_error_against_latency_saved(tmp_path):
-    rows = run_quick(tmp_path, "--variants")
+@pytest.mark.parametrize("load", ["soup", "meshes"])
+def test_the_variants_plot_image_error_against_latency_saved(tmp_path, load):
+    rows = run_quick(tmp_path, "--variants", "--load", load)
     assert [r["spec"] for r in rows] == ["warp", "warp:views=2,recon=grid,holes=1"]
     for r in rows:
+        assert r["load"] == load
         assert r["latency_saved_ms"] == pytest.approx(r["direct_latency_ms"] - r["latency_measured_ms"])
         assert 0.9 < r["ssim"] <= 1.0 and r["primitives"] > 0 and r["server_ms_median"] > 0
     assert rows[1]["hole_pct"] <= rows[0]["hole_pct"]

@@ -201,6 +201,21 @@ def test_load_geometry_has_exactly_n_triangles_and_depends_only_on_the_seed():
     assert gl.load_triangles(0, seed=7).shape == (0, 3, 3)
 
 
+@pytest.mark.parametrize("count", [1, 7, 1000, 12345])
+def test_the_meshes_load_is_a_few_tessellated_solids_of_exactly_n_triangles(count):
+    """Its triangles share their vertices (a soup's do not), lie in the load's depth range, come far
+    to near by their mean depth and depend only on the seed."""
+    triangles = gl.load_triangles(count, seed=7, shape="meshes")
+    assert triangles.shape == (count, 3, 3) and triangles.dtype == np.float32
+    np.testing.assert_array_equal(triangles, gl.load_triangles(count, seed=7, shape="meshes"))
+    depth = triangles[:, :, 2]
+    assert (depth >= gl.LOAD_DEPTH_RANGE[0]).all() and (depth <= gl.LOAD_DEPTH_RANGE[1]).all()
+    assert (np.diff(depth.mean(axis=1)) <= 0.0).all()
+    if count >= 1000:
+        assert len(np.unique(triangles.reshape(-1, 3), axis=0)) < count
+        assert not np.array_equal(triangles, gl.load_triangles(count, seed=8, shape="meshes"))
+
+
 def test_renderer_builds_exactly_the_requested_load():
     renderer = opened(orthographic(0.4, 0.3), scene_triangles=4321)
     try:
@@ -273,6 +288,7 @@ def test_headlight_of_a_perspective_camera_is_its_eye():
         {"world_to_clip": np.full((4, 4), np.nan)},
         {"sphere_radius_m": -0.1},
         {"scene_triangles": -1},
+        {"scene_load": "cubes"},
     ],
     ids=lambda change: next(iter(change)),
 )

@@ -39,9 +39,9 @@ def at(position) -> callable:
     return lambda t: Pose(t, np.asarray(position, dtype=np.float64), IDENTITY)
 
 
-def opened(world_to_clip=ORTHOGRAPHIC, triangles: int = 400, **options) -> WarpRenderer:
+def opened(world_to_clip=ORTHOGRAPHIC, triangles: int = 400, load: str = "soup", **options) -> WarpRenderer:
     renderer = WarpRenderer(**options)
-    renderer.open(RenderSetup(WIDTH, HEIGHT, world_to_clip, RADIUS, scene_triangles=triangles, seed=3))
+    renderer.open(RenderSetup(WIDTH, HEIGHT, world_to_clip, RADIUS, scene_triangles=triangles, scene_load=load, seed=3))
     return renderer
 
 
@@ -135,12 +135,12 @@ def test_the_gl_warp_agrees_with_the_numpy_reference(views):
     assert (expected[:, :, 3] == 0).mean() > 0.001  # the test scene has holes: they must agree too
 
 
-def warped_by_each(reconstructions: tuple[str, ...], moved) -> dict[str, tuple[np.ndarray, np.ndarray, int]]:
+def warped_by_each(reconstructions: tuple[str, ...], moved, **scene) -> dict[str, tuple[np.ndarray, np.ndarray, int]]:
     """Per reconstruction: (display image, reference render, primitives drawn) of one client frame
-    warped to `moved`."""
+    warped to `moved`, on the scene `opened` makes of `scene`."""
     result = {}
     for mode in reconstructions:
-        renderer = opened(recon=mode)
+        renderer = opened(recon=mode, **scene)
         try:
             client_frame(renderer, 0, [0.0, 0.0, 0.0])
             image = display(renderer, 0, moved, 0)
@@ -156,8 +156,9 @@ def test_quad_splats_and_the_adaptive_grid_match_point_splats_under_translation(
     assert np.all(warped["point"][0] == warped[mode][0], axis=2).mean() >= 0.99
 
 
-def test_the_adaptive_grid_draws_at_least_four_times_fewer_primitives_than_point_splats():
-    warped = warped_by_each(("point", "grid"), [0.043, -0.021, 0.0])
+@pytest.mark.parametrize(("load", "triangles"), [("soup", 400), ("meshes", 200_000)])
+def test_the_adaptive_grid_draws_at_least_four_times_fewer_primitives_than_point_splats(load, triangles):
+    warped = warped_by_each(("point", "grid"), [0.043, -0.021, 0.0], load=load, triangles=triangles)
     assert warped["point"][2] == (WIDTH + 2 * 5) * (HEIGHT + 2 * 4)  # a point per client pixel (5 % border)
     assert 4 * warped["grid"][2] <= warped["point"][2]
     errors = {mode: lab_error_percent(image, reference) for mode, (image, reference, _) in warped.items()}
