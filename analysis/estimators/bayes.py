@@ -19,7 +19,7 @@ class BayesEstimator:
         import analysis.fit.posterior  # noqa: F401
 
     def estimate(self, context: EstimationContext) -> MethodResult:
-        # JAX and emcee are imported only when asked for, as in ``joint_fit``.
+        # JAX and emcee are imported only when asked for: ``import analysis`` and sinefit never pay for them.
         from analysis.fit.posterior import sample_posterior
 
         fit = context.shared(joint_fit)

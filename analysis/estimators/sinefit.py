@@ -3,23 +3,17 @@
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
 
 from analysis.estimators.contract import EstimationContext
+from analysis.fit.least_squares import Guess, SineFit, fit_sine
 from analysis.result import MethodResult
 from analysis.windows import gain_ratio
-
-if TYPE_CHECKING:
-    from analysis.fit.least_squares import SineFit
 
 
 def joint_fit(context: EstimationContext) -> SineFit:
     """The joint fit, started from the swing as measured and the chosen whole number of periods;
     shared through ``context.shared`` (bayes samples around it). A warning says when the fit moved
     the latency by more than a quarter period from where it started."""
-    # JAX is imported only when a fit is asked for: ``import analysis``, fft and xcorr never pay for it.
-    from analysis.fit.least_squares import Guess, fit_sine
-
     swing, reference = context.swing, context.cycles.reference_s
     guess = Guess(swing.frequency_hz, swing.damping, 0.0, reference, gain_ratio(swing.windows))
     fit = fit_sine(swing.signals, (swing.windows.led_noise, swing.windows.sphere_noise), guess)
@@ -36,9 +30,6 @@ class SineFitEstimator:
 
     name = "sinefit"
     gives_interval = True
-
-    def prepare(self) -> None:
-        import analysis.fit.least_squares  # noqa: F401
 
     def estimate(self, context: EstimationContext) -> MethodResult:
         started = time.perf_counter()

@@ -1,8 +1,10 @@
 """The joint least-squares fit (``sinefit``): both swings with a shared frequency, damping and chirp.
 
-The model is in ``analysis.fit.model``; its lag parameter is the latency. The fit runs on the
-signals averaged in bins of a few frames (about BINS_PER_PERIOD bins per swing period; see
-``analysis.signals.binned``), padded to a power-of-two length so that one JAX compilation serves
+The model is in ``analysis.fit.model``; its lag parameter is the latency. The fit is numpy's
+and imports no JAX: Levenberg-Marquardt (``analysis.fit.levenberg_marquardt``) on the projected
+residual, with analytic Jacobians (``analysis.fit.jacobians``). It runs on the signals averaged in
+bins of a few frames (about BINS_PER_PERIOD bins per swing period; see ``analysis.signals.binned``),
+padded to a power-of-two length so that one JAX compilation of the posterior's likelihood serves
 every clip of similar length. Each bin is weighted by sqrt(frames in it) / (the signal's noise);
 after a first fit of the richest model each signal's weights are rescaled to make its weighted
 residuals' RMS one, so the LED and the sphere count by how well each is actually measured.
@@ -31,10 +33,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-import jax.numpy as jnp
 import numpy as np
 
 from analysis.fit import model
+from analysis.fit.jacobians import full_jacobian, projected_residual_and_jacobian
+from analysis.fit.levenberg_marquardt import levenberg_marquardt
 from analysis.longrun import long_run_variance
 from analysis.signals import BinnedSignals, SwingSignals, binned
 
@@ -59,6 +62,9 @@ RICHEST = "damped+harmonics+drift"
 HAC_PERIODS = 1.0
 # Models whose Wald-approximated BIC exceeds the best by more than this are not fitted.
 SCREEN_MARGIN = 20.0
+# Levenberg-Marquardt: iterations and the relative step at which it stops.
+MAX_ITERATIONS = 60
+STEP_TOLERANCE = 1e-11
 
 
 @dataclass(frozen=True)
@@ -74,7 +80,7 @@ class Guess:
 
 @dataclass(frozen=True)
 class FitProblem:
-    """A fit set up for JAX: data, the bins it came from, and how scaled parameters map to physical ones."""
+    """A fit set up: data, the bins it came from, and how scaled parameters map to physical ones."""
 
     data: model.FitData
     bins: BinnedSignals
@@ -115,16 +121,15 @@ class SineFit:
         """The chosen model's variance inflation of the latency: (se / white-noise se)^2."""
         return (self.se_s / self.naive_se_s) ** 2
 
-    @model.in_float64
     def curves(self) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """For the LED, then the sphere: (bin times, binned values, fitted values) over used bins."""
         data = self.problem.data
-        coefficients, _ = model.linear_solution(jnp.asarray(self.params), self.structure, data)
-        fitted = np.asarray(model.design(jnp.asarray(self.params), self.structure, data) @ coefficients)
+        coefficients, _ = model.linear_solution(self.params, self.structure, data)
+        fitted = model.design(self.params, self.structure, data) @ coefficients
         n = data.tau.shape[0] // 2
-        times = np.asarray(data.tau) + self.problem.mid
-        used = np.asarray(data.w) > 0
-        values = np.asarray(data.y)
+        times = data.tau + self.problem.mid
+        used = data.w > 0
+        values = data.y
         return tuple(
             (times[s][used[s]], values[s][used[s]], fitted[s][used[s]]) for s in (slice(0, n), slice(n, 2 * n))
         )
@@ -157,9 +162,7 @@ def make_problem(signals: SwingSignals, noise: tuple[float, float], guess: Guess
         w[offset : offset + count] = np.where(valid, np.sqrt(number) / max(sigma, 1e-9), 0.0)
     omega = 2 * math.pi * guess.frequency_hz
     scales = np.array([2 * math.pi / span, 1 / span, 1 / span**2, 1 / omega, 1.0])
-    data = model.FitData(
-        jnp.asarray(tau), jnp.asarray(y), jnp.asarray(w), jnp.asarray(span / 2), jnp.asarray(scales)
-    )
+    data = model.FitData(tau, y, w, np.asarray(span / 2), scales)
     return FitProblem(data, bins, count, span, mid, scales, period / (bins.frames_per_bin * signals.frame_interval))
 
 
@@ -172,7 +175,7 @@ def structure_of(name: str, start: np.ndarray) -> model.Structure:
     fixed = np.where(free > 0, start, 0.0)
     fixed[model.CYCLES] = start[model.CYCLES]
     fixed[model.GAIN] = start[model.GAIN]
-    return model.Structure(jnp.asarray(free), jnp.asarray(fixed), jnp.asarray(linear))
+    return model.Structure(free, fixed, linear)
 
 
 def scaled_guess(guess: Guess, problem: FitProblem) -> np.ndarray:
@@ -180,14 +183,26 @@ def scaled_guess(guess: Guess, problem: FitProblem) -> np.ndarray:
     return physical / problem.scales
 
 
+def _fit(params: np.ndarray, structure: model.Structure, data: model.FitData) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Levenberg-Marquardt from ``params``: (scaled parameters, coefficients, residual, iterations)."""
+    solution = levenberg_marquardt(
+        lambda x: model.projected_residual(x, structure, data),
+        lambda x: projected_residual_and_jacobian(x, structure, data),
+        params,
+        MAX_ITERATIONS,
+        STEP_TOLERANCE,
+    )
+    coefficients, residual = model.linear_solution(solution.params, structure, data)
+    return solution.params, coefficients, residual, solution.iterations
+
+
 def _variances(params: np.ndarray, coefficients: np.ndarray, structure: model.Structure, problem: FitProblem) -> tuple[float, float, np.ndarray]:
     """(sandwich variance, white-noise variance) of the scaled lag parameter, and the white-noise
     covariance of all 5 + 16 parameters (zero for those the structure leaves out): the inverse
     Gauss-Newton information times the residual variance."""
-    jacobian, residual = (
-        np.asarray(a) for a in model.jacobian(jnp.asarray(params), jnp.asarray(coefficients), structure, problem.data)
-    )
-    active = np.concatenate([np.asarray(structure.free), np.asarray(structure.linear)]) > 0
+    jacobian = full_jacobian(params, coefficients, structure, problem.data)
+    residual = model.full_residual(np.concatenate([params, coefficients]), structure, problem.data)
+    active = np.concatenate([structure.free, structure.linear]) > 0
     reduced = jacobian[:, active]
     information = reduced.T @ reduced
     covariance = np.linalg.inv(information)
@@ -196,7 +211,7 @@ def _variances(params: np.ndarray, coefficients: np.ndarray, structure: model.St
     influence = residual * (reduced @ direction)
     n = problem.data.tau.shape[0] // 2
     per_bin = influence[:n] + influence[n:]
-    dof = max(int(np.count_nonzero(np.asarray(problem.data.w) > 0)) - int(np.count_nonzero(active)), 1)
+    dof = max(int(np.count_nonzero(problem.data.w > 0)) - int(np.count_nonzero(active)), 1)
     residual_variance = float(residual @ residual) / dof
     naive = float(covariance[lag_index, lag_index]) * residual_variance
     sandwich = long_run_variance(per_bin[: problem.count], _bandwidth(problem))
@@ -211,13 +226,13 @@ def _reweighted(problem: FitProblem, residual: np.ndarray) -> FitProblem:
     The first weights come from per-frame scatter; what a bin average keeps of it (a display's
     staircase, say, mostly cancels within a bin) is only known once the model is fitted.
     """
-    weights = np.asarray(problem.data.w).copy()
+    weights = problem.data.w.copy()
     n = weights.size // 2
     for block in (slice(0, n), slice(n, 2 * n)):
         used = weights[block] > 0
         rms = math.sqrt(float(np.mean(residual[block][used] ** 2))) if np.any(used) else 1.0
         weights[block] /= max(rms, 1e-12)
-    return replace(problem, data=problem.data._replace(w=jnp.asarray(weights)))
+    return replace(problem, data=problem.data._replace(w=weights))
 
 
 def _bandwidth(problem: FitProblem) -> int:
@@ -261,7 +276,6 @@ def _screened_bic(
     return approximate
 
 
-@model.in_float64
 def fit_sine(signals: SwingSignals, noise: tuple[float, float], guess: Guess) -> SineFit:
     """Fit the models, choose by BIC, and return the chosen model's latency with its uncertainty.
 
@@ -270,12 +284,11 @@ def fit_sine(signals: SwingSignals, noise: tuple[float, float], guess: Guess) ->
     """
     problem = make_problem(signals, noise, guess)
     start = scaled_guess(guess, problem)
-    bins_used = int(np.count_nonzero(np.asarray(problem.data.w) > 0))
+    bins_used = int(np.count_nonzero(problem.data.w > 0))
     fits = {}
-    params, _, residual, _ = model.fit(jnp.asarray(start), structure_of(RICHEST, start), problem.data)
-    problem = _reweighted(problem, np.asarray(residual))
-    params, coefficients, residual, iterations = model.fit(params, structure_of(RICHEST, start), problem.data)
-    fits[RICHEST] = (np.asarray(params), np.asarray(coefficients), np.asarray(residual), int(iterations))
+    params, _, residual, _ = _fit(start, structure_of(RICHEST, start), problem.data)
+    problem = _reweighted(problem, residual)
+    fits[RICHEST] = _fit(params, structure_of(RICHEST, start), problem.data)
     richest_params = fits[RICHEST][0]
     sandwich, naive, covariance = _variances(richest_params, fits[RICHEST][1], structure_of(RICHEST, richest_params), problem)
     inflation = max(1.0, sandwich / naive)
@@ -288,19 +301,18 @@ def fit_sine(signals: SwingSignals, noise: tuple[float, float], guess: Guess) ->
         if approximate > best_guess + SCREEN_MARGIN:
             continue
         structure = structure_of(name, richest_params)
-        params, coefficients, residual, iterations = model.fit(jnp.asarray(richest_params), structure, problem.data)
-        fits[name] = (np.asarray(params), np.asarray(coefficients), np.asarray(residual), int(iterations))
+        fits[name] = _fit(richest_params, structure, problem.data)
         bic[name] = _bic(float(fits[name][2] @ fits[name][2]), _parameter_count(name), bins_used, inflation)
     chosen = min(bic, key=bic.__getitem__)
     params, coefficients, residual, iterations = fits[chosen]
     structure = structure_of(chosen, richest_params)
     sandwich, naive, covariance = _variances(params, coefficients, structure, problem)
     critical = critical_value(_bandwidth(problem) / problem.count)
-    physical = np.asarray(model.physical(jnp.asarray(params), structure, problem.data))
+    physical = model.physical(params, structure, problem.data)
     se = math.sqrt(sandwich) * problem.scales[model.PHASE_LAG]
     latency = float(physical[model.PHASE_LAG])
     n = problem.data.tau.shape[0] // 2
-    w = np.asarray(problem.data.w)
+    w = problem.data.w
     rms = tuple(
         float(np.sqrt(np.sum((residual[s] / np.where(w[s] > 0, w[s], 1.0)) ** 2 * (w[s] > 0)) / max(np.count_nonzero(w[s] > 0), 1)))
         for s in (slice(0, n), slice(n, 2 * n))

@@ -1,12 +1,11 @@
-"""The joint model of the LED and sphere swings, in JAX: what `sinefit` fits and `bayes` samples.
+"""The joint model of the LED and sphere swings: what `sinefit` fits and `bayes` samples.
 
-The model needs 64-bit floats: phases of a few hundred radians must keep sub-microradian
-precision. Importing this module changes no JAX setting; instead each entry point that builds or
-fits the model's arrays (``least_squares.fit_sine``, ``SineFit.curves``,
-``posterior.sample_posterior``) runs under ``in_float64``, which turns on JAX's 64-bit mode for the
-calling thread and the duration of the call only, so a user's own JAX code in the same process
-keeps its setting. The analyser imports this module only when a fit is asked for, so
-``import analysis`` and the fft and xcorr methods never pay for JAX.
+One definition serves both: each function computes with the namespace of its arrays
+(``array_namespace``), numpy for the least-squares fit (``least_squares``, which therefore never
+imports JAX) and jax.numpy for the posterior, whose likelihood (``marginal``) JAX traces and
+differentiates through these same functions. The model needs 64-bit floats: phases of a few
+hundred radians must keep sub-microradian precision; numpy's are, and the posterior asks JAX for
+them per call (``marginal.in_float64``).
 
 Time tau is measured from the middle of the clip. With D = exp(-gamma tau) the damping envelope
 and Phi(tau) = omega tau - zeta h(tau) the swing's phase, the LED's displacement along its axis is
@@ -38,17 +37,11 @@ least-squares solution, so the optimiser and the sampler work in five dimensions
 
 from __future__ import annotations
 
-import warnings
-from collections.abc import Callable
-from typing import NamedTuple, TypeVar
+import sys
+from types import ModuleType
+from typing import Any, NamedTuple
 
-import jax
-import jax.numpy as jnp
-
-with warnings.catch_warnings():
-    # jaxopt announces on import that it is no longer maintained; its LM solver is what we use.
-    warnings.filterwarnings("ignore", message="JAXopt is no longer maintained", category=DeprecationWarning)
-    import jaxopt
+import numpy as np
 
 # Non-linear parameters, in order. The linear coefficients are, in order: a, b, the LED's and the
 # sphere's offsets, the LED's drift s and s^2, the sphere's, the LED's cos 2Phi, sin 2Phi, cos 3Phi,
@@ -57,20 +50,20 @@ CYCLES, DAMPING, CHIRP, PHASE_LAG, GAIN = range(5)
 FUNDAMENTAL = (0, 1, 2, 3)
 DRIFT = (4, 5, 6, 7)
 HARMONICS = tuple(range(8, 16))
-# Below this |x| phi2 is evaluated by its series (the closed form loses digits to cancellation).
+# Below this |x| phi2 and its derivative are evaluated by their series (the closed forms lose
+# digits to cancellation).
 _SERIES_BELOW = 1e-2
-# Levenberg-Marquardt: iterations and the relative step at which it stops.
-MAX_ITERATIONS = 60
-STEP_TOLERANCE = 1e-11
 
-_Function = TypeVar("_Function", bound=Callable)
+Array = Any  # a numpy array, or a JAX array (or tracer) when the posterior traces the model
 
 
-def in_float64(function: _Function) -> _Function:
-    """``function``, run with JAX in 64-bit mode (``jax.enable_x64``) in the calling thread for the
-    duration of each call; the thread's setting is restored afterwards. The model's arrays made
-    inside keep float64 when used later under this mode again."""
-    return jax.enable_x64(True)(function)
+def array_namespace(*arrays: object) -> ModuleType:
+    """jax.numpy if any of ``arrays`` is a JAX array (a tracer included), else numpy. A JAX array
+    exists only once JAX is imported, so asking never imports it."""
+    jax = sys.modules.get("jax")
+    if jax is not None and any(isinstance(array, jax.Array) for array in arrays):
+        return sys.modules["jax.numpy"]
+    return np
 
 
 class FitData(NamedTuple):
@@ -81,42 +74,61 @@ class FitData(NamedTuple):
     turning the scaled non-linear parameters into omega, gamma, zeta, lag and gain.
     """
 
-    tau: jax.Array
-    y: jax.Array
-    w: jax.Array
-    half_span: jax.Array
-    scales: jax.Array
+    tau: Array
+    y: Array
+    w: Array
+    half_span: Array
+    scales: Array
 
 
 class Structure(NamedTuple):
     """Which parameters a model has: free (5,) 1.0 for a fitted non-linear parameter, 0.0 for one
     held at ``fixed``; linear (16,) 1.0 for a coefficient in the model, 0.0 for one left out."""
 
-    free: jax.Array
-    fixed: jax.Array
-    linear: jax.Array
+    free: Array
+    fixed: Array
+    linear: Array
 
 
-def _phi2(x: jax.Array) -> jax.Array:
-    small = jnp.abs(x) < _SERIES_BELOW
-    safe = jnp.where(small, 1.0, x)
-    closed = (jnp.expm1(-safe) + safe) / safe**2
+def _namespace(params: Array, structure: Structure, data: FitData) -> ModuleType:
+    return array_namespace(params, *structure, *data)
+
+
+def _phi2(x: Array, xp: ModuleType) -> Array:
+    small = xp.abs(x) < _SERIES_BELOW
+    safe = xp.where(small, 1.0, x)
+    closed = (xp.expm1(-safe) + safe) / safe**2
     series = 0.5 - x / 6.0 + x**2 / 24.0 - x**3 / 120.0
-    return jnp.where(small, series, closed)
+    return xp.where(small, series, closed)
 
 
-def swing_phase(tau: jax.Array, omega: jax.Array, gamma: jax.Array, zeta: jax.Array) -> jax.Array:
+def _phi2_slope(x: Array, phi2: Array, xp: ModuleType) -> Array:
+    """phi2'(x) = (phi1(x) - 2 phi2(x)) / x, phi1(x) = (1 - exp(-x)) / x; by its series near 0.
+
+    The closed form's relative error grows as eps / x^2 (about 6e-12 at the switch to the series);
+    the series' first omitted term, x^4 / 1008, is 6e-11 of it there (that of phi2's, x^4 / 720,
+    3e-11 of phi2).
+    """
+    small = xp.abs(x) < _SERIES_BELOW
+    safe = xp.where(small, 1.0, x)
+    closed = (-xp.expm1(-safe) / safe - 2.0 * phi2) / safe
+    series = -1.0 / 6.0 + x / 12.0 - x**2 / 40.0 + x**3 / 180.0
+    return xp.where(small, series, closed)
+
+
+def swing_phase(tau: Array, omega: Array, gamma: Array, zeta: Array) -> Array:
     """Phi(tau) = omega tau - zeta h(tau): the phase of a damped pendulum whose frequency drifts."""
-    return omega * tau - zeta * 2.0 * tau**2 * _phi2(2.0 * gamma * tau)
+    xp = array_namespace(tau, omega, gamma, zeta)
+    return omega * tau - zeta * 2.0 * tau**2 * _phi2(2.0 * gamma * tau, xp)
 
 
-def physical(params: jax.Array, structure: Structure, data: FitData) -> jax.Array:
+def physical(params: Array, structure: Structure, data: FitData) -> Array:
     """(omega, gamma, zeta, lag, gain) from scaled parameters, fixed ones taken from the structure."""
     chosen = structure.free * params + (1.0 - structure.free) * structure.fixed
     return chosen * data.scales
 
 
-def _placement() -> jax.Array:
+def _placement() -> np.ndarray:
     """(2, 9, 16): where each signal's nine basis functions go among the 16 linear coefficients.
 
     Basis per signal: fundamental cos and sin (shared by both signals through ``gain``), offset,
@@ -124,117 +136,147 @@ def _placement() -> jax.Array:
     """
     led = [0, 1, 2, 4, 5, 8, 9, 10, 11]
     sphere = [0, 1, 3, 6, 7, 12, 13, 14, 15]
-    eye = jnp.eye(16)
-    return jnp.stack([eye[jnp.array(led)], eye[jnp.array(sphere)]])
+    eye = np.eye(16)
+    return np.stack([eye[led], eye[sphere]])
 
 
-def basis(params: jax.Array, structure: Structure, data: FitData) -> jax.Array:
-    """(2, N, 9) each signal's basis functions at its sample times (see ``_placement``); left-out
-    functions are zero."""
-    omega, gamma, zeta, lag, gain = physical(params, structure, data)
+PLACEMENT = _placement()
+
+
+class _Swing(NamedTuple):
+    """What the basis and its derivatives share: (omega, gamma, zeta, lag, gain), and per signal
+    (2, N) the times from mid-clip, the times less the signal's lag, its gain, the envelope D, and
+    the cos and sin of Phi, 2 Phi and 3 Phi."""
+
+    physical: Array
+    tau: Array
+    shifted: Array
+    gains: Array
+    envelope: Array
+    harmonics: tuple[Array, Array, Array, Array, Array, Array]
+
+
+def _swing(params: Array, structure: Structure, data: FitData, xp: ModuleType) -> _Swing:
+    values = physical(params, structure, data)
+    omega, gamma, zeta, lag, gain = values
     tau = data.tau.reshape(2, -1)
-    lags = jnp.stack([0.0, lag])[:, None]
-    gains = jnp.stack([1.0, gain])[:, None]
-    envelope = jnp.exp(-gamma * tau)
-    phase = swing_phase(tau - lags, omega, gamma, zeta)
-    cos, sin = jnp.cos(phase), jnp.sin(phase)
+    shifted = tau - xp.stack([0.0, lag])[:, None]
+    phase = swing_phase(shifted, omega, gamma, zeta)
+    cos, sin = xp.cos(phase), xp.sin(phase)
     cos2, sin2 = 2.0 * cos**2 - 1.0, 2.0 * sin * cos
     cos3, sin3 = cos * (4.0 * cos**2 - 3.0), sin * (3.0 - 4.0 * sin**2)
-    s = tau / data.half_span
+    gains = xp.stack([1.0, gain])[:, None]
+    return _Swing(values, tau, shifted, gains, xp.exp(-gamma * tau), (cos, sin, cos2, sin2, cos3, sin3))
+
+
+def _used(structure: Structure, xp: ModuleType) -> Array:
+    """(2, 9): 1.0 where a signal's basis function is in the model."""
+    return xp.einsum("kbc,c->kb", PLACEMENT, structure.linear)
+
+
+def basis(params: Array, structure: Structure, data: FitData) -> Array:
+    """(2, N, 9) each signal's basis functions at its sample times (see ``_placement``); left-out
+    functions are zero."""
+    xp = _namespace(params, structure, data)
+    swing = _swing(params, structure, data, xp)
+    cos, sin, cos2, sin2, cos3, sin3 = swing.harmonics
+    envelope = swing.envelope
+    s = swing.tau / data.half_span
     squared, cubed = envelope**2, envelope**3
-    functions = jnp.stack(
+    functions = xp.stack(
         [
-            gains * envelope * cos, gains * envelope * sin, jnp.ones_like(s), s, s**2,
+            swing.gains * envelope * cos, swing.gains * envelope * sin, xp.ones_like(s), s, s**2,
             squared * cos2, squared * sin2, cubed * cos3, cubed * sin3,
         ],
         axis=-1,
     )  # fmt: skip
-    used = jnp.einsum("kbc,c->kb", _placement(), structure.linear)
-    return functions * used[:, None, :]
+    return functions * _used(structure, xp)[:, None, :]
 
 
-def design(params: jax.Array, structure: Structure, data: FitData) -> jax.Array:
+def basis_slopes(params: Array, structure: Structure, data: FitData) -> Array:
+    """(5, 2, N, 9): the derivatives of ``basis`` in each scaled non-linear parameter (zero for
+    one the structure holds fixed), analytic.
+
+    With Phi_p the derivative of the phase, L_p that of log D and g_p that of the gain, the m-th
+    harmonic D^m (cos m Phi, sin m Phi) has derivative m D^m (L_p cos m Phi - Phi_p sin m Phi,
+    L_p sin m Phi + Phi_p cos m Phi); the fundamental g D (cos Phi, sin Phi) has g times that, plus
+    g_p D (cos Phi, sin Phi). The phase's: Phi_omega = t, Phi_zeta = -h(t), Phi_gamma = -zeta dh/dgamma = -4 zeta t^3 phi2'(2 gamma t),
+    Phi_lag = -dPhi/dt = -(omega - zeta dh/dt), dh/dt = 4 t phi2 + 4 gamma t^2 phi2' (the sphere's
+    only; t = tau less the signal's lag); L_gamma = -tau.
+    """
+    xp = _namespace(params, structure, data)
+    swing = _swing(params, structure, data, xp)
+    omega, gamma, zeta, _, _ = swing.physical
+    t = swing.shifted
+    x = 2.0 * gamma * t
+    phi2 = _phi2(x, xp)
+    slope = _phi2_slope(x, phi2, xp)
+    zero = xp.zeros_like(t)
+    sphere = xp.stack([zero[0], xp.ones_like(t[1])])
+    phase_slopes = xp.stack(
+        [t, -4.0 * zeta * t**3 * slope, -2.0 * t**2 * phi2, -sphere * (omega - zeta * (4.0 * t * phi2 + 2.0 * t * x * slope)), zero]
+    )
+    envelope_slopes = xp.stack([zero, -swing.tau, zero, zero, zero])
+    gain_slopes = xp.stack([zero, zero, zero, zero, sphere])
+    cos, sin, cos2, sin2, cos3, sin3 = swing.harmonics
+    envelope = swing.envelope
+    fundamental = swing.gains * envelope
+    squared, cubed = envelope**2, envelope**3
+    turn, grow = phase_slopes, envelope_slopes
+    constant = xp.zeros_like(turn)
+    slopes = xp.stack(
+        [
+            fundamental * (grow * cos - turn * sin) + gain_slopes * envelope * cos,
+            fundamental * (grow * sin + turn * cos) + gain_slopes * envelope * sin,
+            constant, constant, constant,
+            2.0 * squared * (grow * cos2 - turn * sin2), 2.0 * squared * (grow * sin2 + turn * cos2),
+            3.0 * cubed * (grow * cos3 - turn * sin3), 3.0 * cubed * (grow * sin3 + turn * cos3),
+        ],
+        axis=-1,
+    )  # fmt: skip
+    chain = structure.free * data.scales
+    return slopes * _used(structure, xp)[None, :, None, :] * chain[:, None, None, None]
+
+
+def design(params: Array, structure: Structure, data: FitData) -> Array:
     """The (2N, 16) matrix of the linear model's columns, unweighted; left-out columns are zero."""
-    return jnp.einsum("knb,kbc->knc", basis(params, structure, data), _placement()).reshape(-1, 16)
+    xp = _namespace(params, structure, data)
+    return xp.einsum("knb,kbc->knc", basis(params, structure, data), PLACEMENT).reshape(-1, 16)
 
 
-def _normal_equations(
-    params: jax.Array, structure: Structure, data: FitData, weights: jax.Array
-) -> tuple[jax.Array, jax.Array, jax.Array, jax.Array]:
-    """(weighted basis (2, N, 9), weighted data (2, N), normal matrix (16, 16), right-hand side (16,)).
+def normal_equations(
+    functions: Array, structure: Structure, data: FitData, weights: Array
+) -> tuple[Array, Array, Array, Array]:
+    """(weighted basis (2, N, 9), weighted data (2, N), normal matrix (16, 16), right-hand side (16,))
+    of the basis ``functions`` (2, N, 9).
 
     Built per signal (9 x 9 blocks placed into 16 x 16): a third of the work of the full design.
     Left-out coefficients get an identity row, so they solve to zero.
     """
-    placement = _placement()
-    weighted = basis(params, structure, data) * weights.reshape(2, -1, 1)
+    xp = array_namespace(functions, weights, *structure, *data)
+    weighted = functions * weights.reshape(2, -1, 1)
     target = (weights * data.y).reshape(2, -1)
-    blocks = jnp.einsum("knb,knc->kbc", weighted, weighted)
-    normal = jnp.einsum("kbi,kbc,kcj->ij", placement, blocks, placement) + jnp.diag(1.0 - structure.linear)
-    rhs = jnp.einsum("kbi,knb,kn->i", placement, weighted, target)
+    blocks = xp.einsum("knb,knc->kbc", weighted, weighted)
+    normal = xp.einsum("kbi,kbc,kcj->ij", PLACEMENT, blocks, PLACEMENT) + xp.diag(1.0 - structure.linear)
+    rhs = xp.einsum("kbi,kb->i", PLACEMENT, xp.einsum("knb,kn->kb", weighted, target))
     return weighted, target, normal, rhs
 
 
-def linear_solution(params: jax.Array, structure: Structure, data: FitData) -> tuple[jax.Array, jax.Array]:
+def linear_solution(params: Array, structure: Structure, data: FitData) -> tuple[Array, Array]:
     """(coefficients (16,), weighted residual (2N,)) of the weighted least-squares linear fit."""
-    weighted, target, normal, rhs = _normal_equations(params, structure, data, data.w)
-    coefficients = jnp.linalg.solve(normal, rhs)
-    fitted = jnp.einsum("knb,kbi,i->kn", weighted, _placement(), coefficients)
+    xp = _namespace(params, structure, data)
+    weighted, target, normal, rhs = normal_equations(basis(params, structure, data), structure, data, data.w)
+    coefficients = xp.linalg.solve(normal, rhs)
+    fitted = xp.einsum("knb,kb->kn", weighted, xp.einsum("kbi,i->kb", PLACEMENT, coefficients))
     return coefficients, (target - fitted).reshape(-1)
 
 
-def projected_residual(params: jax.Array, structure: Structure, data: FitData) -> jax.Array:
+def projected_residual(params: Array, structure: Structure, data: FitData) -> Array:
     """The weighted residual with the linear coefficients at their best: what LM minimises."""
     return linear_solution(params, structure, data)[1]
 
 
-_solver = jaxopt.LevenbergMarquardt(
-    residual_fun=projected_residual,
-    maxiter=MAX_ITERATIONS,
-    stop_criterion="madsen-nielsen",
-    xtol=STEP_TOLERANCE,
-    gtol=0.0,
-    solver="cholesky",
-    materialize_jac=True,
-    implicit_diff=False,
-)
-
-
-@jax.jit
-def fit(params: jax.Array, structure: Structure, data: FitData) -> tuple[jax.Array, jax.Array, jax.Array, jax.Array]:
-    """Levenberg-Marquardt from ``params``: (scaled parameters, coefficients, residual, iterations)."""
-    result = _solver.run(params, structure, data)
-    coefficients, residual = linear_solution(result.params, structure, data)
-    return result.params, coefficients, residual, result.state.iter_num
-
-
-def full_residual(combined: jax.Array, structure: Structure, data: FitData) -> jax.Array:
+def full_residual(combined: Array, structure: Structure, data: FitData) -> Array:
+    """The weighted residual in all 5 + 16 parameters, non-linear first."""
     params, coefficients = combined[:5], combined[5:]
     return data.w * (data.y - design(params, structure, data) @ coefficients)
-
-
-@jax.jit
-def jacobian(
-    params: jax.Array, coefficients: jax.Array, structure: Structure, data: FitData
-) -> tuple[jax.Array, jax.Array]:
-    """((2N, 21) Jacobian of the weighted residual in all parameters, non-linear first; the residual)."""
-    combined = jnp.concatenate([params, coefficients])
-    return jax.jacfwd(full_residual)(combined, structure, data), full_residual(combined, structure, data)
-
-
-def log_marginal(
-    params: jax.Array, log_noise: jax.Array, inflation: jax.Array, structure: Structure, data: FitData
-) -> jax.Array:
-    """Log likelihood, the linear coefficients integrated out under flat priors.
-
-    Each signal's weighted residuals are Gaussian with standard deviation exp(log_noise[k]); the
-    log likelihood is divided by ``inflation`` (an effective-sample-size correction: correlated
-    residuals carry less information than as many independent ones).
-    """
-    count = data.tau.shape[0] // 2
-    weights = data.w / jnp.repeat(jnp.exp(log_noise) * jnp.sqrt(inflation), count)
-    _, target, normal, rhs = _normal_equations(params, structure, data, weights)
-    factor = jnp.linalg.cholesky(normal)
-    chi2 = jnp.sum(target**2) - rhs @ jax.scipy.linalg.cho_solve((factor, True), rhs)
-    used = jnp.stack([jnp.sum(data.w[:count] > 0), jnp.sum(data.w[count:] > 0)])
-    return -jnp.sum(used * log_noise) / inflation - 0.5 * chi2 - jnp.sum(jnp.log(jnp.diag(factor)))

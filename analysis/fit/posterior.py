@@ -32,6 +32,7 @@ import numpy as np
 
 from analysis.fit import model
 from analysis.fit.least_squares import SineFit
+from analysis.fit.marginal import in_float64, log_marginal
 
 WALKERS = 32
 BURN_IN = 150
@@ -94,14 +95,14 @@ def _log_posterior(
 
     def one(position: jax.Array) -> jax.Array:
         params = base.at[free].set(position[:count])
-        value = model.log_marginal(params, position[count:], inflation, structure, data)
+        value = log_marginal(params, position[count:], inflation, structure, data)
         inside = jnp.all((position >= low) & (position <= high))
         return jnp.where(inside & jnp.isfinite(value), value, -jnp.inf)
 
     return jax.vmap(one)(walkers)
 
 
-@model.in_float64
+@in_float64
 def sample_posterior(fit: SineFit, seed: int, steps: int = STEPS, burn_in: int = BURN_IN) -> Posterior:
     """Sample the latency's posterior under the fit's model, starting from the fit."""
     tempering = fit.lag_inflation * (fit.critical / NORMAL_95) ** 2

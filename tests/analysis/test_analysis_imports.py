@@ -27,3 +27,19 @@ def test_importing_every_analysis_module_leaves_jax_in_32_bit_mode():
         "print('analysis.fit.model' in names, jax.config.jax_enable_x64)\n"
     )
     assert run_python(code).split() == ["True", "False"]
+
+
+def test_the_least_squares_fit_imports_no_jax():
+    code = (
+        "import sys\n"
+        "import numpy as np\n"
+        "import analysis.estimators.sinefit\n"
+        "from analysis.fit.least_squares import Guess, fit_sine\n"
+        "from analysis.signals import SwingSignals\n"
+        "t = np.arange(720) / 120\n"
+        "led = 40 * np.sin(2 * np.pi * t / 0.8)\n"
+        "sphere = 25 * np.sin(2 * np.pi * (t - 0.05) / 0.8)\n"
+        "fit = fit_sine(SwingSignals(t, led, sphere), (0.01, 0.01), Guess(1.25, 0.0, 0.0, 0.054, 0.6))\n"
+        "print(round(fit.latency_s, 6), [name for name in sys.modules if name.split('.')[0] in ('jax', 'jaxlib', 'jaxopt')])\n"
+    )
+    assert run_python(code).split() == ["0.05", "[]"]
