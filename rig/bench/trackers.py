@@ -12,8 +12,8 @@ an LSL outlet, with the emulator's log of every record's fate) and records it in
 * us_per_sample: this process's CPU time over the run (the reader thread, liblsl's threads, the
   recording loop writing both files), per recorded sample; reader_us_per_sample: the reader
   thread's alone (reading, decoding, checking, mapping the clock);
-* latency_ms_median, latency_ms_p95: from the emulator's write of a record to the moment the
-  recording loop had it in hand (where a predictor would get it), both on the monotonic clock.
+* latency_ms_median, latency_ms_p95: from the emulator's write of a record to its arrival, when
+  the reader has queued it and a predictor's `poll()` gets it, both on the monotonic clock.
 
 Rows are keyed by the device's time (to the microsecond), which every emulated record carries.
 """
@@ -110,9 +110,9 @@ def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: C
     clock = MonotonicClock()
     arrivals: list[tuple[float, float]] = []
 
-    def on_batch(records: list[TrackerRecord], t_available: float) -> None:
-        available = clock.origin_ns / 1e9 + t_available
-        arrivals.extend((record.device_time, available) for record in records)
+    def on_batch(records: list[TrackerRecord]) -> None:
+        origin = clock.origin_ns / 1e9
+        arrivals.extend((record.device_time, origin + record.t_arrival) for record in records)
 
     cpu = resource.getrusage(resource.RUSAGE_SELF)
     try:
@@ -213,7 +213,7 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
     latency.bar(x + 0.2, [r["latency_ms_p95"] or 0.0 for r in rows], width=0.4, label="95th percentile")
     latency.axhline(TARGET_LATENCY_MEDIAN_MS, color="k", linestyle="--")
     latency.axhline(TARGET_LATENCY_P95_MS, color="k", linestyle=":")
-    latency.set_ylabel("emulator write to recording loop (ms)")
+    latency.set_ylabel("emulator write to queued for a predictor (ms)")
     latency.set_xticks(x, labels, fontsize=8)
     latency.legend()
     figure.tight_layout()

@@ -251,7 +251,7 @@ def _add_trackers(benchmarks: argparse._SubParsersAction) -> None:
         description="Stream the simulated pendulum from `rig emulate-tracker` (a pseudo-terminal, TCP, LSL), clean and "
         "with faults (1%% of bytes corrupted and a 0.5 s disconnect; a disconnect for LSL), record each with the rig's "
         "tracker source as `rig record-tracker` does, and report per case what was sent, recorded, missing, fabricated "
-        "and counted corrupt, the CPU per sample, and the latency from the emulator's write to the recording loop.",
+        "and counted corrupt, the CPU per sample, and the latency from the emulator's write to the sample's queueing for a predictor.",
     )
     parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the rows as a JSON list")
     parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="plot CPU per sample and latency per case")

@@ -25,7 +25,6 @@ from typing import Any, Callable
 import numpy as np
 
 import predictors
-from predictors import sample_row
 from rig.clock import MonotonicClock
 from rig.devices.protocols import Camera, Display
 from rig.devices.registry import DeviceContext, make_device
@@ -132,7 +131,7 @@ def _record_left_over(tracker: Any, record: RunRecord) -> None:
     """Samples that arrived after the session last took any (it has closed the tracker): recorded too."""
     if isinstance(tracker, TrackerStream):
         for left in tracker.take_queued():
-            record.tracker.write(sample_row(left.sample))
+            record.tracker.write(left.sample_row())
 
 
 def frame_view(tracker_spec: str, clock: MonotonicClock, width: int, height: int, mirror: bool, seconds: float = FRAMING_S) -> View:

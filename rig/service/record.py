@@ -4,9 +4,12 @@ The folder gets `tracker.csv` (the one tracker sample format, `predictors.SAMPLE
 `rig bench predictors --trace` and `rig tune --trace` read), `tracker_device.csv` (row for row
 beside it: what the device said besides the pose, its own time, record counter and angular rate)
 and `tracker.json` (the device, its profile, the clock mapping with its uncertainty, the counters,
-link events, and whether the run was interrupted). Rows are flushed as each batch arrives; Ctrl-C
-ends the recording cleanly: the reader is stopped, what it had queued is written, the sidecar
-too, and the interrupt goes on to the caller.
+link events, and whether the run was interrupted). The tracker's reader thread queues samples as
+they arrive, where a predictor's `poll()` would take them; the recording takes what is queued every
+WRITE_INTERVAL_S and flushes it, so a crash of the process loses at most that much, and the
+recording costs one wake-up per interval rather than one per sample (at 1000 Hz the wake-ups
+would cost more CPU than the samples). Ctrl-C ends the recording cleanly: the reader is stopped,
+what it had queued is written, the sidecar too, and the interrupt goes on to the caller.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from predictors import SAMPLE_COLUMNS, sample_row
+from predictors import SAMPLE_COLUMNS
 from rig.clock import MonotonicClock
 from rig.devices.registry import DeviceContext, make_device
 from rig.devices.trackers.stream import TrackerRecord, TrackerStream
@@ -28,7 +31,7 @@ TRACKER_FILE = "tracker.csv"
 DEVICE_FILE = "tracker_device.csv"
 SIDECAR_FILE = "tracker.json"
 DEVICE_COLUMNS = ("t_arrival", "device_time", "seq", "wx", "wy", "wz")
-WAIT_S = 0.1
+WRITE_INTERVAL_S = 0.02
 
 
 @dataclass(frozen=True)
@@ -40,10 +43,10 @@ class TrackerRecording:
     sidecar: dict[str, Any]
 
 
-def _records(tracker: Any, timeout_s: float) -> list[TrackerRecord]:
+def _queued(tracker: Any) -> list[TrackerRecord]:
     if isinstance(tracker, TrackerStream):
-        return tracker.wait_records(timeout_s)
-    return [TrackerRecord(sample, None, None, None) for sample in tracker.wait(timeout_s)]
+        return tracker.poll_records()
+    return [TrackerRecord.of_sample(sample) for sample in tracker.poll()]
 
 
 def record_tracker(
@@ -53,13 +56,13 @@ def record_tracker(
     *,
     overwrite: bool = False,
     progress: Callable[[float, float], None] = lambda done, total: None,
-    on_batch: Callable[[list[TrackerRecord], float], None] = lambda records, t: None,
+    on_batch: Callable[[list[TrackerRecord]], None] = lambda records: None,
     clock: MonotonicClock | None = None,
 ) -> TrackerRecording:
     """Records the tracker `spec` for `duration_s` seconds (None: until interrupted) into `out_dir`,
     on `clock` (a new MonotonicClock by default).
 
-    `on_batch(records, t_available)` sees every batch with the rig time it was handed over.
+    `on_batch(records)` sees every batch as it is written.
     """
     tracker = make_device("tracker", spec, DeviceContext())
     try:
@@ -76,21 +79,23 @@ def record_tracker(
     ):
 
         def write(records: list[TrackerRecord]) -> None:
-            for record in records:
-                sample_csv.write(sample_row(record.sample))
-                device_csv.write((record.sample.t_arrival, record.device_time, record.seq, *(record.angular_rate or (None,) * 3)))
+            sample_csv.write_numbers([record.sample_row() for record in records])
+            device_csv.write_numbers(
+                [(r.t_arrival, r.device_time, r.seq, *(r.angular_rate or (None, None, None))) for r in records]
+            )
             sample_csv.flush()
             device_csv.flush()
 
         tracker.connect(clock)
         try:
             while (now := clock.now()) < end:
-                records = _records(tracker, min(WAIT_S, end - now))
+                clock.wait_until(min(now + WRITE_INTERVAL_S, end))
+                records = _queued(tracker)
                 if records:
                     write(records)
                     samples += len(records)
-                    on_batch(records, clock.now())
-                progress(min(now, end), end)
+                    on_batch(records)
+                progress(min(clock.now(), end), end)
             interrupted = False
         finally:
             tracker.close()

@@ -62,6 +62,25 @@ def test_a_row_must_fill_the_header(tmp_path) -> None:
         record.write([1])
 
 
+def test_rows_of_numbers_written_in_bulk_must_fill_the_header_too(tmp_path) -> None:
+    with CsvRecord(tmp_path / "t.csv", ["a", "b"]) as record, pytest.raises(ValueError, match="2"):
+        record.write_numbers([(1.0, 2.0), (1.0,)])
+
+
+cell = st.one_of(st.none(), st.floats(), st.integers(), st.floats(width=32).map(np.float32), st.floats().map(np.float64))
+
+
+@given(rows=st.lists(st.lists(cell, min_size=3, max_size=3), max_size=5))
+def test_rows_of_numbers_written_in_bulk_are_the_rows_written_one_by_one(tmp_path_factory, rows) -> None:
+    folder = tmp_path_factory.mktemp("bulk")
+    with CsvRecord(folder / "one.csv", ["a", "b", "c"]) as one, CsvRecord(folder / "bulk.csv", ["a", "b", "c"]) as bulk:
+        for row in rows:
+            one.write(row)
+        bulk.write_numbers(rows)
+    assert (folder / "bulk.csv").read_text() == (folder / "one.csv").read_text()
+    assert bulk.rows == one.rows == len(rows)
+
+
 finite = st.floats(allow_nan=False, allow_infinity=False)
 
 

@@ -80,9 +80,8 @@ class HidLink:
                 f"cannot open HID device {self.ids} ({error}): check that it is plugged in (`rig devices` lists "
                 "what it sees) and that your user may read its /dev/hidraw* node (a udev rule)"
             ) from None
-        self._decoder.reset()
 
-    def read(self, clock: Clock) -> list[Reading]:
+    def receive(self, clock: Clock) -> bytes | None:
         device = self._device
         if device is None:
             raise LinkLost("the device is closed")
@@ -90,9 +89,13 @@ class HidLink:
             report = device.read(self._read_bytes, READ_TIMEOUT_MS)
         except (OSError, ValueError) as error:
             raise LinkLost(str(error)) from None
-        if not report:
-            return []
-        return self._decoder.feed(bytes(report), clock.now())
+        return bytes(report) if report else None
+
+    def decode(self, chunk: bytes, t_arrival: float) -> list[Reading]:
+        return self._decoder.feed(chunk, t_arrival)
+
+    def restart(self) -> None:
+        self._decoder.reset()
 
     def close(self) -> None:
         device, self._device = self._device, None

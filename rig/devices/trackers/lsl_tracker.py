@@ -80,6 +80,7 @@ class LslLink:
         self.source_id = ""
         self._inlet: Any = None
         self._next_correction = 0.0
+        self._correction: tuple[float, float, float] | None = None
 
     def open(self, clock: Clock) -> None:
         lsl = pylsl()
@@ -102,11 +103,14 @@ class LslLink:
             raise RigError(f"LSL stream {self.name!r} did not answer: {error}") from None
         if self.mapping.origin_s is None:
             self.mapping.origin_s = lsl_origin(clock)
-        self.mapping.add_correction(correction, uncertainty, clock.now())
+        # Handed to the mapping with the first samples, on the thread that maps them.
+        self._correction = (correction, uncertainty, clock.now())
         self._next_correction = clock.now() + CORRECTION_INTERVAL_S
         self._inlet = inlet
 
-    def read(self, clock: Clock) -> list[Reading]:
+    def receive(self, clock: Clock) -> tuple[list, list, tuple[float, float, float] | None] | None:
+        """(samples, their LSL stamps, a fresh clock correction (offset, uncertainty, rig time) or
+        None), or None if nothing came in time."""
         lsl = pylsl()
         inlet = self._inlet
         if inlet is None:
@@ -114,21 +118,33 @@ class LslLink:
         try:
             first, stamp = inlet.pull_sample(timeout=READ_TIMEOUT_S)
             if first is None:
-                return []
-            rest, stamps = inlet.pull_chunk(timeout=0.0)
-            t_arrival = clock.now()
-            if t_arrival >= self._next_correction:
-                self._next_correction = t_arrival + CORRECTION_INTERVAL_S
-                self.mapping.add_correction(*time_correction(inlet, 0.0), t_arrival)
+                return None
+            # A chunk pull allocates buffers for its largest size: asked only for what is waiting.
+            waiting = inlet.samples_available()
+            rest, stamps = inlet.pull_chunk(timeout=0.0, max_samples=waiting) if waiting else ([], [])
+            now = clock.now()
+            if now >= self._next_correction:
+                self._next_correction = now + CORRECTION_INTERVAL_S
+                self._correction = (*time_correction(inlet, 0.0), now)
         except lsl.util.TimeoutError:
             pass  # no fresh estimate yet (liblsl measures in the background): the mapping keeps the last
         except lsl.util.LostError as error:
             raise LinkLost(f"the sender is gone ({error})") from None
+        correction, self._correction = self._correction, None
+        return [first, *rest], [stamp, *stamps], correction
+
+    def decode(self, chunk: tuple[list, list, tuple[float, float, float] | None], t_arrival: float) -> list[Reading]:
+        samples, stamps, correction = chunk
+        if correction is not None:
+            self.mapping.add_correction(*correction)
         readings = []
-        for values, device_time in zip([first, *rest], [stamp, *stamps]):
+        for values, device_time in zip(samples, stamps):
             px, py, pz, qw, qx, qy, qz = values
             readings.append(Reading(t_arrival, device_time, None, (px, py, pz), (qw, qx, qy, qz)))
         return readings
+
+    def restart(self) -> None:
+        pass
 
     def close(self) -> None:
         inlet, self._inlet = self._inlet, None

@@ -112,16 +112,15 @@ class SerialLink:
             raise _open_problem(self.url, error) from None
         self._fd = _file_descriptor(port)
         self._port = port
-        self._decoder.reset()
 
-    def read(self, clock: Clock) -> list[Reading]:
+    def receive(self, clock: Clock) -> bytes | None:
         port = self._port
         if port is None:
             raise LinkLost("the port is closed")
         try:
             if self._fd is not None:
                 if not select.select([self._fd], [], [], READ_TIMEOUT_S)[0]:
-                    return []
+                    return None
                 data = os.read(self._fd, CHUNK_BYTES)
                 if not data:
                     raise LinkLost("the port reports data but returned none (disconnected)")
@@ -130,9 +129,13 @@ class SerialLink:
         except (serial.SerialException, OSError, TypeError, ValueError) as error:
             # pyserial raises TypeError when close() takes the port away in the middle of a read.
             raise LinkLost(str(error)) from None
-        if not data:
-            return []
-        return self._decoder.feed(data, clock.now())
+        return data or None
+
+    def decode(self, chunk: bytes, t_arrival: float) -> list[Reading]:
+        return self._decoder.feed(chunk, t_arrival)
+
+    def restart(self) -> None:
+        self._decoder.reset()
 
     def close(self) -> None:
         port, self._port = self._port, None

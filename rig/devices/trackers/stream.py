@@ -1,11 +1,16 @@
 """One real tracker source: a link read by its own thread, samples handed over without blocking.
 
 `TrackerStream` is the `TrackerSource` (rig.devices.protocols) of every real tracker. Its link
-(serial, HID, LSL) turns what the device sends into readings; the stream's reader thread checks
-each one, maps its device time onto the rig clock, counts what was wrong, and queues the sample.
-The session (or `rig record-tracker`) takes samples with `poll()`, which never blocks, or waits for
-the next with `wait(timeout)`. A lost link is logged, leaves a gap, and is reopened until the
-stream is closed; everything that happened is in `report()`.
+(serial, HID, LSL) receives what the device sends on the stream's reader thread, which stamps each
+chunk with its arrival time and queues it: that is all the thread does per wake-up, because at
+1000 records a second the wake-ups are most of the cost, and code run once per wake-up runs
+cold, several times slower than the same code run over a batch. The consumer's `poll()` (the
+session's render loop, or `rig record-tracker`), which never blocks, or `wait(timeout)`, decodes
+the queued chunks into records: each is checked, its device time mapped onto the rig clock,
+what was wrong counted, in arrival order. A record is available to a predictor from its arrival
+time, when the reader queued its chunk. A lost link is logged, leaves a gap, and is
+reopened until the stream is closed; everything that happened is in `report()`. One thread
+consumes a stream.
 """
 
 from __future__ import annotations
@@ -15,7 +20,7 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass
-from typing import Any, Callable, Protocol
+from typing import Any, Callable, NamedTuple, Protocol
 
 from predictors import PoseSample
 from rig.clock import Clock
@@ -39,8 +44,9 @@ class LinkLost(Exception):
 
 
 class Link(Protocol):
-    """What a stream reads: a device's transport and its decoder. `read` waits briefly (tens of ms)
-    so the reader notices close; it returns the readings completed, stamped with `clock`."""
+    """What a stream reads: a device's transport and its decoder. `receive` runs on the reader
+    thread and waits briefly (tens of ms) so that the reader notices close; `decode` and `restart`
+    run on the consumer's thread, in the order the chunks came."""
 
     description: str
     corrupt: int
@@ -48,20 +54,53 @@ class Link(Protocol):
     def open(self, clock: Clock) -> None:
         """Opens the device, its times to go on `clock`; RigError saying what to do if it cannot."""
 
-    def read(self, clock: Clock) -> list[Reading]:
-        """Raises LinkLost when the device went away."""
+    def receive(self, clock: Clock) -> Any:
+        """What arrived (None if nothing did in time); raises LinkLost when the device went away."""
+
+    def decode(self, chunk: Any, t_arrival: float) -> list[Reading]:
+        """The readings a received chunk completes, stamped `t_arrival`."""
+
+    def restart(self) -> None:
+        """Forgets a partial record: what follows comes from a reopened device."""
 
     def close(self) -> None: ...
 
 
-@dataclass(frozen=True)
-class TrackerRecord:
-    """A sample and what the device said beside it: its own time (s), counter, angular rate (rad/s)."""
+class _Chunk(NamedTuple):
+    payload: Any
+    t_arrival: float
 
-    sample: PoseSample
+
+_RESTORED = object()
+"""Queued after the chunks of a lost link, before those of the reopened one."""
+
+
+class TrackerRecord(NamedTuple):
+    """A checked record: its sensor and arrival times on the rig clock (s), position (m) and unit
+    orientation (w, x, y, z), and what the device said beside them: its own time (s), counter and
+    angular rate (rad/s). Plain numbers: a recording writes them as they are, and only a predictor
+    that asks for the `sample` pays for building one."""
+
+    t_sensor: float
+    t_arrival: float
+    position: tuple[float, float, float]
+    orientation: tuple[float, float, float, float]
     device_time: float | None
     seq: int | None
     angular_rate: tuple[float, float, float] | None
+
+    @classmethod
+    def of_sample(cls, sample: PoseSample) -> TrackerRecord:
+        """The record of a source that says nothing beside the pose."""
+        return cls(sample.t_sensor, sample.t_arrival, tuple(sample.position.tolist()), tuple(sample.orientation.tolist()), None, None, None)
+
+    @property
+    def sample(self) -> PoseSample:
+        return PoseSample(self.t_sensor, self.t_arrival, self.position, self.orientation)
+
+    def sample_row(self) -> tuple[float, ...]:
+        """The sample's values in the trace format's order (`predictors.SAMPLE_COLUMNS`)."""
+        return (self.t_sensor, self.t_arrival, *self.position, *self.orientation)
 
 
 @dataclass(frozen=True)
@@ -97,8 +136,9 @@ class TrackerStream:
         self._sequence = SequenceCheck(self.counters, sequence_bits)
         self._describe = describe
         self._clock: Clock | None = None
-        self._queue: deque[TrackerRecord] = deque()
+        self._chunks: deque[_Chunk | object] = deque()
         self._ready = threading.Condition()
+        self._waiting = False
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._failure: BaseException | None = None
@@ -122,24 +162,31 @@ class TrackerStream:
         return [record.sample for record in self.wait_records(timeout_s)]
 
     def poll_records(self) -> list[TrackerRecord]:
-        """Every record queued since the last call, in arrival order; never blocks."""
+        """Every record received since the last call, in arrival order; never blocks."""
         records = self.take_queued()
         if not records:
             self._raise_failure()
         return records
 
     def take_queued(self) -> list[TrackerRecord]:
-        """Every record queued, whatever became of the reader (for the end of a run)."""
-        with self._ready:
-            records = list(self._queue)
-            self._queue.clear()
+        """Every record received, whatever became of the reader (for the end of a run)."""
+        chunks = self._chunks
+        records: list[TrackerRecord] = []
+        while chunks:
+            chunk = chunks.popleft()
+            if chunk is _RESTORED:
+                self._restart()
+            else:
+                self._accept(chunk, records)
         return records
 
     def wait_records(self, timeout_s: float) -> list[TrackerRecord]:
-        """As poll_records, after waiting up to `timeout_s` for the first."""
+        """As poll_records, after waiting up to `timeout_s` for something to arrive."""
         with self._ready:
-            if not self._queue and self._failure is None:
+            self._waiting = True
+            if not self._chunks and self._failure is None:
                 self._ready.wait(timeout_s)
+            self._waiting = False
         return self.poll_records()
 
     def close(self) -> None:
@@ -161,7 +208,7 @@ class TrackerStream:
             "reader_cpu_us_per_sample": self.reader_cpu_s / max(self.counters.received, 1) * 1e6,
             "latency": self.latency.summary() if self.mapping.latency_known else None,
             "clock_mapping": self.mapping.describe(),
-            "events": [{"t": e.t, "what": e.what, "detail": e.detail} for e in self.events],
+            "events": [{"t": e.t, "what": e.what, "detail": e.detail} for e in sorted(self.events, key=lambda e: e.t)],
         }
 
     def _raise_failure(self) -> None:
@@ -177,66 +224,84 @@ class TrackerStream:
 
     def _read_loop(self) -> None:
         started = time.thread_time()
+        clock, link, chunks = self._clock, self.link, self._chunks
         try:
             while not self._stop.is_set():
                 try:
-                    readings = self.link.read(self._clock)
+                    payload = link.receive(clock)
                 except LinkLost as lost:
                     self._lost(str(lost))
                     if not self._reopen():
                         return
                     continue
-                self._count_corrupt()
-                if readings:
-                    self._accept(readings)
-        except BaseException as error:  # noqa: BLE001 - handed to the session's thread, never lost
+                if payload is not None:
+                    chunks.append(_Chunk(payload, clock.now()))
+                    if self._waiting:
+                        self._wake()
+        except BaseException as error:  # noqa: BLE001 - handed to the consumer's thread, never lost
             self._failure = error
-            with self._ready:
-                self._ready.notify_all()
+            self._wake()
         finally:
             self.reader_cpu_s += time.thread_time() - started
 
-    def _accept(self, readings: list[Reading]) -> None:
-        """Checks, counts and queues the readings of one read; the clock mapping learns from all of
-        them before it maps any, so records read together keep their order in sensor time."""
-        counters, mapping = self.counters, self.mapping
+    def _accept(self, chunk: _Chunk, records: list[TrackerRecord]) -> None:
+        """Decodes, checks and counts one chunk's readings and adds their records to `records`; the
+        clock mapping learns from all of them before it maps any, so records that came together
+        keep their order in sensor time."""
+        readings = self.link.decode(chunk.payload, chunk.t_arrival)
+        self._count_corrupt()
+        if not readings:
+            return
+        counters, mapping, sequence = self.counters, self.mapping, self._sequence
         possible = []
         for reading in readings:
             problem = check_reading(reading, self._unit_tolerance)
             if problem is not None:
                 counters.rejected += 1
-                self._sequence.discarded(1)
+                sequence.discarded(1)
                 if counters.rejected <= LOGGED_REJECTIONS:
                     log.warning("tracker %s: impossible record discarded: %s", self.name, problem)
                 continue
-            self._sequence.accept(reading.seq, reading.device_time)
+            sequence.accept(reading.seq, reading.device_time)
             mapping.observe(reading.device_time, reading.t_arrival)
             possible.append(reading)
-        records = []
+        if not possible:
+            return
+        latency = self.latency if mapping.latency_known else None
         for reading in possible:
             t_sensor = mapping.sensor_time(reading.device_time, reading.t_arrival)
-            if mapping.latency_known:
-                self.latency.add(reading.t_arrival - t_sensor)
-            sample = PoseSample(t_sensor, reading.t_arrival, reading.position, reading.orientation)
-            records.append(TrackerRecord(sample, reading.device_time, reading.seq, reading.angular_rate))
-        counters.received += len(records)
-        if records:
-            first = records[0].sample.t_arrival
-            if self._last_arrival is not None and first - self._last_arrival > GAP_S:
-                self._event("gap", f"no samples for {first - self._last_arrival:.3f} s")
-            self._last_arrival = records[-1].sample.t_arrival
-            with self._ready:
-                self._queue.extend(records)
-                self._ready.notify_all()
+            if latency is not None:
+                latency.add(reading.t_arrival - t_sensor)
+            records.append(
+                TrackerRecord(t_sensor, reading.t_arrival, reading.position, reading.orientation, reading.device_time, reading.seq, reading.angular_rate)
+            )
+        counters.received += len(possible)
+        if self._last_arrival is not None and chunk.t_arrival - self._last_arrival > GAP_S:
+            self._event("gap", f"no samples for {chunk.t_arrival - self._last_arrival:.3f} s", chunk.t_arrival)
+        self._last_arrival = chunk.t_arrival
 
-    def _event(self, what: str, detail: str) -> None:
-        event = LinkEvent(self._clock.now(), what, detail)
+    def _wake(self) -> None:
+        """Wakes a consumer in `wait_records`: the reader appends without the lock (a deque's append
+        is atomic), and a consumer sets `_waiting` under it before it looks at the chunks, so a
+        chunk that comes after its look finds the flag set."""
+        with self._ready:
+            self._ready.notify_all()
+
+    def _restart(self) -> None:
+        """The chunks of a reopened link follow: a partial record is forgotten (and counted), a
+        counter or device clock may start again."""
+        self.link.restart()
+        self._count_corrupt()
+        self._sequence.link_restored()
+        self.mapping.restart()
+
+    def _event(self, what: str, detail: str, t: float | None = None) -> None:
+        event = LinkEvent(self._clock.now() if t is None else t, what, detail)
         self.events.append(event)
         log.warning("tracker %s: link %s at %.3f s: %s", self.name, what, event.t, detail)
 
     def _lost(self, detail: str) -> None:
         self.link.close()
-        self._count_corrupt()
         self._event("lost", f"{detail}; reconnecting")
 
     def _reopen(self) -> bool:
@@ -249,8 +314,7 @@ class TrackerStream:
                 wait = min(2 * wait, RECONNECT_LONGEST_WAIT_S)
                 continue
             self.counters.reconnects += 1
-            self._sequence.link_restored()
-            self.mapping.restart()
+            self._chunks.append(_RESTORED)
             self._event("restored", self.link.description)
             return True
         return False
