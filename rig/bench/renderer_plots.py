@@ -65,9 +65,9 @@ def plot_rows(rows: list[dict[str, Any]], path: Path) -> None:
     _draw(path, 2, draw)
 
 
-def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path: Path) -> None:
+def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path: Path, label: str) -> None:
     """Latency against scene size, ours and the seed's; and latency against the direct frame time,
-    both in refreshes of each one's display."""
+    both in refreshes of each one's display. `label` says what ours measured (load, warp spec)."""
 
     def draw(figure: Any, axes: list[Any]) -> None:
         left, right = axes
@@ -81,7 +81,7 @@ def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path
                     right.plot(*zip(*points), marker="o" if filled else "s", color=colour, mfc=colour if filled else "none",
                                label=f"{renderer}, {who}")  # fmt: skip
         left.set(xscale="log", yscale="log", xlabel="scene triangles", ylabel="latency (ms), bars: sd",
-                 title="latency against scene size, measured by filming")  # fmt: skip
+                 title=f"latency against scene size, measured by filming\nthis machine: {label}")  # fmt: skip
         right.set(xscale="log", yscale="log", xlabel="direct frame time (display refreshes)", ylabel="latency (display refreshes)",
                   title="machine-independent: both in refreshes")  # fmt: skip
         for axis in axes:

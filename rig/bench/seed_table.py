@@ -14,7 +14,10 @@ the frame time measured before the run. Each latency is also given in display re
 stereo CRT, 60 Hz per eye, and its server's budget one 16.6 ms frame (its Table 1), so its figures
 are divided by that; ours by this run's refresh. The crossover is the scene size at which the
 direct renderer's latency overtakes the warp's, interpolated in log size, with the direct frame
-time there: the machine-independent way to set the two tables side by side.
+time there: the machine-independent way to set the two tables side by side. The load is a soup
+of small random triangles by default (the stress case) or a few tessellated solid objects (`load`,
+meshes), what the seed's scenes were; the rows, the printed table and the plot say which, and the
+warp renderer's spec.
 """
 
 from __future__ import annotations
@@ -60,6 +63,9 @@ class SeedTableSpec:
     size: tuple[int, int] = (320, 240)
     predictor: str = "hold"
     warp: str = "warp"
+    load: str = "soup"
+    """what the load's triangles make (`rig.render.gl.LOAD_SHAPES`): the soup is the stress case,
+    meshes a few tessellated solid objects, as the seed's scenes were"""
     server_ms: float | None = None
     refresh_hz: float = 60.0
     max_period_s: float = 8.0
@@ -128,11 +134,11 @@ def _probe_warp(spec: SeedTableSpec, setup, pendulum) -> tuple[float, float]:
 def run_seed_table(spec: SeedTableSpec, runs_dir: Path, log: Log) -> list[dict[str, Any]]:
     """Our rows (see the module docstring), one per renderer and load size."""
     machine = machine_name()
-    log(f"machine: {machine}")
+    log(f"machine: {machine}; load: {spec.load}; warp: {spec.warp}")
     rows: list[dict[str, Any]] = []
     refresh_ms = 1e3 / spec.refresh_hz
     for triangles in spec.sizes():
-        setup, pendulum = scene_setup(*spec.size, triangles, spec.refresh_hz)
+        setup, pendulum = scene_setup(*spec.size, triangles, spec.refresh_hz, spec.load)
         direct_s = float(np.median(time_direct(setup, spec.probe)[0]))
         if direct_s > spec.max_frame_s:
             log(f"{triangles} triangles: a direct frame takes {direct_s:.1f} s, over {spec.max_frame_s:g} s; the table stops here")
@@ -141,14 +147,15 @@ def run_seed_table(spec: SeedTableSpec, runs_dir: Path, log: Log) -> list[dict[s
         for renderer, app_s, comp_s in (("direct", direct_s, 0.0), (spec.warp, client_s, server_s)):
             started = time.perf_counter()
             run = LatencyRun(renderer, triangles, spec.size, spec.predictor, server_ms=spec.server_ms, refresh_hz=spec.refresh_hz,
-                             camera=spec.camera, min_duration_s=spec.min_duration_s, max_period_s=spec.max_period_s)  # fmt: skip
-            figures = film_latency(run, app_s, comp_s, runs_dir / f"seed-{renderer.replace(':', '_')}-{triangles}")
+                             camera=spec.camera, min_duration_s=spec.min_duration_s, max_period_s=spec.max_period_s, load=spec.load)  # fmt: skip
+            figures = film_latency(run, app_s, comp_s, runs_dir / f"seed-{spec.load}-{renderer.replace(':', '_')}-{triangles}")
             latency = figures["latency_measured_ms"]
             if figures["frame_ms_median"] is None:
                 figures["frame_ms_median"] = app_s * 1e3 if renderer == "direct" else comp_s * 1e3
             rows.append({
                 **figures, "source": "this machine", "renderer": "direct" if renderer == "direct" else "warp", "spec": renderer,
-                "latency_refreshes": latency / refresh_ms if latency is not None else None, "refresh_ms": refresh_ms, "machine": machine,
+                "load": spec.load, "latency_refreshes": latency / refresh_ms if latency is not None else None, "refresh_ms": refresh_ms,
+                "machine": machine,
             })  # fmt: skip
             shown = f"{latency:.1f} ms (sd {figures['latency_sd_ms'] or 0:.1f})" if latency is not None else figures["latency_note"]
             log(f"{triangles:>9} triangles {renderer:8}: frame {figures['frame_ms_median'] or 0:8.1f} ms, latency {shown} "
@@ -156,6 +163,13 @@ def run_seed_table(spec: SeedTableSpec, runs_dir: Path, log: Log) -> list[dict[s
         if triangles * 4 > spec.max_triangles or direct_s * 4 > spec.max_frame_s:
             break
     return rows
+
+
+def run_label(rows: list[dict[str, Any]]) -> str:
+    """What our rows measured: the load's shape and the warp renderer's spec."""
+    loads = "/".join(sorted({r["load"] for r in rows}))
+    warps = "/".join(sorted({r["spec"] for r in rows if r["renderer"] == "warp"}))
+    return f"load {loads}, warp {warps}"
 
 
 def _cell(value: float | None, digits: int = 1) -> str:
@@ -178,8 +192,8 @@ def _no_crossover(rows: list[dict[str, Any]]) -> str:
 def seed_table_text(rows: list[dict[str, Any]]) -> str:
     """Ours and the seed's, side by side, with each crossover."""
     sources = "; ".join(f"{renderer} {'/'.join(sorted({r['cost_source'] for r in rows if r['renderer'] == renderer}))}" for renderer in ("direct", "warp"))
-    lines = [f"this machine (costs: {sources}; {rows[0]['width']}x{rows[0]['height']}, {1e3 / rows[0]['refresh_ms']:g} Hz, "
-             f"predictor {rows[0]['predictor']}):" if rows else "this machine: no rows"]  # fmt: skip
+    lines = [f"this machine ({run_label(rows)}; costs: {sources}; {rows[0]['width']}x{rows[0]['height']}, "
+             f"{1e3 / rows[0]['refresh_ms']:g} Hz, predictor {rows[0]['predictor']}):" if rows else "this machine: no rows"]  # fmt: skip
     lines.append(f"{'triangles':>10} | {'direct frame':>12} {'latency (sd)':>16} {'/refresh':>8} | {'warp frame':>10} "
                  f"{'latency (sd)':>16} {'/refresh':>8} {'missed':>7}")  # fmt: skip
     by = {(r["renderer"], r["triangles"]): r for r in rows}

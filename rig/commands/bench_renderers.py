@@ -77,10 +77,11 @@ def _seed_table(args: argparse.Namespace, runs: Path) -> tuple[list[dict], str]:
     spec = seed_table.QUICK_SPEC if args.quick else seed_table.SeedTableSpec()
     spec = replace(spec, predictor=args.predictor, server_ms=args.server_ms, max_frame_s=args.max_frame_s,
                    max_triangles=args.max_triangles if args.max_triangles is not None else spec.max_triangles,
-                   **({"warp": args.warp} if args.warp else {}), **({"size": args.resolutions[0]} if args.resolutions else {}))  # fmt: skip
+                   **({"warp": args.warp} if args.warp else {}), **({"load": args.load} if args.load else {}),
+                   **({"size": args.resolutions[0]} if args.resolutions else {}))  # fmt: skip
     rows = seed_table.run_seed_table(spec, runs, _log)
     if args.plot is not None:
-        renderer_plots.plot_seed_table(rows, seed_table.seed_rows(), args.plot)
+        renderer_plots.plot_seed_table(rows, seed_table.seed_rows(), args.plot, seed_table.run_label(rows))
     return rows + seed_table.seed_rows(), seed_table.seed_table_text(rows)
 
 
@@ -151,7 +152,7 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--resolutions", type=_resolution_list, metavar="WxH,...", help="display sizes; the first is the latency runs' (default 320x240,640x480,1280x720)")
     parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
     parser.add_argument("--warp", metavar="SPEC", help="the warp renderer and its options, e.g. warp:recon=grid,views=2 (default: warp)")
-    parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
+    parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants, --seed-table: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
     parser.add_argument("--variant", action="append", metavar="SPEC", help="a warp variant for --variants; repeat for several (default: the seeds' features one by one)")
     parser.add_argument("--predictor", default="hold", help="the predictor of every latency run, both renderers alike (default: %(default)s, as the seeds' Table 2)")
     parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")

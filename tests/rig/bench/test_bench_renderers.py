@@ -8,7 +8,9 @@ import json
 
 import pytest
 
-from rig.bench.renderers import QUICK_GRID, ROW_FIELDS
+from rig.bench import seed_table
+from rig.bench.renderer_latency import film_latency
+from rig.bench.renderers import QUICK_GRID, ROW_FIELDS, scene_setup
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
 from rig.commands import bench
 
@@ -93,13 +95,35 @@ def test_the_seed_table_films_both_renderers_alike_and_sets_the_seeds_figures_be
     assert {(r["renderer"], r["triangles"]) for r in ours} == {(renderer, n) for renderer in ("direct", "warp") for n in (1_000, 4_000)}
     for r in ours:
         assert {"renderer", "triangles", "width", "latency_measured_ms", "latency_sd_ms", "frame_ms_median", "cost_source"} <= set(r)
-        assert r["cost_source"] == "measured" and r["predictor"] == "hold" and r["width"] == 160
+        assert r["cost_source"] == "measured" and r["predictor"] == "hold" and r["width"] == 160 and r["load"] == "soup"
         assert abs(r["latency_measured_ms"] - r["latency_true_ms"]) < 1.5 and r["latency_sd_ms"] >= 0
         assert r["latency_refreshes"] == pytest.approx(r["latency_measured_ms"] / (1e3 / 60))
     assert len(seed) == 2 * len(SEED_TABLE_2)
     printed = capsys.readouterr().out
     assert "crossover, seed: 2.15M triangles" in printed and "780.0 (14.2)" in printed
     assert (tmp_path / "plot.png").stat().st_size > 20_000
+
+
+@pytest.mark.slow
+def test_the_seed_table_probes_and_films_the_load_and_warp_it_is_given_and_says_so(tmp_path, capsys, monkeypatch):
+    probed, filmed = [], []
+
+    def probe(*args):
+        probed.append(args[4])
+        return scene_setup(*args)
+
+    def film(run, *args):
+        filmed.append((run.renderer, run.load))
+        return film_latency(run, *args)
+
+    monkeypatch.setattr(seed_table, "scene_setup", probe)
+    monkeypatch.setattr(seed_table, "film_latency", film)
+    rows = run_quick(tmp_path, "--seed-table", "--load", "meshes", "--warp", "warp:recon=grid")
+    assert probed == ["meshes", "meshes"] and filmed == [("direct", "meshes"), ("warp:recon=grid", "meshes")] * 2
+    ours = [r for r in rows if r["source"] == "this machine"]
+    assert {(r["renderer"], r["spec"], r["load"]) for r in ours} == {("direct", "direct", "meshes"), ("warp", "warp:recon=grid", "meshes")}
+    assert all(r["latency_measured_ms"] > 0 and r["cost_source"] == "measured" for r in ours)
+    assert "this machine (load meshes, warp warp:recon=grid;" in capsys.readouterr().out
 
 
 @pytest.mark.slow
