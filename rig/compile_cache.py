@@ -1,10 +1,10 @@
-"""Compiled fits kept between runs: JAX's persistent compilation cache, on by default for the `rig`
-command line (and the Dask workers it starts, which inherit its environment).
+"""Compiled programs kept between runs: JAX's persistent compilation cache, on by default for the
+`rig` command line (and the Dask workers it starts, which inherit its environment).
 
-The analyser's fit is compiled by XLA on its first use in a process, which costs seconds against a
-short clip's fraction of a second of fitting. The cache holds every compiled program on disk, so a
-later process (the next `rig analyse`, a batch worker) loads it instead. Set JAX_COMPILATION_CACHE_DIR
-to choose the folder.
+What runs on JAX (the `bayes` estimator's likelihood, predictor tuning) is compiled by XLA on its
+first use in a process, which costs seconds. The cache holds every compiled program on disk, so a
+later process loads it instead. Set JAX_COMPILATION_CACHE_DIR to choose the folder. The default
+analysis (`sinefit`) is numpy and compiles nothing.
 """
 
 from __future__ import annotations
