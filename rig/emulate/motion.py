@@ -6,6 +6,7 @@ them up.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +25,9 @@ class Motion:
         self.rate_hz = rate_hz
         self.source = str(trace) if trace else "simulated pendulum"
         if trace is None:
-            pendulum = Pendulum(PendulumConfig(), t_end=duration_s + 2.0)
+            # Poses come a block at a time: the window covers the whole block of the last sample.
+            blocks = math.ceil((duration_s * rate_hz + 1) / BLOCK)
+            pendulum = Pendulum(PendulumConfig(), t_end=max(duration_s + 2.0, (blocks * BLOCK + 1) / rate_hz))
             self._pose_at = pendulum.sensor_pose
         else:
             recorded = read_trace(trace)

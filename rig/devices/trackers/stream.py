@@ -132,6 +132,8 @@ class TrackerStream:
         self.events: list[LinkEvent] = []
         self.reader_cpu_s = 0.0
         """CPU time the reader thread has used, once it has ended (after close)."""
+        self.decode_cpu_s = 0.0
+        """CPU time the consumer has spent decoding, checking and mapping records."""
         self._unit_tolerance = unit_tolerance
         self._sequence = SequenceCheck(self.counters, sequence_bits)
         self._describe = describe
@@ -170,6 +172,7 @@ class TrackerStream:
 
     def take_queued(self) -> list[TrackerRecord]:
         """Every record received, whatever became of the reader (for the end of a run)."""
+        started = time.thread_time()
         chunks = self._chunks
         records: list[TrackerRecord] = []
         while chunks:
@@ -178,6 +181,7 @@ class TrackerStream:
                 self._restart()
             else:
                 self._accept(chunk, records)
+        self.decode_cpu_s += time.thread_time() - started
         return records
 
     def wait_records(self, timeout_s: float) -> list[TrackerRecord]:
@@ -206,6 +210,7 @@ class TrackerStream:
             **self._describe(),
             "counters": self.counters.as_dict(),
             "reader_cpu_us_per_sample": self.reader_cpu_s / max(self.counters.received, 1) * 1e6,
+            "reading_cpu_us_per_sample": (self.reader_cpu_s + self.decode_cpu_s) / max(self.counters.received, 1) * 1e6,
             "latency": self.latency.summary() if self.mapping.latency_known else None,
             "clock_mapping": self.mapping.describe(),
             "events": [{"t": e.t, "what": e.what, "detail": e.detail} for e in sorted(self.events, key=lambda e: e.t)],

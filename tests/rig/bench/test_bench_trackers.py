@@ -1,0 +1,36 @@
+"""The tracker bench's parts on a short case: what it counts must be what the emulator sent."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from rig.bench import trackers
+
+
+def test_a_clean_pty_case_counts_every_record_sent_and_measures_its_costs(tmp_path: Path) -> None:
+    case = trackers.Case("serial", "pty", "binary-pose", "none")
+    row = trackers.run_case(case, rate_hz=200.0, duration_s=1.0, folder=tmp_path / "case", log=lambda line: None)
+    assert row["sent"] == row["recorded"] == 200
+    assert (row["missing"], row["fabricated"], row["corrupt"]) == (0, 0, 0)
+    assert row["in_order"]
+    assert 0 < row["reader_us_per_sample"] <= row["reading_us_per_sample"] <= row["us_per_sample"]
+    assert 0 <= row["latency_ms_median"] <= row["latency_ms_p95"]
+
+
+def test_the_wake_floor_is_a_cost_per_record_of_the_bare_reader(tmp_path: Path) -> None:
+    floor = trackers.wake_floor(rate_hz=200.0, duration_s=0.5, folder=tmp_path)
+    assert math.isfinite(floor) and floor > 0
+
+
+def test_the_table_and_the_plot_show_every_row(tmp_path: Path) -> None:
+    row = {
+        "source": "serial", "transport": "pty", "profile": "csv", "faults": "corrupt=0.01,disconnect=5:0.5", "sent": 10,
+        "recorded": 9, "missing": 0, "fabricated": 0, "corrupt": 1, "damaged_sent": 1, "reading_us_per_sample": 40.0,
+        "reader_us_per_sample": 20.0, "us_per_sample": 70.0, "wake_floor_us": 18.0, "latency_ms_median": 0.1,
+        "latency_ms_p95": 0.4,
+    }  # fmt: skip
+    lines = trackers.table([row, {**row, "source": "lsl"}]).splitlines()
+    assert len(lines) == 4 and "40.0 (20.0), 70.0 | 18.0" in lines[2]
+    trackers.plot([row], tmp_path / "trackers.png")
+    assert (tmp_path / "trackers.png").stat().st_size > 0
