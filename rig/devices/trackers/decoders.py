@@ -13,7 +13,8 @@ records completed by them; what it could not decode it discards and counts in `c
 * `HidReportDecoder`: one input report is one record, after its report id where the device uses
   them; reports of other ids are someone else's and ignored, short ones are corrupt.
 
-`reset()` forgets a partial record and the time counter's history (after a reconnection).
+`reset()` forgets a partial record, counting it corrupt, and the time counter's history (after a
+reconnection, or once the stream is closed).
 """
 
 from __future__ import annotations
@@ -92,6 +93,7 @@ class TextDecoder:
         return self._maker.make(values, t_arrival, self._time.seconds(values))
 
     def reset(self) -> None:
+        self.corrupt += bool(self._buffer.strip())
         self._buffer.clear()
         self._time.reset()
 

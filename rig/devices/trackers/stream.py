@@ -73,6 +73,8 @@ class _Chunk(NamedTuple):
 
 _RESTORED = object()
 """Queued after the chunks of a lost link, before those of the reopened one."""
+_CLOSED = object()
+"""Queued after the last chunk, once the stream is closed: what the decoder holds is incomplete."""
 
 
 class TrackerRecord(NamedTuple):
@@ -179,6 +181,9 @@ class TrackerStream:
             chunk = chunks.popleft()
             if chunk is _RESTORED:
                 self._restart()
+            elif chunk is _CLOSED:
+                self.link.restart()
+                self._count_corrupt()
             else:
                 self._accept(chunk, records)
         self.decode_cpu_s += time.thread_time() - started
@@ -199,6 +204,7 @@ class TrackerStream:
         thread, self._thread = self._thread, None
         if thread is not None:
             thread.join()
+            self._chunks.append(_CLOSED)
         self.link.close()
 
     def report(self) -> dict[str, Any]:

@@ -121,3 +121,46 @@ def test_the_latency_histogram_gives_median_and_95th_percentile() -> None:
         histogram.add(latency)
     assert histogram.quantile_ms(0.5) == pytest.approx(5.0, abs=0.02)
     assert histogram.quantile_ms(0.95) == pytest.approx(9.5, abs=0.02)
+
+
+def test_a_partial_line_left_at_a_reset_is_one_corrupt_record() -> None:
+    decoder = decoder_for(load_profile("csv"))
+    decoder.feed(b"1.0,0,0,0,1,0,0,0\n1.001,0,0,", 5.0)
+    decoder.reset()
+    decoder.reset()
+    assert decoder.corrupt == 1
+
+
+class _OneReadPort:
+    """A port without a file descriptor that gives `data` at its first read and nothing after."""
+
+    def __init__(self, data: bytes) -> None:
+        self._data = data
+
+    @property
+    def in_waiting(self) -> int:
+        return len(self._data)
+
+    def read(self, size: int = 1) -> bytes:
+        data, self._data = self._data[:size], self._data[size:]
+        return data
+
+    def close(self) -> None:
+        pass
+
+
+def test_a_damaged_last_record_is_counted_once_the_stream_is_closed() -> None:
+    from rig.clock import MonotonicClock
+    from rig.devices.trackers.serial_tracker import serial_tracker
+
+    encoder = RecordEncoder(load_profile("binary-pose"))
+    records = [encoder.encode(e) for e in emissions(3)]
+    damaged = records[2][:-1] + bytes([records[2][-1] ^ 0xFF])
+    tracker = serial_tracker("fake?profile=binary-pose", open_port=lambda url, baud: _OneReadPort(b"".join(records[:2]) + damaged))
+    tracker.connect(MonotonicClock())
+    received = []
+    while len(received) < 2:
+        received += tracker.wait_records(0.05)
+    tracker.close()
+    assert tracker.take_queued() == []
+    assert (tracker.counters.received, tracker.report()["counters"]["corrupt"]) == (2, 1)
