@@ -1,15 +1,21 @@
-"""Swing signals of known latency for the fit's tests, given to them as the ``swing`` fixture."""
+"""Swing signals of known latency for the fit's tests, given to them as the ``swing`` fixture, and
+jaxopt's solver as the fit was configured before it moved to numpy, the reference it is checked
+against (``jaxopt_levenberg_marquardt``)."""
 
 from __future__ import annotations
 
+import functools
 import math
+import warnings
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
 
 from analysis.cycles import chirp_shape
-from analysis.fit.least_squares import Guess
+from analysis.fit import model
+from analysis.fit.least_squares import STEP_TOLERANCE, Guess
 from analysis.signals import SwingSignals
 
 
@@ -47,3 +53,28 @@ def make_swing(
 @pytest.fixture
 def swing() -> Callable[..., tuple[SwingSignals, Guess]]:
     return make_swing
+
+
+@functools.cache
+def jaxopt_levenberg_marquardt(max_iterations: int) -> Any:
+    """jaxopt's Levenberg-Marquardt on the projected residual, configured as the JAX fit had it
+    (one solver per iteration limit, so what a test compiles of it is compiled once)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="JAXopt is no longer maintained", category=DeprecationWarning)
+        import jaxopt
+
+    return jaxopt.LevenbergMarquardt(
+        residual_fun=model.projected_residual,
+        maxiter=max_iterations,
+        stop_criterion="madsen-nielsen",
+        xtol=STEP_TOLERANCE,
+        gtol=0.0,
+        solver="cholesky",
+        materialize_jac=True,
+        implicit_diff=False,
+    )
+
+
+@pytest.fixture
+def jaxopt_solver() -> Callable[[int], Any]:
+    return jaxopt_levenberg_marquardt

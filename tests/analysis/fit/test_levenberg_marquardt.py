@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
@@ -42,30 +40,17 @@ def test_the_iterations_end_at_the_limit():
 
 
 @pytest.mark.parametrize("iterations", [1, 2, 5])
-def test_each_step_is_the_step_jaxopts_levenberg_marquardt_takes(swing, iterations):
+def test_each_step_is_the_step_jaxopts_levenberg_marquardt_takes(swing, jaxopt_solver, iterations):
     """The numpy solver replaced jaxopt's (madsen-nielsen, Cholesky, materialised Jacobian) in the
     fit; while the steps are well above rounding, the two take the same ones."""
     import jax
     import jax.numpy as jnp
 
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message="JAXopt is no longer maintained", category=DeprecationWarning)
-        import jaxopt
-
     signals, guess = swing(0.137, decay=0.15, chirp=0.01, wide=0.03, noise=(0.3, 0.5))
     problem = make_problem(signals, (0.3, 0.5), guess)
     start = scaled_guess(guess, problem)
     structure = structure_of(RICHEST, start)
-    solver = jaxopt.LevenbergMarquardt(
-        residual_fun=model.projected_residual,
-        maxiter=iterations,
-        stop_criterion="madsen-nielsen",
-        xtol=STEP_TOLERANCE,
-        gtol=0.0,
-        solver="cholesky",
-        materialize_jac=True,
-        implicit_diff=False,
-    )
+    solver = jaxopt_solver(iterations)
     with jax.enable_x64(True):
         as_jax = [type(pack)(*(jnp.asarray(a) for a in pack)) for pack in (structure, problem.data)]
         reference = solver.run(jnp.asarray(start), *as_jax)
