@@ -1,49 +1,26 @@
 """The joint fit on swing signals of known latency: accuracy, model choice, honest uncertainty."""
 
-import math
-
 import numpy as np
 import pytest
 
-from analysis.cycles import chirp_shape
 from analysis.signals import SwingSignals
 from analysis.fit.least_squares import Guess, fit_sine, frames_per_bin, long_run_variance
 
-FPS = 120.0
-SECONDS = 6.0
 PERIOD = 0.8
 
 
-def swing(
-    latency: float,
-    *,
-    decay: float = 0.0,
-    chirp: float = 0.0,
-    wide: float = 0.0,
-    noise: tuple[float, float] = (0.0, 0.0),
-    seed: int = 0,
-) -> SwingSignals:
-    """LED and sphere signals: a damped swing whose frequency rises as it decays (the pendulum's
-    chirp, see analysis.fit.model), with a third harmonic of relative size ``wide`` decaying with
-    the cube of the amplitude, and the same swing ``latency`` later."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(int(SECONDS * FPS)) / FPS
-
-    def position(time: np.ndarray) -> np.ndarray:
-        phase = 2 * math.pi * time / PERIOD - chirp * chirp_shape(time - SECONDS / 2, decay) + 0.3
-        return np.exp(-decay * time) * (np.sin(phase) - wide * np.exp(-2 * decay * time) * np.sin(3 * phase))
-
-    led = 40 * position(t) + noise[0] * rng.standard_normal(t.size)
-    sphere = 25 * position(t - latency) + 3.0 + noise[1] * rng.standard_normal(t.size)
-    return SwingSignals(t, led, sphere)
+@pytest.fixture
+def swing_signals(swing):
+    """The conftest's swing signals alone (its default swing: a 0.8 s period, 6 s at 120 fps)."""
+    return lambda latency, **options: swing(latency, **options)[0]
 
 
 def guess(latency: float) -> Guess:
     return Guess(1 / PERIOD * 1.0005, 0.0, 0.0, latency + 0.004, 0.6)
 
 
-def test_noise_free_damped_chirping_swing_is_fitted_exactly():
-    fit = fit_sine(swing(0.137, decay=0.15, chirp=0.01), (0.01, 0.01), guess(0.137))
+def test_noise_free_damped_chirping_swing_is_fitted_exactly(swing_signals):
+    fit = fit_sine(swing_signals(0.137, decay=0.15, chirp=0.01), (0.01, 0.01), guess(0.137))
     assert fit.latency_s == pytest.approx(0.137, abs=2e-6)
     assert fit.frequency_hz == pytest.approx(1 / PERIOD, rel=1e-4)
     assert fit.damping == pytest.approx(0.15, rel=1e-3)
@@ -55,14 +32,14 @@ def test_noise_free_damped_chirping_swing_is_fitted_exactly():
     [({}, "sine"), ({"decay": 0.2}, "damped"), ({"decay": 0.2, "wide": 0.03}, "damped+harmonics")],
     ids=["pure", "damped", "wide"],
 )
-def test_the_simplest_model_the_data_support_is_chosen(kind, model):
-    fit = fit_sine(swing(0.05, noise=(0.05, 0.1), **kind), (0.05, 0.1), guess(0.05))
+def test_the_simplest_model_the_data_support_is_chosen(kind, model, swing_signals):
+    fit = fit_sine(swing_signals(0.05, noise=(0.05, 0.1), **kind), (0.05, 0.1), guess(0.05))
     assert fit.model == model
     assert fit.latency_s == pytest.approx(0.05, abs=5 * fit.se_s)
 
 
-def test_missing_samples_carry_no_weight():
-    signals = swing(0.08, decay=0.1, noise=(0.05, 0.1), seed=4)
+def test_missing_samples_carry_no_weight(swing_signals):
+    signals = swing_signals(0.08, decay=0.1, noise=(0.05, 0.1), seed=4)
     sphere = signals.sphere.copy()
     sphere[np.random.default_rng(1).choice(sphere.size, sphere.size // 10, replace=False)] = np.nan
     sphere[200:260] = np.nan
@@ -71,10 +48,10 @@ def test_missing_samples_carry_no_weight():
     assert fit.se_s < 2e-4
 
 
-def test_standard_errors_match_the_scatter_over_noise_draws():
+def test_standard_errors_match_the_scatter_over_noise_draws(swing_signals):
     errors, ses = [], []
     for seed in range(24):
-        fit = fit_sine(swing(0.06, decay=0.1, noise=(0.3, 0.5), seed=seed), (0.3, 0.5), guess(0.06))
+        fit = fit_sine(swing_signals(0.06, decay=0.1, noise=(0.3, 0.5), seed=seed), (0.3, 0.5), guess(0.06))
         errors.append(fit.latency_s - 0.06)
         ses.append(fit.se_s)
     z = np.array(errors) / np.array(ses)
@@ -82,9 +59,9 @@ def test_standard_errors_match_the_scatter_over_noise_draws():
     assert np.mean(np.abs(z) < 1.96) >= 0.8
 
 
-def test_correlated_residuals_widen_the_interval():
+def test_correlated_residuals_widen_the_interval(swing_signals):
     rng = np.random.default_rng(2)
-    signals = swing(0.06, decay=0.1)
+    signals = swing_signals(0.06, decay=0.1)
     # A slow random wander (AR(1), 0.97 per frame) on the sphere: far fewer independent samples.
     wander = np.zeros(signals.t.size)
     for i in range(1, wander.size):
@@ -110,10 +87,10 @@ def test_frames_are_binned_to_about_sixteen_per_period():
     assert frames_per_bin(1 / 60, 0.3) == 1
 
 
-def test_posterior_agrees_with_the_fit_and_reports_its_sampler():
+def test_posterior_agrees_with_the_fit_and_reports_its_sampler(swing_signals):
     from analysis.fit.posterior import sample_posterior
 
-    fit = fit_sine(swing(0.06, decay=0.1, noise=(0.3, 0.5), seed=3), (0.3, 0.5), guess(0.06))
+    fit = fit_sine(swing_signals(0.06, decay=0.1, noise=(0.3, 0.5), seed=3), (0.3, 0.5), guess(0.06))
     posterior = sample_posterior(fit, seed=1, steps=300, burn_in=100)
     assert posterior.median_s == pytest.approx(fit.latency_s, abs=0.3 * fit.se_s)
     width = posterior.ci95_s[1] - posterior.ci95_s[0]
@@ -125,10 +102,10 @@ def test_posterior_agrees_with_the_fit_and_reports_its_sampler():
     assert sample_posterior(fit, seed=1, steps=300, burn_in=100).median_s == posterior.median_s
 
 
-def test_an_interrupt_in_the_likelihood_ends_the_sampling_without_emcees_traceback(monkeypatch, capsys):
+def test_an_interrupt_in_the_likelihood_ends_the_sampling_without_emcees_traceback(monkeypatch, capsys, swing_signals):
     from analysis.fit import posterior
 
-    fit = fit_sine(swing(0.06, decay=0.1, noise=(0.3, 0.5), seed=3), (0.3, 0.5), guess(0.06))
+    fit = fit_sine(swing_signals(0.06, decay=0.1, noise=(0.3, 0.5), seed=3), (0.3, 0.5), guess(0.06))
     calls = []
     likelihood = posterior._log_posterior
 
@@ -146,11 +123,11 @@ def test_an_interrupt_in_the_likelihood_ends_the_sampling_without_emcees_traceba
     assert "Traceback" not in captured.err and "emcee" not in captured.out
 
 
-def test_the_fit_is_64_bit_in_a_process_whose_jax_is_32_bit():
+def test_the_fit_is_64_bit_in_a_process_whose_jax_is_32_bit(swing_signals):
     import jax
 
     with jax.enable_x64(False):
-        fit = fit_sine(swing(0.137, decay=0.15, chirp=0.01), (0.01, 0.01), guess(0.137))
+        fit = fit_sine(swing_signals(0.137, decay=0.15, chirp=0.01), (0.01, 0.01), guess(0.137))
         curves = fit.curves()
         assert not jax.config.jax_enable_x64
     assert fit.problem.data.tau.dtype == fit.problem.data.y.dtype == np.float64
