@@ -103,8 +103,9 @@ class SimDisplay:
 
     def present(self, image: np.ndarray, t_ready: float, image_id: int) -> int:
         """Show `image` from the first blank after `t_ready`, but no sooner than one refresh after
-        the previous image; the refresh it appears at."""
-        refresh = max(self.refresh_after(t_ready), self._last_present + 1)
+        the previous image, nor at a refresh whose content `shown` has already given; the refresh
+        it appears at."""
+        refresh = max(self.refresh_after(t_ready), self._last_present + 1, len(self.content))
         self._last_present = refresh
         self._presents.append((refresh, image_id))
         self.images[image_id] = image
