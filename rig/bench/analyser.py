@@ -1,30 +1,34 @@
 """The analyser bench (`rig bench analyser`): each estimator's error, interval coverage, confidently
 wrong answers and speed on videos of known latency.
 
-Two grids of simulated films (``rig.bench.analyser_grid``): the mixed grid of pendulums, rates,
-swings and impairments, and the hard grid of what goes wrong in a lab (camera and display rates
-that lock, short exposures, a dim LED, swapped sides, a bar across a blob's path, decimated films).
-Every case is analysed with every method. Errors are against the simulation's true latency, in ms
-and in the film's frame intervals; coverage is the fraction of cases whose 95 % interval holds the
-truth (methods without intervals have none); a *confidently wrong* answer is one whose interval
-misses the truth by more than max(WRONG_MS, its half-width), or, for a method without an interval,
-whose number is off by more than WRONG_MS. Cases the analyser refuses (it cannot tell the LED from
-the sphere) give no number and are counted apart, as are cases flagged ambiguous (left out of
-the error statistics). Accuracy is also summarised over the cases whose camera is not phase-locked
-to the display (the refreshes walk through the frames), where the target is today's.
+The bench is a sweep (`rig.service.sweep`) with a fixed spec, `specs/analyser.toml` (three tiny
+cases in `specs/analyser-quick.toml`): the mixed grid of pendulums, rates, swings and impairments,
+and the hard grid of what goes wrong in a lab (camera and display rates that lock, short
+exposures, a dim LED, swapped sides, a bar across a blob's path, decimated films), written out
+point by point; the impairments are the simulated camera's (`rig.sim.impairments`). Each point is
+simulated and analysed as `rig sweep` does it, giving the sweep's summary row; the bench then
+analyses the same film with every method and adds its record of the case to the row ("bench").
+Errors are against the simulation's true latency, in ms and in the film's frame intervals;
+coverage is the fraction of cases whose 95 % interval holds the truth (methods without intervals
+have none); a *confidently wrong* answer is one whose interval misses the truth by more than
+max(WRONG_MS, its half-width), or, for a method without an interval, whose number is off by more
+than WRONG_MS. Cases the analyser refuses (the sweep's row failed: it cannot tell the LED from the
+sphere) give no number and are counted apart, as are cases flagged ambiguous (left out of the
+error statistics). Accuracy is also summarised over the cases whose camera is not phase-locked to
+the display (the refreshes walk through the frames), where the target is today's.
 
-Speed: each film is first decoded alone (the fastest the analyser's own reader can go, nothing
-else done), then analysed with every method at once; a method's time is the whole analysis less
-the other methods' own estimation time. A sinefit analysis runs first (warm-up: JAX compiles once
-per process and clip length); sinefit's time is the faster of the two runs, and decoding's the
-faster of two decodes, one before each analysis, so that a burst of load from elsewhere on the
-machine touches the ratio less. Films that share a simulated run (a decimated film's phases) share
-its simulation.
+Speed: the sweep's analysis (sinefit) runs first and is the warm-up; the film is then decoded
+alone (the fastest the analyser's own reader can go, nothing else done), analysed with every method
+at once, and decoded again; a method's time is the whole analysis less the other methods' own
+estimation time. Sinefit's time is the faster of its two runs, and decoding's the faster of the
+two decodes, one either side of the analysis, so that a burst of load from elsewhere on the
+machine touches the ratio less.
 """
 
 from __future__ import annotations
 
 import time
+from functools import partial
 from pathlib import Path
 from typing import Any, Callable
 
@@ -33,9 +37,12 @@ import numpy as np
 import analysis
 from analysis.sampling.model import commensurate
 from analysis.video.sources import open_frames
-from rig.bench.analyser_grid import Case, film_fps, impaired
-from rig.executor import executor
-from rig.service import SimulationResult, simulate
+from rig.service.sweep import Sweep, SweepPoint, run_point, run_sweep
+from rig.sim.config import SimulationConfig
+
+SPECS = Path(__file__).parent / "specs"
+SPEC = SPECS / "analyser.toml"
+QUICK_SPEC = SPECS / "analyser-quick.toml"
 
 TARGETS = {
     "median_frames": 0.1,
@@ -67,9 +74,9 @@ def confidently_wrong(truth_ms: float, latency_ms: float, ci95_ms: tuple[float, 
     return bool(max(low - truth_ms, truth_ms - high, 0.0) > max(WRONG_MS, (high - low) / 2))
 
 
-def phase_locked(case: Case) -> bool:
+def phase_locked(config: SimulationConfig) -> bool:
     """Whether the film's frames sample the display at one phase of its refresh."""
-    ratio = commensurate(film_fps(case) / case.config.display.refresh_hz)
+    ratio = commensurate(config.camera.film_fps / config.display.refresh_hz)
     return ratio is not None and ratio[0] == 1
 
 
@@ -92,51 +99,59 @@ def _method_row(
     }
 
 
-def run_case(case: Case, run: SimulationResult, log: Log) -> dict[str, Any]:
-    """Impair, decode and analyse one case's film of ``run``; one JSON-ready row."""
+def measure_point(point: SweepPoint, log: Log) -> dict[str, Any]:
+    """A sweep job: the point's sweep row (simulated and analysed as `rig sweep` does), with the
+    bench's record of the case under "bench": the film decoded and analysed with every method."""
     started = time.perf_counter()
-    truth_ms = float(run.truth.latency_ms)
-    video = impaired(run.video_path, case, run.truth, case.config.seed)
+    row = run_point(point)
+    return row | {"bench": _case_record(point, row, log, started)}
+
+
+def _case_record(point: SweepPoint, row: dict[str, Any], log: Log, started: float) -> dict[str, Any]:
+    config, video, truth_ms = point.config, point.analysis.video, float(row["truth_ms"])
+    name = point.labels.get("case", point.out_dir.name)
     first_decode, frames = decode_seconds(video)
-    row: dict[str, Any] = {
-        "case": case.name,
-        "group": case.group,
-        "period_s": case.config.pendulum.period_s,
-        "camera_fps": film_fps(case),
-        "display_hz": case.config.display.refresh_hz,
-        "exposure_ms": case.config.camera.exposure * 1e3,
-        "display_phase": case.config.display.phase,
-        "phase_locked": phase_locked(case),
-        "amplitude_deg": case.config.pendulum.amplitude_deg,
-        "quality": case.config.pendulum.quality,
-        "impairment": case.impairment,
-        "predictor": case.config.predictor,
+    record: dict[str, Any] = {
+        "case": name,
+        "group": point.labels.get("group", "mixed"),
+        "period_s": config.pendulum.period_s,
+        "camera_fps": config.camera.film_fps,
+        "display_hz": config.display.refresh_hz,
+        "exposure_ms": config.camera.exposure * 1e3,
+        "display_phase": config.display.phase,
+        "phase_locked": phase_locked(config),
+        "amplitude_deg": config.pendulum.amplitude_deg,
+        "quality": config.pendulum.quality,
+        "impairment": point.labels.get("impairment", "none"),
+        "predictor": config.predictor,
         "truth_ms": truth_ms,
         "frames": frames,
     }
-    try:
-        warm_started = time.perf_counter()
-        analysis.analyse(video, method="sinefit")
-        warm_s = time.perf_counter() - warm_started
-        second_decode, _ = decode_seconds(video)
-        analysed_started = time.perf_counter()
-        result = analysis.analyse(video, method="all", seed=case.config.seed)
-        total_s = time.perf_counter() - analysed_started
-    except analysis.AnalysisError as error:
-        log(f"{case.name}: truth {truth_ms:.2f} ms, REFUSED: {error}")
-        return {**row, "refused": str(error), "ambiguous": False, "methods": {}, "warnings": [], "decode_s": first_decode}
+    refused = row["error"] if row["status"] == "failed" else None
+    if refused is None:
+        try:
+            analysed_started = time.perf_counter()
+            result = analysis.analyse(video, method="all", seed=config.seed)
+            total_s = time.perf_counter() - analysed_started
+            second_decode, _ = decode_seconds(video)
+        except analysis.AnalysisError as error:
+            refused = str(error)
+    if refused is not None:
+        log(f"{name}: truth {truth_ms:.2f} ms, REFUSED: {refused}")
+        return {**record, "refused": refused, "ambiguous": False, "methods": {}, "warnings": [], "decode_s": first_decode}
     decode_s = min(first_decode, second_decode)
+    warm_s = row["seconds"]
     estimation = sum(m.seconds for m in result.methods.values())
     methods = {}
-    for name, estimate in result.methods.items():
+    for method, estimate in result.methods.items():
         seconds = total_s - estimation + estimate.seconds
-        if name == "sinefit":
+        if method == "sinefit":
             seconds = min(seconds, warm_s)
-        if name == "bayes":
+        if method == "bayes":
             # The posterior starts from the fit: its time includes the fit's.
             seconds += result.methods["sinefit"].seconds
-        methods[name] = _method_row(estimate, truth_ms, 1e3 / film_fps(case), seconds, decode_s, frames)
-    row.update(
+        methods[method] = _method_row(estimate, truth_ms, 1e3 / config.camera.film_fps, seconds, decode_s, frames)
+    record.update(
         refused=None,
         ambiguous=result.ambiguous,
         cycles=result.cycles.to_dict(),
@@ -150,11 +165,11 @@ def run_case(case: Case, run: SimulationResult, log: Log) -> dict[str, Any]:
     sinefit = methods["sinefit"]
     flags = (" AMBIGUOUS" if result.ambiguous else "") + (" CONFIDENTLY WRONG" if sinefit["confidently_wrong"] else "")
     log(
-        f"{case.name}: truth {truth_ms:.2f} ms, sinefit {sinefit['error_ms']:+.3f} ms "
+        f"{name}: truth {truth_ms:.2f} ms, sinefit {sinefit['error_ms']:+.3f} ms "
         f"(95% {sinefit['ci95_ms'][0] - truth_ms:+.2f} to {sinefit['ci95_ms'][1] - truth_ms:+.2f} about the truth){flags}, "
         f"speed x{sinefit['speed_ratio']:.2f} of decoding ({time.perf_counter() - started:.0f} s)"
     )
-    return row
+    return record
 
 
 def summarise(rows: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
@@ -273,35 +288,29 @@ def plot(summary: dict[str, dict[str, Any]], rows: list[dict[str, Any]], path: P
     figure.savefig(path, dpi=110)
 
 
-def film_and_analyse(job: tuple[Path, tuple[Case, ...], Log]) -> list[dict[str, Any]]:
-    """Simulate the film that ``cases`` share (one config) into the folder, and each case's row.
-    A job for `rig.executor`: a worker process can run it."""
-    folder, cases, log = job
-    started = time.perf_counter()
-    run = simulate(cases[0].config, folder, overwrite=True)
-    log(f"  {folder.name} simulated in {time.perf_counter() - started:.0f} s")
-    return [run_case(case, run, log) for case in cases]
-
-
 def run_bench(
-    cases: list[Case], folder: Path, log: Log, workers: int | None = None, scheduler: str | None = None
+    sweep: Sweep,
+    folder: Path,
+    log: Log,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    groups: tuple[str, ...] = GROUPS["all"],
 ) -> dict[str, Any]:
-    """Every case, each simulation once (cases that share a film share it), serially or on Dask
-    (`rig.executor`); the rows in the order of the cases, the summaries per group of cases
-    (GROUPS) and the targets. On Dask, speed ratios are taken with the workers sharing the cores."""
-    films: dict[str, list[int]] = {}
-    for position, case in enumerate(cases):
-        films.setdefault(repr(case.config), []).append(position)
-    jobs = [(folder / f"run{index:03d}", tuple(cases[p] for p in positions), log) for index, positions in enumerate(films.values())]
-    by_position: dict[int, dict[str, Any]] = {}
-    with executor(workers, scheduler) as run:
-        for index, film_rows in run(film_and_analyse, jobs):
-            by_position.update(zip(list(films.values())[index], film_rows))
-            log(f"[{len(by_position)}/{len(cases)} cases]")
-    rows = [by_position[position] for position in range(len(cases))]
+    """The sweep's points of `groups` (a point's "group" label; none is "mixed") run as a sweep into
+    `folder` (serially or on Dask, `rig.executor`), each measured by `measure_point`: the sweep's
+    rows ("sweep", and folder/summary.csv), the bench's record of every case in their order
+    ("cases"), the summaries per group of cases (GROUPS) and the targets. On Dask, speed ratios are
+    taken with the workers sharing the cores."""
+    chosen = sweep if groups == GROUPS["all"] else sweep.only(lambda labels: labels.get("group", "mixed") in groups)
+
+    def progress(done: float, total: float) -> None:
+        log(f"[{done}/{total} cases]")
+
+    rows, _ = run_sweep(chosen, folder, workers, scheduler, progress, overwrite=True, job=partial(measure_point, log=log))
+    cases = [row.pop("bench") for row in rows]
     summaries = {
-        group: summarise(chosen)
-        for group, members in GROUPS.items()
-        if (chosen := [row for row in rows if row["group"] in members])
+        group: summarise(members)
+        for group, member_groups in GROUPS.items()
+        if (members := [case for case in cases if group == "all" or case["group"] in member_groups])
     }
-    return {"summary": summaries["all"], "summaries": summaries, "targets_met": targets_met(summaries), "cases": rows}
+    return {"summary": summaries["all"], "summaries": summaries, "targets_met": targets_met(summaries), "cases": cases, "sweep": rows}

@@ -16,13 +16,14 @@ from typing import Callable
 
 import predictors
 from predictors import read_trace
-from rig.bench import analyser, analyser_grid, batch
+from rig.bench import analyser, batch
 from rig.bench import predictors as predictor_bench
 from rig.commands import choices, options, outputs
 from rig.commands.bench_live import add_live
 from rig.commands.bench_renderers import add_renderers
 from rig.errors import ConfigError
 from rig.progress import ProgressBar
+from rig.service.sweep import read_sweep
 
 
 def _log(message: str) -> None:
@@ -32,19 +33,12 @@ def _log(message: str) -> None:
 # -- analyser ------------------------------------------------------------------------------------
 
 
-def _analyser_cases(args: argparse.Namespace) -> list[analyser_grid.Case]:
-    if args.quick:
-        return analyser_grid.quick_grid()
-    mixed = analyser_grid.grid(args.cases) if args.grid in ("all", "mixed") else []
-    return mixed + (analyser_grid.hard_grid() if args.grid in ("all", "hard") else [])
-
-
 def _run_analyser(args: argparse.Namespace) -> int:
-    cases = _analyser_cases(args)
+    sweep = read_sweep(analyser.QUICK_SPEC if args.quick else args.spec)
     started = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="rig-bench-analyser-") as scratch:
         folder = args.runs if args.runs is not None else Path(scratch)
-        report = analyser.run_bench(cases, folder, _log, args.workers, args.scheduler)
+        report = analyser.run_bench(sweep, folder, _log, args.workers, args.scheduler, analyser.GROUPS[args.grid])
     report["seconds"] = time.perf_counter() - started
     writes = outputs.LateWrites()
     if args.json is not None:
@@ -56,7 +50,7 @@ def _run_analyser(args: argparse.Namespace) -> int:
         print(analyser.table(summary))
     for target, met in report["targets_met"].items():
         print(f"{target}: {'met' if met else 'not met' if met is not None else 'n/a'}")
-    print(f"{len(cases)} cases in {report['seconds'] / 60:.1f} minutes")
+    print(f"{len(report['cases'])} cases in {report['seconds'] / 60:.1f} minutes")
     writes.check()
     return 0
 
@@ -71,14 +65,20 @@ def _add_analyser(benchmarks: argparse._SubParsersAction) -> None:
         "decoding alone. The mixed grid spans periods, frame rates, refresh rates, swings, damping and "
         "impairments; the hard grid, what goes wrong in a lab: camera rates that lock to the display's, short "
         "exposures, a dim LED or sphere, swapped sides, a second bright object, a partly hidden blob, decimated "
-        "films. Both take about forty minutes on two cores; --quick runs three tiny cases.",
+        "films. Both take about forty minutes on two cores; --quick runs three tiny cases. The cases are a sweep "
+        f"spec ({analyser.SPEC.name}, in {analyser.SPECS}): `rig sweep` on it gives the same summary rows; "
+        "--spec runs the bench on an edited copy.",
     )
-    parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the summaries and every case as JSON")
+    parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the summaries, every case and the sweep's rows as JSON")
     parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="plot speed against error per method")
-    parser.add_argument("--quick", action="store_true", help="three short cases (a smoke test)")
-    parser.add_argument("--grid", choices=("all", "mixed", "hard"), default="all", help="which grid to run (default: %(default)s)")
-    parser.add_argument("--cases", type=options.positive_int, default=analyser_grid.DEFAULT_CASES, help="mixed cases besides the named hard ones (default: %(default)s)")
-    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the simulated videos here (default: a temporary folder)")
+    cases = parser.add_mutually_exclusive_group()
+    cases.add_argument("--spec", type=Path, default=analyser.SPEC, metavar="SPEC.toml",
+                       help="the cases, as a sweep whose points are labelled case, group (mixed, named or hard) and "
+                       "impairment (default: the bench's own)")  # fmt: skip
+    cases.add_argument("--quick", action="store_true", help=f"three short cases (a smoke test; {analyser.QUICK_SPEC.name})")
+    parser.add_argument("--grid", choices=tuple(analyser.GROUPS), default="all", help="which grid to run, by the points' group (default: %(default)s)")
+    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR",
+                        help="keep the simulated videos and the sweep's summary.csv here (default: a temporary folder)")  # fmt: skip
     options.add_executor_options(parser, "the grid")
     parser.set_defaults(func=_run_analyser)
 

@@ -13,6 +13,7 @@ from rig.session import PHOTON_TARGETS
 from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
+from rig.sim.impairments import OCCLUDABLE, FilmImpairments
 from rig.sim.pendulum import MAX_AMPLITUDE_DEG, PendulumConfig
 from rig.sim.tracker import TrackerConfig
 
@@ -93,6 +94,51 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--period-s", type=options.positive_float, default=PendulumConfig().period_s, help="pendulum period (default: %(default)s)")
     group.add_argument("--amplitude-deg", type=amplitude_deg, default=PendulumConfig().amplitude_deg, help="swing amplitude, up to 45 (default: %(default)s)")
     group.add_argument("--quality", type=options.positive_float, default=PendulumConfig().quality, help="pendulum quality factor Q (default: %(default)s)")
+    _add_camera_options(parser)
+
+
+def _add_camera_options(parser: argparse.ArgumentParser) -> None:
+    """What the simulated camera does to its film besides its rate and exposure (`rig.sim.impairments`)."""
+    camera, film = CameraConfig(), FilmImpairments()
+    group = parser.add_argument_group("simulated camera's film")
+    group.add_argument("--noise-dn", type=options.non_negative_float, default=camera.noise_dn, help="sensor read noise, digital numbers (default: %(default)s)")
+    group.add_argument(
+        "--display-white-dn",
+        type=options.positive_float,
+        default=camera.display_white_dn,
+        help="how bright the display's white films, digital numbers: lower for a dim sphere (default: %(default)s)",
+    )
+    group.add_argument("--blur-px", type=options.non_negative_float, default=film.blur_sigma_px, help="defocus blur, Gaussian sigma in pixels (default: %(default)s)")
+    group.add_argument(
+        "--dim-led",
+        type=options.positive_float,
+        default=film.dim_led,
+        metavar="F",
+        help="scale the LED's half of each frame by F in (0, 1], after the sensor saturates (default: %(default)s)",
+    )
+    group.add_argument("--mirrored", action="store_true", help="flip the film left to right: the LED on the right, the sphere on the left")
+    group.add_argument(
+        "--bright-object-dn",
+        type=options.non_negative_float,
+        default=film.bright_object_dn,
+        help="a static lamp in view between and above the two halves, its peak in digital numbers (default: none)",
+    )
+    group.add_argument("--occluded", choices=OCCLUDABLE, default=None, help="a bar hiding part of this blob's path")
+    group.add_argument(
+        "--missing-fraction",
+        type=options.non_negative_float,
+        default=film.missing_fraction,
+        metavar="F",
+        help="hide the sphere in this share of the frames, drawn by the seed (default: %(default)s)",
+    )
+    group.add_argument("--every-nth", type=options.positive_int, default=film.every_nth, metavar="N", help="film every N-th exposure only (default: %(default)s)")
+    group.add_argument(
+        "--first-frame",
+        type=options.non_negative_int,
+        default=film.first_frame,
+        metavar="K",
+        help="with --every-nth, the first exposure filmed, 0 to N - 1 (default: %(default)s)",
+    )
 
 
 def amplitude_deg(text: str) -> float:
@@ -125,7 +171,22 @@ def config_from_args(args: argparse.Namespace) -> SimulationConfig:
         pendulum=PendulumConfig(period_s=args.period_s, amplitude_deg=args.amplitude_deg, quality=args.quality),
         tracker=TrackerConfig(rate_hz=args.tracker_hz, transport_delay_s=args.transport_delay_ms / 1e3),
         display=DisplayConfig(refresh_hz=args.display_hz, phase=args.display_phase),
-        camera=CameraConfig(fps=args.camera_fps, exposure_s=args.exposure / args.camera_fps),
+        camera=CameraConfig(
+            fps=args.camera_fps,
+            exposure_s=args.exposure / args.camera_fps,
+            noise_dn=args.noise_dn,
+            display_white_dn=args.display_white_dn,
+            impairments=FilmImpairments(
+                blur_sigma_px=args.blur_px,
+                dim_led=args.dim_led,
+                mirrored=args.mirrored,
+                bright_object_dn=args.bright_object_dn,
+                occluded=args.occluded,
+                missing_fraction=args.missing_fraction,
+                every_nth=args.every_nth,
+                first_frame=args.first_frame,
+            ),
+        ),
         renderer=args.renderer,
         predictor=predictor,
         predictor_params=params,

@@ -17,8 +17,9 @@ def _run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(rows))
     else:
+        labels = sweep.labels
         for row in rows:
-            settings = ", ".join(f"{name}={row[name]}" for name in sweep.grid)
+            settings = ", ".join(f"{name}={row[name]}" for name in labels if row.get(name) is not None)
             measured = f"{row['latency_ms']:.2f} ms (true {row['truth_ms']:.2f}, error {row['error_ms']:+.3f})" if row["latency_ms"] is not None else f"failed: {row['error']}"
             print(f"{settings}: {measured}")
         print(f"summary: {summary} and {summary.with_suffix('.json')}")
@@ -30,7 +31,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "sweep",
         help="simulate and analyse a grid of simulated rigs into one summary",
         description="SPEC.toml names [base] simulation settings, a [grid] of settings and the values to sweep each "
-        "over (every combination runs), and optional [analysis] options (method, latency_range_ms, seed, led_side). "
+        "over (every combination runs) and/or [[points]] given one by one (each its settings, and its row's labels "
+        "as labels = {...}), and optional [analysis] options (method, latency_range_ms, seed, led_side). "
         "Each point is simulated into DIR/pointNNN and analysed; DIR/summary.csv (and .json) gets one row per point "
         "as it finishes, with the truth and the error beside the measured latency.",
     )

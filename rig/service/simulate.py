@@ -130,14 +130,15 @@ def simulate(
     _prepare(out_dir, overwrite)
     with RunRecord(out_dir, (camera.fps, camera.width, camera.height), overwrite=overwrite) as record:
         log = Session(parts, world.t_begin, world.t_end, record, progress).run()
+    impairments = config.camera.impairments
     truth = run_truth(
         config,
         world.pendulum,
         display,
         log,
         camera_span=(0.0, float(camera.frame_times[-1] + config.camera.exposure)),
-        frames=len(camera.frame_times),
-        rois=(list(world.layout.led_roi), list(world.layout.sphere_roi)),
+        frames=len(camera.film_times),
+        rois=(list(impairments.film_rect(world.layout.led_roi, camera.width)), list(impairments.film_rect(world.layout.sphere_roi, camera.width))),
         costs=(app_cost.describe(log.app_costs_s), timing.display_frame_cost()),
         board=board.truth() if board is not None else None,
     )

@@ -12,8 +12,14 @@ A sweep is a TOML file:
     "pendulum.period_s" = [0.8, 1.0, 1.4]
     predictor = ["hold", "slerp"]
 
+    [[points]]                   # and/or points given one by one, after the grid's
+    labels = { case = "dim LED" } # the row's labels (default: the settings the point names)
+    camera.impairments.dim_led = 0.35
+
     [analysis]                   # how each video is analysed (rig analyse's options)
     method = "sinefit"
+
+A sweep needs a [grid] or [[points]] or both; each point is the base with its settings over it.
 """
 
 from __future__ import annotations
@@ -39,7 +45,8 @@ _NESTED = {"board": SimulatedBoardConfig}
 
 @dataclass(frozen=True)
 class SweepPoint:
-    """One point of a sweep: its simulation, its labels (the grid's values) and its run folder."""
+    """One point of a sweep: its simulation, its labels (the grid's values, or an explicit point's)
+    and its run folder."""
 
     index: int
     config: SimulationConfig
@@ -50,17 +57,39 @@ class SweepPoint:
 
 @dataclass(frozen=True)
 class Sweep:
+    """base: settings every point shares; grid: settings and the values each takes (every
+    combination is a point); explicit: points given one by one (dotted settings, and optionally
+    their labels under "labels"); analysis: `AnalysisRequest` options."""
+
     base: dict[str, Any]
     grid: dict[str, list[Any]]
     analysis: dict[str, Any] = field(default_factory=dict)
+    explicit: list[dict[str, Any]] = field(default_factory=list)
+
+    def settings(self) -> list[tuple[dict[str, Any], dict[str, str]]]:
+        """Each point's settings over the base's, and its labels: the grid's points, then the explicit."""
+        names = list(self.grid)
+        combinations = itertools.product(*(self.grid[name] for name in names)) if names else ()
+        chosen = [(dict(zip(names, values)), None) for values in combinations]
+        chosen += [({k: v for k, v in point.items() if k != "labels"}, point.get("labels")) for point in self.explicit]
+        return [
+            (_merged(self.base, overrides), {str(k): str(v) for k, v in (labels if labels is not None else _dotted(overrides)).items()})
+            for overrides, labels in chosen
+        ]
+
+    @property
+    def labels(self) -> list[str]:
+        """The label columns of the summary: every label any point has, in order of appearance."""
+        return list(dict.fromkeys(name for _, labels in self.settings() for name in labels))
+
+    def only(self, keep: Callable[[dict[str, str]], bool]) -> Sweep:
+        """The sweep of the points whose labels `keep` accepts, each given explicitly."""
+        return Sweep({}, {}, self.analysis, [{**settings, "labels": labels} for settings, labels in self.settings() if keep(labels)])
 
     def points(self, out: Path) -> list[SweepPoint]:
-        names = list(self.grid)
         template = AnalysisRequest(Path(), **{k: tuple(v) if isinstance(v, list) else v for k, v in self.analysis.items()})
         points = []
-        for index, values in enumerate(itertools.product(*(self.grid[name] for name in names))):
-            settings = _merged(self.base, dict(zip(names, values)))
-            labels = {name: str(value) for name, value in zip(names, values)}
+        for index, (settings, labels) in enumerate(self.settings()):
             folder = out / f"point{index:03d}"
             points.append(SweepPoint(index, build(SimulationConfig, settings), labels, folder, dataclasses.replace(template, video=folder / "video.avi")))
         return points
@@ -126,20 +155,26 @@ def read_sweep(path: Path) -> Sweep:
         raise ConfigError(f"cannot read the sweep {path}: {error.strerror}") from None
     except tomllib.TOMLDecodeError as error:
         raise ConfigError(f"{path} is not valid TOML: {error}") from None
-    unknown = set(spec) - {"base", "grid", "analysis"}
+    unknown = set(spec) - {"base", "grid", "points", "analysis"}
     if unknown:
-        raise ConfigError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}; a sweep has [base], [grid] and [analysis]")
+        raise ConfigError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}; a sweep has [base], [grid], [[points]] and [analysis]")
     grid = _dotted(spec.get("grid", {}))
-    if not grid:
-        raise ConfigError(f"{path} has no [grid]: name at least one setting and the values to sweep it over")
+    explicit = spec.get("points", [])
+    if not grid and not explicit:
+        raise ConfigError(f"{path} has no [grid] and no [[points]]: name at least one setting and the values to sweep it over")
     for name, values in grid.items():
         if not isinstance(values, list) or not values:
             raise ConfigError(f"{path}: grid.{name} must be a non-empty list of values")
+    if not isinstance(explicit, list) or not all(isinstance(point, dict) for point in explicit):
+        raise ConfigError(f"{path}: points must be a list of tables ([[points]]), each a point's settings")
+    for number, point in enumerate(explicit, 1):
+        if "labels" in point and not isinstance(point["labels"], dict):
+            raise ConfigError(f"{path}: point {number}'s labels must be a table of names and values")
     analysis = spec.get("analysis", {})
     bad = set(analysis) - set(ANALYSIS_OPTIONS)
     if bad:
         raise ConfigError(f"{path}: [analysis] takes {', '.join(ANALYSIS_OPTIONS)}, not {', '.join(sorted(bad))}")
-    return Sweep(spec.get("base", {}), grid, analysis)
+    return Sweep(spec.get("base", {}), grid, analysis, explicit)
 
 
 def run_point(point: SweepPoint) -> dict[str, Any]:
@@ -159,9 +194,11 @@ def run_sweep(
     scheduler: str | None = None,
     progress: Callable[[float, float], object] | None = None,
     overwrite: bool = False,
+    job: Callable[[SweepPoint], dict[str, Any]] = run_point,
 ) -> tuple[list[dict[str, Any]], Path]:
     """Every point of the sweep into out/pointNNN, and the summary out/summary.csv (and .json); a
-    folder that holds a sweep already is refused unless `overwrite`."""
+    folder that holds a sweep already is refused unless `overwrite`. `job` measures a point: its
+    row (`run_point`'s, or a bench's, which adds to it; the CSV keeps the sweep's columns)."""
     points = sweep.points(Path(out))
     summary = Path(out) / "summary.csv"
     held = [path.name for path in (summary, *(point.out_dir for point in points)) if path.exists()]
@@ -169,11 +206,11 @@ def run_sweep(
         raise ConfigError(f"{out} already holds a sweep ({', '.join(held[:3])}{', ...' if len(held) > 3 else ''}); "
                           "choose another folder or pass --overwrite")  # fmt: skip
     Path(out).mkdir(parents=True, exist_ok=True)
-    run = BatchRun(summary, (*SUMMARY_COLUMNS, "truth_ms", "error_ms", *sweep.grid))
+    run = BatchRun(summary, (*SUMMARY_COLUMNS, "truth_ms", "error_ms", *sweep.labels))
     run.open()
     try:
         with executor(workers, scheduler) as jobs:
-            for _, row in jobs(run_point, points):
+            for _, row in jobs(job, points):
                 run.add(row)
                 if progress is not None:
                     progress(len(run.rows), len(points))

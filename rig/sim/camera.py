@@ -7,13 +7,17 @@ instants of the exposure (motion blur); the display panel's rows are integrated 
 refresh a row shows weighted by how long it shows it during the exposure (`rig.sim.scene`), so a
 refresh that switches inside an exposure is seen where it switches, as a real sensor sees it.
 
+What a lab's camera may do to the film besides (blur, a dim LED, a mirrored image, a lamp or a bar
+in view, hidden frames, decimation) is the camera's `impairments` (`rig.sim.impairments`), applied
+to each frame the sensor makes before it is recorded.
+
 Read noise is drawn from a bank of precomputed noise fields at random offsets: full per-pixel
 Gaussian draws would dominate the simulation's cost, and the analyser cannot tell the difference.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -21,6 +25,7 @@ import numpy as np
 from rig.clock import Clock
 from rig.devices.protocols import CameraFrame
 from rig.errors import ConfigError
+from rig.sim.impairments import FilmImpairments, FrameImpairer
 
 if TYPE_CHECKING:
     from rig.sim.scene import FilmedScene
@@ -43,6 +48,7 @@ class CameraConfig:
     display_black_dn: float = 6.0
     display_white_dn: float = 190.0
     subsamples: int = 8
+    impairments: FilmImpairments = field(default_factory=FilmImpairments)
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.fps) and 1.0 <= self.fps <= 10000.0):
@@ -67,6 +73,11 @@ class CameraConfig:
         biased by up to half a refresh (``analysis.sampling`` works out by how much).
         """
         return self.exposure_s if self.exposure_s is not None else 1.0 / self.fps
+
+    @property
+    def film_fps(self) -> float:
+        """The frame rate of the film: the camera's, or a decimated film's (every n-th frame)."""
+        return self.fps / self.impairments.every_nth
 
     def subsample_offsets(self) -> np.ndarray:
         """Instants within the exposure (s from the frame's start) that are averaged."""
@@ -132,20 +143,38 @@ class CameraSensor:
 
 
 class SimCamera:
-    """The simulated twin of a camera (`rig.devices.protocols.Camera`): frames start at 0 s on the
-    rig clock, one every 1 / fps, for `duration_s`; each is exposed as soon as everything it sees
-    is known (the display's content up to the end of its exposure)."""
+    """The simulated twin of a camera (`rig.devices.protocols.Camera`): exposures start at 0 s on
+    the rig clock, one every 1 / fps, for `duration_s`; each is exposed as soon as everything it
+    sees is known (the display's content up to the end of its exposure), and impaired. The film
+    holds the frames the impairments keep (`film_times`), at `fps` (the film's rate).
 
-    def __init__(self, config: CameraConfig, scene: FilmedScene, duration_s: float, seed: int) -> None:
+    `impairment_seed` draws the frames whose sphere is hidden (`FilmImpairments.missing_fraction`).
+    """
+
+    def __init__(self, config: CameraConfig, scene: FilmedScene, duration_s: float, seed: int, impairment_seed: int) -> None:
         self.config = config
-        self.fps = config.fps
+        self.fps = config.film_fps
         self.width = config.width
         self.height = config.height
         self.scene = scene
         self.frame_times = np.arange(0.0, duration_s - config.exposure, 1.0 / config.fps)
+        self._impair = FrameImpairer(
+            config.impairments,
+            _background(config, scene.panel),
+            {"led": scene.layout.led_roi, "sphere": scene.layout.sphere_roi},
+            len(self.frame_times),
+            impairment_seed,
+        )
         self._seed = seed
         self._sensor: CameraSensor | None = None
         self._next = 0
+        self._filmed = 0
+
+    @property
+    def film_times(self) -> np.ndarray:
+        """When each frame of the film starts exposing (s)."""
+        impairments = self.config.impairments
+        return self.frame_times[impairments.first_frame :: impairments.every_nth]
 
     def connect(self, clock: Clock) -> None:
         self._sensor = CameraSensor(self.config, seed=self._seed)
@@ -163,9 +192,20 @@ class SimCamera:
             image = self._sensor.expose(
                 self.scene.led_pixels(instants), self.scene.panel_light(t_start, exposure), self.scene.panel, self.scene.led_levels(instants)
             )
-            frames.append(CameraFrame(self._next, t_start, exposure, image))
+            filmed = self._impair(self._next, image)
+            if filmed is not None:
+                frames.append(CameraFrame(self._filmed, t_start, exposure, filmed))
+                self._filmed += 1
             self._next += 1
         return frames
 
     def close(self) -> None:
         self._sensor = None
+
+
+def _background(config: CameraConfig, panel: tuple[int, int, int, int]) -> np.ndarray:
+    """The sensor's image of the rig with nothing in view lit: its dark level, and the panel's black."""
+    image = np.full((config.height, config.width), config.dark_dn, dtype=np.float32)
+    x, y, w, h = panel
+    image[y : y + h, x : x + w] += config.display_black_dn
+    return np.clip(np.rint(image), 0, 255).astype(np.uint8)

@@ -101,9 +101,11 @@ class Truth:
     refreshes: how many refreshes showed an image and how many missed; app_frame_cost: what the
     clock charged per application frame; display_frame_cost: what it charged per composed image, for
     a renderer composing at refreshes (None for one that does not); each cost says whether it was
-    "modelled" (its ms) or "measured" (median, 95th percentile and largest ms); led_roi, sphere_roi:
-    where the LED and the sphere swing in the video; board: the rig board's clock offset, the
-    pendulum's release and the blink (None without a board); config: the run's whole configuration.
+    "modelled" (its ms) or "measured" (median, 95th percentile and largest ms); camera_fps, frames:
+    the film's rate and frame count (a decimated film's, where the camera's impairments decimate);
+    led_roi, sphere_roi: where the LED and the sphere swing in the video (mirrored with the film);
+    board: the rig board's clock offset, the pendulum's release and the blink (None without a
+    board); config: the run's whole configuration.
     """
 
     latency_ms: float
@@ -171,7 +173,7 @@ def run_truth(
             values=[round(float(d), 6) for d in delays_ms],
         ),
         refreshes=RefreshCount(shown=int(in_span.sum()), missed=missed),
-        camera_fps=config.camera.fps,
+        camera_fps=config.camera.film_fps,
         frames=frames,
         period_s=pendulum.period_s,
         app_frame_cost=costs[0],

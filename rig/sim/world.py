@@ -47,7 +47,7 @@ class SimulatedWorld:
         scene = FilmedScene(
             self.pendulum, self._display, self.layout, c.camera.display_black_dn, c.camera.display_white_dn, c.board
         )
-        return SimCamera(c.camera, scene, c.duration_s, seed=c.seed + 1)
+        return SimCamera(c.camera, scene, c.duration_s, seed=c.seed + 1, impairment_seed=c.seed)
 
     def board(self, out_dir: Path) -> SimulatedBoard | None:
         """The rig board beside the pendulum, recording into `out_dir`; None without one."""

@@ -3,6 +3,7 @@
 import json
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 
@@ -54,3 +55,23 @@ def test_a_negative_release_is_rejected_by_the_parser(tmp_path: Path, capsys: py
         main(["simulate", "--out", str(tmp_path / "x"), "--release-s", "-1"])
     assert exit_.value.code == 2
     assert "--release-s" in capsys.readouterr().err
+
+
+def test_the_cameras_impairments_are_options_and_reach_truth_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    options = ["--camera-fps", "120", "--every-nth", "2", "--first-frame", "1", "--mirrored", "--blur-px", "1.5", "--noise-dn", "4",
+               "--dim-led", "0.5", "--occluded", "led", "--missing-fraction", "0.1", "--bright-object-dn", "300"]  # fmt: skip
+    assert main(["simulate", "--out", str(tmp_path), "--duration", "2", *options, "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    camera = truth["config"]["camera"]
+    assert camera["noise_dn"] == 4.0
+    assert camera["impairments"] == {
+        "blur_sigma_px": 1.5, "dim_led": 0.5, "mirrored": True, "bright_object_dn": 300.0, "occluded": "led",
+        "missing_fraction": 0.1, "every_nth": 2, "first_frame": 1,
+    }  # fmt: skip
+    assert truth["camera_fps"] == 60.0 and summary["camera_fps"] == 60.0
+    video = cv2.VideoCapture(str(tmp_path / "video.avi"))
+    assert video.get(cv2.CAP_PROP_FPS) == pytest.approx(60.0)
+    assert truth["frames"] == int(video.get(cv2.CAP_PROP_FRAME_COUNT)) == 119  # of the sensor's 239 exposures
+    led_x, sphere_x = truth["led_roi"][0], truth["sphere_roi"][0]
+    assert sphere_x < camera["width"] / 2 < led_x  # mirrored: the LED films on the right

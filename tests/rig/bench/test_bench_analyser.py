@@ -1,13 +1,17 @@
-"""`rig bench analyser --quick`: the whole benchmark on three tiny simulated videos; the grids."""
+"""`rig bench analyser --quick`: the whole benchmark on three tiny simulated videos; its spec (a
+sweep), and `rig sweep` on it giving the bench's rows."""
 
 import argparse
 import json
+import tomllib
 from pathlib import Path
 
 import pytest
 
-from rig.bench import analyser, analyser_grid
+from rig.bench import analyser
+from rig.cli import main
 from rig.commands import bench
+from rig.service.sweep import SweepPoint, read_sweep
 
 
 @pytest.fixture
@@ -27,6 +31,7 @@ def test_quick_bench_reports_every_method_with_errors_coverage_and_speed(
     assert set(report["summary"]) == {"fft", "xcorr", "sinefit", "bayes"}
     assert set(report["summaries"]) == {"all", "mixed", "hard"}
     assert len(report["cases"]) == 3
+    assert [row["case"] for row in report["sweep"]] == [case["case"] for case in report["cases"]]
     for case in report["cases"]:
         assert not case["refused"]
         frame_ms = 1e3 / case["camera_fps"]
@@ -49,38 +54,52 @@ def test_quick_bench_reports_every_method_with_errors_coverage_and_speed(
     assert "| sinefit |" in table and "| bayes |" in table and "confidently wrong" in table
 
 
-def test_grid_covers_every_axis_value_and_the_hard_cases() -> None:
-    grid = analyser_grid
-    cases = grid.grid(24)
-    configs = [case.config for case in cases[:24]]
-    assert {c.pendulum.period_s for c in configs} == set(grid.PERIODS_S)
-    assert {c.camera.fps for c in configs} == set(grid.CAMERA_FPS)
-    assert {c.display.refresh_hz for c in configs} == set(grid.DISPLAY_HZ)
-    assert {c.pendulum.amplitude_deg for c in configs} == set(grid.AMPLITUDES_DEG)
-    assert {c.pendulum.quality for c in configs} == set(grid.QUALITIES)
-    assert {case.impairment for case in cases[:24]} == set(grid.IMPAIRMENTS)
-    beyond_half = [case for case in cases if case.target_ms > case.config.pendulum.period_s * 500]
-    assert beyond_half
-    assert any(case.config.pendulum.release_s is not None for case in beyond_half)
+def _cases(spec: Path) -> list[SweepPoint]:
+    return read_sweep(spec).points(Path("runs"))
+
+
+def test_the_shipped_spec_parses_into_the_mixed_grid_its_named_cases_and_the_hard_grid() -> None:
+    points = _cases(analyser.SPEC)
+    groups = [point.labels["group"] for point in points]
+    assert groups == ["mixed"] * 48 + ["named"] * 5 + ["hard"] * 50
+    assert len({point.labels["case"] for point in points}) == len(points)
+    mixed = [point for point in points if point.labels["group"] == "mixed"]
+    configs = [point.config for point in mixed]
+    assert {c.pendulum.period_s for c in configs} == {0.6, 1.0, 1.4, 1.9}
+    assert {c.camera.fps for c in configs} == {60.0, 120.0, 240.0, 480.0}
+    assert {c.display.refresh_hz for c in configs} == {60.0, 90.0, 120.0, 144.0}
+    assert {c.pendulum.amplitude_deg for c in configs} == {5.0, 20.0, 45.0}
+    assert {c.pendulum.quality for c in configs} == {20.0, 100.0, 500.0}
+    assert {point.labels["impairment"] for point in mixed} == {"none", "noise", "blur", "dim", "missing"}
     assert len({c.display.phase for c in configs}) == len(configs)
-    assert grid.grid(24) == cases
+    beyond_half = [p for p in points if float(p.labels["target_ms"]) > p.config.pendulum.period_s * 500]
+    assert any(p.config.pendulum.release_s is not None for p in beyond_half)
+    film = {p.labels["impairment"]: p.config.camera for p in points}
+    assert film["noise"].noise_dn == 8.0 and film["dim"].display_white_dn == 45.0
+    assert film["blur"].impairments.blur_sigma_px == 2.5 and film["missing"].impairments.missing_fraction == 0.05
 
 
-def test_hard_grid_has_every_rate_pair_exposure_impairment_and_decimation() -> None:
-    cases = analyser_grid.hard_grid()
-    assert {case.group for case in cases} == {"hard"}
-    rates = {(case.config.camera.fps, case.config.display.refresh_hz) for case in cases}
-    assert rates >= set(analyser_grid.HARD_RATES)
-    fractions = {round(case.config.camera.exposure * case.config.camera.fps, 6) for case in cases}
-    assert fractions >= set(analyser_grid.HARD_EXPOSURES)
-    assert {case.impairment for case in cases} >= {impairment for impairment, *_ in analyser_grid.HARD_IMPAIRMENTS}
-    for fps, every in analyser_grid.DECIMATIONS:
-        starts = {case.decimation[1] for case in cases if case.decimation and case.decimation[0] == every}
-        assert starts == set(range(every))
-    table = [case for case in cases if case.name.startswith("table-")]
-    assert [(c.config.camera.fps, c.config.display.refresh_hz, c.config.display.phase) for c in table] == [
-        (60.0, 60.0, 0.0), (144.0, 144.0, 0.0)
-    ]  # fmt: skip
+def test_the_hard_grid_has_every_rate_pair_exposure_impairment_and_decimation() -> None:
+    hard = [point for point in _cases(analyser.SPEC) if point.labels["group"] == "hard"]
+    rates = {(p.config.camera.fps, p.config.display.refresh_hz) for p in hard}
+    assert rates >= {(60.0, 60.0), (120.0, 60.0), (60.0, 120.0), (144.0, 144.0), (240.0, 144.0), (59.94, 60.0), (90.0, 60.0), (30.0, 60.0)}
+    assert {round(p.config.camera.exposure * p.config.camera.fps, 6) for p in hard} >= {0.05, 0.25, 0.5, 1.0}
+    film = {p.labels["impairment"]: p.config.camera.impairments for p in hard}
+    assert film["dim-led"].dim_led == 0.35 and film["swapped"].mirrored and film["bright-object"].bright_object_dn == 900.0
+    assert film["occluded-sphere"].occluded == "sphere" and film["occluded-led"].occluded == "led"
+    decimated = [p.config.camera for p in hard if p.labels["impairment"] == "decimated"]
+    phases = {(c.fps, c.impairments.every_nth, c.impairments.first_frame) for c in decimated}
+    assert phases == {(240.0, 4, k) for k in range(4)} | {(120.0, 2, k) for k in range(2)}
+    assert {c.film_fps for c in decimated} == {60.0}
+    table = [p.config for p in hard if p.labels["case"].startswith("table-")]
+    assert [(c.camera.fps, c.display.refresh_hz, c.display.phase) for c in table] == [(60.0, 60.0, 0.0), (144.0, 144.0, 0.0)]
+
+
+def test_the_specs_are_package_data() -> None:
+    pyproject = tomllib.loads((Path(__file__).parents[3] / "pyproject.toml").read_text())
+    patterns = pyproject["tool"]["setuptools"]["package-data"]["rig.bench"]
+    shipped = {path.name for pattern in patterns for path in Path(analyser.__file__).parent.glob(pattern)}
+    assert shipped == {analyser.SPEC.name, analyser.QUICK_SPEC.name}
 
 
 @pytest.mark.parametrize(
@@ -101,15 +120,39 @@ def test_confidently_wrong_is_outside_by_more_than_half_a_millisecond_and_the_ha
     assert analyser.confidently_wrong(truth, latency, ci) is wrong
 
 
-def test_cases_that_share_a_film_simulate_it_once_and_rows_keep_the_cases_order(monkeypatch, tmp_path: Path) -> None:
-    cases = analyser_grid.quick_grid()
-    cases = [cases[0], cases[1], cases[0], cases[2], cases[1]]
-    simulated: list[Path] = []
-    monkeypatch.setattr(analyser, "simulate", lambda config, folder, overwrite: simulated.append(folder) or config)
-    monkeypatch.setattr(analyser, "run_case", lambda case, run, log: {"case": case.name, "film": repr(run), "group": case.group})
-    monkeypatch.setattr(analyser, "summarise", lambda rows: {})
+def test_rig_sweep_on_the_spec_gives_the_rows_of_the_bench(monkeypatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # The first of the quick cases; the bench's own analysis of each film (every method) is left
+    # out here: the rows compared are the sweep's, which the bench records beside its own.
+    text = analyser.QUICK_SPEC.read_text()
+    spec = tmp_path / "one.toml"
+    spec.write_text(text[: text.index("[[points]]", text.index("[[points]]") + 1)])
+    monkeypatch.setattr(analyser, "_case_record", lambda point, row, log, started: {"case": point.labels["case"], "group": "mixed"})
+    monkeypatch.setattr(analyser, "summarise", lambda cases: {})
     monkeypatch.setattr(analyser, "targets_met", lambda summaries: {})
-    report = analyser.run_bench(cases, tmp_path, lambda message: None)
-    assert len(simulated) == len({repr(case.config) for case in cases})
-    assert [row["case"] for row in report["cases"]] == [case.name for case in cases]
-    assert [row["film"] for row in report["cases"]] == [repr(case.config) for case in cases]
+    benched = analyser.run_bench(read_sweep(spec), tmp_path / "bench", lambda message: None)["sweep"]
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "sweep"), "--json"]) == 0
+    swept = json.loads(capsys.readouterr().out)
+
+    def comparable(rows: list[dict]) -> list[dict]:
+        return [row | {"video": Path(row["video"]).parent.name, "seconds": None} for row in rows]
+
+    assert len(swept) == 1 and swept[0]["status"] in ("ok", "warning")
+    assert swept[0]["case"].startswith("quick-a") and swept[0]["group"] == "named"
+    assert comparable(benched) == comparable(swept)
+    summary = (tmp_path / "bench" / "summary.csv").read_text().splitlines()[0]
+    assert summary == (tmp_path / "sweep" / "summary.csv").read_text().splitlines()[0]
+
+
+def test_grid_runs_the_points_of_its_group(monkeypatch, tmp_path: Path) -> None:
+    ran: list[str] = []
+
+    def measured(point: SweepPoint, log) -> dict:
+        ran.append(point.labels["case"])
+        return {"index": point.index, "bench": {"case": point.labels["case"], "group": point.labels["group"]}}
+
+    monkeypatch.setattr(analyser, "measure_point", measured)
+    monkeypatch.setattr(analyser, "summarise", lambda cases: {"cases": len(cases)})
+    monkeypatch.setattr(analyser, "targets_met", lambda summaries: {})
+    report = analyser.run_bench(read_sweep(analyser.QUICK_SPEC), tmp_path, lambda message: None, groups=analyser.GROUPS["hard"])
+    assert ran == [case["case"] for case in report["cases"]] and len(ran) == 1 and ran[0].startswith("quick-dim-led")
+    assert report["summaries"] == {"all": {"cases": 1}, "hard": {"cases": 1}}

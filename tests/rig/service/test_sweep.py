@@ -49,6 +49,34 @@ def test_settings_are_checked_against_the_configs_fields() -> None:
         build(SimulationConfig, {"seed.x": 1})
 
 
+def test_points_given_one_by_one_follow_the_grids_with_their_labels_or_their_settings(tmp_path: Path) -> None:
+    spec = tmp_path / "sweep.toml"
+    spec.write_text("""
+[base]
+duration_s = 3.0
+
+[grid]
+seed = [1, 2]
+
+[[points]]
+labels = { case = "dim LED", group = "hard" }
+camera = { fps = 120.0, impairments = { dim_led = 0.35 } }
+
+[[points]]
+"pendulum.period_s" = 0.7
+""")
+    sweep = read_sweep(spec)
+    points = sweep.points(tmp_path / "out")
+    assert [point.labels for point in points] == [
+        {"seed": "1"}, {"seed": "2"}, {"case": "dim LED", "group": "hard"}, {"pendulum.period_s": "0.7"}
+    ]  # fmt: skip
+    assert sweep.labels == ["seed", "case", "group", "pendulum.period_s"]
+    assert points[2].config.camera.impairments.dim_led == 0.35 and points[2].config.duration_s == 3.0
+    assert points[3].config.pendulum.period_s == 0.7 and points[3].out_dir == tmp_path / "out" / "point003"
+    hard = sweep.only(lambda labels: labels.get("group") == "hard").points(tmp_path / "out")
+    assert [(point.config, point.labels) for point in hard] == [(points[2].config, points[2].labels)]
+
+
 @pytest.mark.parametrize(
     "text, message",
     [
@@ -57,6 +85,8 @@ def test_settings_are_checked_against_the_configs_fields() -> None:
         ("[gird]\nseed = [1]\n", "unknown table"),
         ("[grid]\nseed = [1]\n[analysis]\nfps = 3\n", "\\[analysis\\] takes"),
         ("[grid\n", "not valid TOML"),
+        ("points = [1]\n", "list of tables"),
+        ("[[points]]\nlabels = 3\n", "labels must be a table"),
     ],
 )
 def test_a_bad_sweep_file_says_what_is_wrong(tmp_path: Path, text: str, message: str) -> None:
