@@ -1,10 +1,16 @@
-"""The one compiled part: analysis._jpeg_region, decoding a rectangle of a JPEG with the system's
-libjpeg(-turbo) (Debian: libjpeg62-turbo-dev). Everything else is declared in pyproject.toml."""
+"""The compiled parts, each with a pure-Python fallback where it is not built:
+
+* analysis._jpeg_region, decoding a rectangle of a JPEG with the system's libjpeg(-turbo) (Debian:
+  libjpeg62-turbo-dev);
+* rig.devices.trackers._fd_wait, a serial tracker's wait-and-read per record (plain POSIX).
+
+Everything else is declared in pyproject.toml."""
 
 from setuptools import Extension, setup
 
 setup(
     ext_modules=[
         Extension("analysis._jpeg_region", sources=["analysis/_jpeg_region.c"], libraries=["jpeg"]),
+        Extension("rig.devices.trackers._fd_wait", sources=["rig/devices/trackers/_fd_wait.c"]),
     ]
 )

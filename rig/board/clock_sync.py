@@ -150,16 +150,30 @@ class ClockModel:
         anchor = run[-1] if rig_time > run[-1].at else run[0]
         return anchor.midpoint + (drift.rate * (rig_time - anchor.at) if drift else 0.0)
 
-    def to_rig_time(self, board_time: float) -> float:
-        """The rig time of a board time: solves rig = board - offset(rig) (two steps suffice, the
-        offset changing by parts per million)."""
+    def offsets_at(self, rig_times: Sequence[float]) -> list[float]:
+        """`offset_at` of each of `rig_times`, the same numbers; the extrapolation past the latest
+        measurement, where a stream's new events fall, is set up once for all of them."""
         latest = self.latest
         if latest is None:
             raise ValueError("the clock has not been synchronised")
-        rig_time = board_time - latest.midpoint
+        midpoint, at = latest.midpoint, latest.at
+        rate = self._drift.rate if self._drift else 0.0
+        return [midpoint + rate * (t - at) if t > at else self.offset_at(t) for t in rig_times]
+
+    def to_rig_time(self, board_time: float) -> float:
+        """The rig time of a board time: solves rig = board - offset(rig) (two steps suffice, the
+        offset changing by parts per million)."""
+        return self.to_rig_times([board_time])[0]
+
+    def to_rig_times(self, board_times: Sequence[float]) -> list[float]:
+        """`to_rig_time` of each of `board_times`."""
+        latest = self.latest
+        if latest is None:
+            raise ValueError("the clock has not been synchronised")
+        rig_times = [board_time - latest.midpoint for board_time in board_times]
         for _ in range(2):
-            rig_time = board_time - self.offset_at(rig_time)
-        return rig_time
+            rig_times = [board_time - offset for board_time, offset in zip(board_times, self.offsets_at(rig_times))]
+        return rig_times
 
 
 class TickUnwrapper:

@@ -21,7 +21,7 @@ so far, started afresh when the device's clock restarts.
 from __future__ import annotations
 
 import math
-from typing import Any, Protocol
+from typing import Any, Protocol, Sequence
 
 from rig.board.clock_sync import CLOCK_RESTART_S, ClockModel, OffsetInterval
 from rig.devices.trackers.profile import SECONDS_PER, TIME, Profile
@@ -35,9 +35,10 @@ class ClockMapping(Protocol):
     latency_known: bool
 
     def observe(self, device_time: float | None, t_arrival: float) -> None:
-        """Learn from a record, before `sensor_time` is asked for it and the others that came with it."""
+        """Learn from a record, before `sensor_times` is asked for it and the others taken with it."""
 
-    def sensor_time(self, device_time: float | None, t_arrival: float) -> float: ...
+    def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
+        """The sensor times of records taken together (a consumer's batch), in one call."""
 
     def restart(self) -> None:
         """The link was lost and restored: the device's clock may have restarted."""
@@ -66,8 +67,8 @@ class ArrivalTime:
     def observe(self, device_time: float | None, t_arrival: float) -> None:
         pass
 
-    def sensor_time(self, device_time: float | None, t_arrival: float) -> float:
-        return t_arrival
+    def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
+        return list(arrivals)
 
     def restart(self) -> None:
         pass
@@ -102,14 +103,21 @@ class OneWayMapping:
         elif bound > self._second:
             self._second = bound
 
-    def sensor_time(self, device_time: float | None, t_arrival: float) -> float:
-        assert device_time is not None
-        offset = self._best
-        if self.model.latest is not None:
-            modelled = self.model.offset_at(t_arrival)
-            if not (self._fresh and abs(self._best - modelled) > CLOCK_RESTART_S):
-                offset = max(modelled, device_time - t_arrival)
-        return min(device_time - offset, t_arrival)
+    def sensor_time(self, device_time: float, t_arrival: float) -> float:
+        return self.sensor_times([device_time], [t_arrival])[0]
+
+    def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
+        """Each record's device time less the modelled offset at its arrival (the current window's
+        best bound while the model is empty, or while a restarted clock is far from it), never
+        after its arrival."""
+        best = self._best
+        if self.model.latest is None:
+            return [min(d - best, t) for d, t in zip(device_times, arrivals)]  # type: ignore[operator]
+        times = []
+        for d, t, modelled in zip(device_times, arrivals, self.model.offsets_at(arrivals)):
+            offset = best if self._fresh and abs(best - modelled) > CLOCK_RESTART_S else max(modelled, d - t)  # type: ignore[operator]
+            times.append(min(d - offset, t))  # type: ignore[operator]
+        return times
 
     def _close_window(self) -> None:
         gap = self._best - self._second if self._second > -math.inf else 0.0
@@ -155,9 +163,11 @@ class CorrectedMapping:
     def observe(self, device_time: float | None, t_arrival: float) -> None:
         pass
 
-    def sensor_time(self, device_time: float | None, t_arrival: float) -> float:
-        assert device_time is not None
+    def sensor_time(self, device_time: float, t_arrival: float) -> float:
         return self.model.to_rig_time(device_time)
+
+    def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
+        return self.model.to_rig_times(device_times)  # type: ignore[arg-type]
 
     def restart(self) -> None:
         self._last = None

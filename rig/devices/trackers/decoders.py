@@ -22,41 +22,17 @@ from __future__ import annotations
 import math
 import struct
 
-from rig.board.clock_sync import TickUnwrapper
 from rig.devices.trackers.checksums import CHECK_BYTES, CHECKSUMS
-from rig.devices.trackers.profile import TIME, Profile
+from rig.devices.trackers.profile import Profile
 from rig.devices.trackers.readings import Reading, ReadingMaker
 
 MAX_LINE = 4096
-
-
-class DeviceTime:
-    """The device's time field in seconds: integer counters unwrapped at their width."""
-
-    def __init__(self, profile: Profile, maker: ReadingMaker) -> None:
-        time_field = profile.field(TIME)
-        bits = time_field.integer_bits if time_field else None
-        self._unwrap = TickUnwrapper(bits) if bits else None
-        self._maker = maker
-
-    def seconds(self, values: tuple | list) -> float | None:
-        raw = self._maker.raw_device_time(values)
-        if raw is None:
-            return None
-        if self._unwrap is not None:
-            raw = self._unwrap.unwrap(int(raw))
-        return self._maker.seconds(raw)
-
-    def reset(self) -> None:
-        if self._unwrap is not None:
-            self._unwrap.reset()
 
 
 class TextDecoder:
     def __init__(self, profile: Profile) -> None:
         self.corrupt = 0
         self._maker = ReadingMaker(profile)
-        self._time = DeviceTime(profile, self._maker)
         self._terminator = profile.terminator
         self._separator = profile.separator
         self._count = len(profile.fields)
@@ -86,23 +62,22 @@ class TextDecoder:
             self.corrupt += bool(line.strip())
             return None
         try:
-            values = [float(part) for part in parts]
+            values = list(map(float, parts))
         except ValueError:
             self.corrupt += [part.strip() for part in parts] != self._header
             return None
-        return self._maker.make(values, t_arrival, self._time.seconds(values))
+        return self._maker.make(values, t_arrival)
 
     def reset(self) -> None:
         self.corrupt += bool(self._buffer.strip())
         self._buffer.clear()
-        self._time.reset()
+        self._maker.reset()
 
 
 class BinaryDecoder:
     def __init__(self, profile: Profile) -> None:
         self.corrupt = 0
         self._maker = ReadingMaker(profile)
-        self._time = DeviceTime(profile, self._maker)
         self._sync = profile.sync
         self._body = struct.Struct(profile.struct_format)
         self._check = CHECKSUMS[profile.checksum]
@@ -137,7 +112,7 @@ class BinaryDecoder:
                 continue
             self._end_stretch()
             values = self._body.unpack(body)
-            readings.append(self._maker.make(values, t_arrival, self._time.seconds(values)))
+            readings.append(self._maker.make(values, t_arrival))
             start += size
         del buffer[:start]
         return readings
@@ -151,14 +126,13 @@ class BinaryDecoder:
         self._discarded += len(self._buffer)
         self._end_stretch()
         self._buffer.clear()
-        self._time.reset()
+        self._maker.reset()
 
 
 class HidReportDecoder:
     def __init__(self, profile: Profile) -> None:
         self.corrupt = 0
         self._maker = ReadingMaker(profile)
-        self._time = DeviceTime(profile, self._maker)
         self._report_id = profile.report_id
         self._body = struct.Struct(profile.struct_format)
         self.report_bytes = self._body.size + (1 if self._report_id else 0)
@@ -172,10 +146,10 @@ class HidReportDecoder:
             self.corrupt += 1
             return []
         values = self._body.unpack_from(report)
-        return [self._maker.make(values, t_arrival, self._time.seconds(values))]
+        return [self._maker.make(values, t_arrival)]
 
     def reset(self) -> None:
-        self._time.reset()
+        self._maker.reset()
 
 
 Decoder = TextDecoder | BinaryDecoder | HidReportDecoder

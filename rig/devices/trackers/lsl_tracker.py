@@ -61,6 +61,37 @@ def time_correction(inlet: Any, timeout_s: float) -> tuple[float, float]:
     return offset, uncertainty.value
 
 
+class SamplePuller:
+    """`inlet.pull_sample` without pylsl's per-call Python (the argument objects it builds, its error
+    handler, its list): liblsl's `lsl_pull_sample_d` into a buffer made once, the timeout too. The
+    reader thread calls it once per wake-up, once per sample at 1000 Hz; liblsl converts any
+    numeric channel format to double."""
+
+    def __init__(self, inlet: Any, timeout_s: float) -> None:
+        lsl = pylsl()
+        self._pull = lsl.lib.lib.lsl_pull_sample_d
+        self._available = lsl.lib.lib.lsl_samples_available
+        self._handle_error = lsl.util.handle_error
+        self._inlet = inlet  # kept alive while its handle is used
+        self._handle = inlet.obj
+        self._values = (ctypes.c_double * len(CHANNELS))()
+        self._timeout = ctypes.c_double(timeout_s)
+        self._error = ctypes.c_int32()
+        self._error_ref = ctypes.byref(self._error)
+
+    def pull(self) -> tuple[list[float], float] | None:
+        """The next sample and its stamp, waiting up to the timeout; None if none came. LostError
+        when the sender is gone, as pylsl raises it."""
+        stamp = self._pull(self._handle, self._values, len(CHANNELS), self._timeout, self._error_ref)
+        if self._error.value:
+            self._handle_error(self._error.value)
+        return (self._values[:], stamp) if stamp else None
+
+    def waiting(self) -> int:
+        """Samples the inlet holds now."""
+        return self._available(self._handle)
+
+
 def lsl_origin(clock: Clock) -> float:
     """The LSL clock's reading at the rig clock's zero. LSL's clock is the system's monotonic clock,
     the same as a MonotonicClock's; another clock is assumed to run at its rate."""
@@ -79,6 +110,7 @@ class LslLink:
         self.mapping = CorrectedMapping()
         self.source_id = ""
         self._inlet: Any = None
+        self._puller: SamplePuller | None = None
         self._next_correction = 0.0
         self._correction: tuple[float, float, float] | None = None
 
@@ -106,21 +138,23 @@ class LslLink:
         # Handed to the mapping with the first samples, on the thread that maps them.
         self._correction = (correction, uncertainty, clock.now())
         self._next_correction = clock.now() + CORRECTION_INTERVAL_S
+        self._puller = SamplePuller(inlet, READ_TIMEOUT_S)
         self._inlet = inlet
 
     def receive(self, clock: Clock) -> tuple[list, list, tuple[float, float, float] | None] | None:
         """(samples, their LSL stamps, a fresh clock correction (offset, uncertainty, rig time) or
         None), or None if nothing came in time."""
         lsl = pylsl()
-        inlet = self._inlet
-        if inlet is None:
+        inlet, puller = self._inlet, self._puller
+        if inlet is None or puller is None:
             raise LinkLost("the inlet is closed")
         try:
-            first, stamp = inlet.pull_sample(timeout=READ_TIMEOUT_S)
-            if first is None:
+            pulled = puller.pull()
+            if pulled is None:
                 return None
+            first, stamp = pulled
             # A chunk pull allocates buffers for its largest size: asked only for what is waiting.
-            waiting = inlet.samples_available()
+            waiting = puller.waiting()
             rest, stamps = inlet.pull_chunk(timeout=0.0, max_samples=waiting) if waiting else ([], [])
             now = clock.now()
             if now >= self._next_correction:
@@ -148,6 +182,7 @@ class LslLink:
 
     def close(self) -> None:
         inlet, self._inlet = self._inlet, None
+        self._puller = None
         if inlet is not None:
             inlet.close_stream()
 

@@ -4,7 +4,8 @@ values away from a predictor.
 A `Reading` is one decoded record before its clock is mapped: the host's arrival time, the device's
 own time and record counter where it sends them, the position in metres, the orientation as it
 came (maybe not of unit norm), and the angular rate where the profile has one. `ReadingMaker` turns
-the record's fields, in profile order, into one; `check_reading` says what is impossible about it.
+the record's fields, in profile order, into one, with no per-field Python loop (at 1000 records a
+second the decoding is most of the consumer's cost); `check_reading` says what is impossible about it.
 Euler angles become a quaternion with plain float arithmetic (a call into scipy per sample would
 cost more than the whole reading budget).
 """
@@ -13,9 +14,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from operator import itemgetter, mul
+from typing import Callable, Sequence
 
 from predictors.scalar_quaternion import Quaternion, multiply
+from rig.board.clock_sync import TickUnwrapper
 from rig.devices.trackers.profile import (
     EULER,
     METRES_PER,
@@ -64,57 +67,67 @@ def euler_quaternion(sequence: str, angles: Sequence[float]) -> Quaternion:
 
 
 class ReadingMaker:
-    """Turns a record's values, in the profile's field order, into a `Reading`."""
+    """Turns a record's values, in the profile's field order, into a `Reading`. Each group of fields
+    (position, orientation, angular rate) is picked by index and multiplied by one factor per field
+    (scale times unit), skipped where every factor is 1 and the fields are floats; an integer time
+    field is unwrapped at its width (`reset` forgets its history)."""
 
     def __init__(self, profile: Profile) -> None:
+        self._euler = profile.euler
+        self._position = _group(profile, POSITION, METRES_PER[profile.position_unit])
+        self._quaternion = _group(profile, QUATERNION, 1.0)
+        self._euler_angles = _group(profile, EULER, RADIANS_PER[profile.angle_unit])
+        self._rate = _group(profile, RATE, RADIANS_PER[profile.angle_unit])
         names = profile.names
-        self._profile = profile
-        self._scale = [profile.scale.get(name, 1.0) for name in names]
-        self._position = [names.index(n) for n in POSITION] if profile.has(*POSITION) else None
-        self._quaternion = [names.index(n) for n in QUATERNION] if profile.has(*QUATERNION) else None
-        self._euler = [names.index(n) for n in EULER] if profile.has(*EULER) else None
-        self._rate = [names.index(n) for n in RATE] if profile.has(*RATE) else None
-        self._time = names.index(TIME) if TIME in names else None
         self._seq = names.index(SEQUENCE) if SEQUENCE in names else None
-        self._metres = METRES_PER[profile.position_unit]
-        self._radians = RADIANS_PER[profile.angle_unit]
+        self._time = names.index(TIME) if TIME in names else None
+        time_field = profile.field(TIME)
+        bits = time_field.integer_bits if time_field else None
+        self._unwrap = TickUnwrapper(bits) if bits else None
+        self._time_scale = profile.scale.get(TIME, 1.0)
         self._seconds = SECONDS_PER[profile.time_unit]
 
-    @property
-    def has_device_time(self) -> bool:
-        return self._time is not None
-
-    def raw_device_time(self, values: Sequence[float]) -> float | None:
-        """The time field as sent, before scale and unit (an integer counter may wrap)."""
-        return None if self._time is None else values[self._time]
-
-    def make(self, values: Sequence[float], t_arrival: float, device_time: float | None) -> Reading:
-        """A reading of `values`; `device_time` is the time field in seconds after unwrapping."""
-        scale = self._scale
-        if self._position is None:
-            position = (0.0, 0.0, 0.0)
-        else:
-            m = self._metres
-            x, y, z = (values[i] * scale[i] * m for i in self._position)
-            position = (x, y, z)
+    def make(self, values: Sequence[float], t_arrival: float) -> Reading:
+        """A reading of `values`, its time field (unwrapped) in seconds."""
+        position = _ORIGIN if self._position is None else _picked(self._position, values)
         if self._quaternion is not None:
-            w, x, y, z = (values[i] * scale[i] for i in self._quaternion)
-            orientation = (w, x, y, z)
+            orientation = _picked(self._quaternion, values)
         else:
-            r = self._radians
-            orientation = euler_quaternion(self._profile.euler, [values[i] * scale[i] * r for i in self._euler])
-        rate = None
-        if self._rate is not None:
-            r = self._radians
-            wx, wy, wz = (values[i] * scale[i] * r for i in self._rate)
-            rate = (wx, wy, wz)
+            orientation = euler_quaternion(self._euler, _picked(self._euler_angles, values))  # type: ignore[arg-type]
+        rate = None if self._rate is None else _picked(self._rate, values)
         seq = None if self._seq is None else int(values[self._seq])
-        return Reading(t_arrival, device_time, seq, position, orientation, rate)
+        device_time = None
+        if self._time is not None:
+            raw = values[self._time]
+            if self._unwrap is not None:
+                raw = self._unwrap.unwrap(int(raw))
+            device_time = raw * self._time_scale * self._seconds
+        return Reading(t_arrival, device_time, seq, position, orientation, rate)  # type: ignore[arg-type]
 
-    def seconds(self, raw_time: float) -> float:
-        """A time field's value (after unwrapping) in seconds."""
-        assert self._time is not None
-        return raw_time * self._scale[self._time] * self._seconds
+    def reset(self) -> None:
+        """What follows comes from a device whose time counter may have started again."""
+        if self._unwrap is not None:
+            self._unwrap.reset()
+
+
+_ORIGIN = (0.0, 0.0, 0.0)
+_Group = tuple[Callable[[Sequence[float]], tuple], tuple[float, ...] | None]
+
+
+def _group(profile: Profile, names: tuple[str, ...], unit: float) -> _Group | None:
+    """How to pick the fields `names` out of a record's values, and their factors (None: all 1, on
+    float fields); None where the profile has no such fields."""
+    if not profile.has(*names):
+        return None
+    indices = [profile.names.index(name) for name in names]
+    factors = tuple(profile.scale.get(name, 1.0) * unit for name in names)
+    floats = all(profile.field(name).integer_bits is None for name in names)  # type: ignore[union-attr]
+    return itemgetter(*indices), (None if floats and all(f == 1.0 for f in factors) else factors)
+
+
+def _picked(group: _Group, values: Sequence[float]) -> tuple:
+    pick, factors = group
+    return pick(values) if factors is None else tuple(map(mul, pick(values), factors))
 
 
 def check_reading(reading: Reading, unit_tolerance: float) -> str | None:

@@ -11,8 +11,10 @@ the rig's; any other query option goes to pyserial with the URL.
 from __future__ import annotations
 
 import errno
+import logging
 import os
 import select
+from functools import partial
 from typing import Callable, Protocol
 from urllib.parse import parse_qsl, urlencode
 
@@ -26,11 +28,23 @@ from rig.devices.trackers.readings import Reading
 from rig.devices.trackers.stream import LinkLost, TrackerStream
 from rig.errors import ConfigError, RigError
 
+try:
+    from rig.devices.trackers._fd_wait import wait_read
+except ImportError:
+    wait_read = None
+
+log = logging.getLogger("rig.trackers")
+
 DEFAULT_PROFILE = "csv"
 DEFAULT_BAUD = 115200
 READ_TIMEOUT_S = 0.05
+READ_TIMEOUT_MS = round(READ_TIMEOUT_S * 1000)
 # Most bytes taken from a port with a file descriptor in one read.
 CHUNK_BYTES = 65536
+WAIT_READ_MISSING = (
+    "rig.devices.trackers._fd_wait is not built, so serial ports are waited on and read through Python: "
+    "the same records, at more CPU per record; to build it, reinstall the package (pip install -e .)"
+)
 
 
 class SerialPort(Protocol):
@@ -73,6 +87,21 @@ def _file_descriptor(port: SerialPort) -> int | None:
         return None
 
 
+def waiting_reader(fd: int) -> Callable[[int, int], bytes | None]:
+    """`read(timeout_ms, size)` for `fd`: waits up to timeout_ms for it to be readable and reads what
+    it holds, up to `size` bytes; None if nothing came in time, b"" at its end, OSError as os.read.
+    The compiled `_fd_wait.wait_read` where it is built, else a poll object registered once."""
+    if wait_read is not None:
+        return partial(wait_read, fd)
+    poller = select.poll()
+    poller.register(fd, select.POLLIN)
+
+    def read(timeout_ms: int, size: int) -> bytes | None:
+        return os.read(fd, size) if poller.poll(timeout_ms) else None
+
+    return read
+
+
 def _open_problem(url: str, error: Exception) -> RigError:
     code = getattr(error, "errno", None)
     if code == errno.EACCES:
@@ -87,10 +116,11 @@ def _open_problem(url: str, error: Exception) -> RigError:
 
 class SerialLink:
     """A pyserial port read through the profile's decoder. A port with a file descriptor (a device, a
-    pty, a socket; pyserial keeps no buffer of its own for these) is waited on with select and read
-    straight from the descriptor, whatever it holds: pyserial's socket handler counts a waiting
-    socket as one byte, which would make reads byte by byte, and its read loop costs more than the
-    decoding. Others (loop://, rfc2217://) are read through pyserial with its timeout."""
+    pty, a socket; pyserial keeps no buffer of its own for these) is waited on and read straight
+    from the descriptor, whatever it holds (`waiting_reader`): pyserial's socket handler counts a
+    waiting socket as one byte, which would make reads byte by byte, and its read loop costs more
+    than the decoding. At 1000 records a second that wait and read is most of the reader thread's
+    cost. Others (loop://, rfc2217://) are read through pyserial with its timeout."""
 
     def __init__(self, url: str, baud: int, profile: Profile, open_port: Callable[[str, int], SerialPort]) -> None:
         self.url = url
@@ -99,7 +129,7 @@ class SerialLink:
         self._open_port = open_port
         self._decoder: TextDecoder | BinaryDecoder = decoder_for(profile)  # type: ignore[assignment]
         self._port: SerialPort | None = None
-        self._fd: int | None = None
+        self._read: Callable[[int, int], bytes | None] | None = None
 
     @property
     def corrupt(self) -> int:
@@ -110,7 +140,8 @@ class SerialLink:
             port = self._open_port(self.url, self.baud)
         except (serial.SerialException, OSError, ValueError) as error:
             raise _open_problem(self.url, error) from None
-        self._fd = _file_descriptor(port)
+        fd = _file_descriptor(port)
+        self._read = None if fd is None else waiting_reader(fd)
         self._port = port
 
     def receive(self, clock: Clock) -> bytes | None:
@@ -118,10 +149,10 @@ class SerialLink:
         if port is None:
             raise LinkLost("the port is closed")
         try:
-            if self._fd is not None:
-                if not select.select([self._fd], [], [], READ_TIMEOUT_S)[0]:
+            if self._read is not None:
+                data = self._read(READ_TIMEOUT_MS, CHUNK_BYTES)
+                if data is None:
                     return None
-                data = os.read(self._fd, CHUNK_BYTES)
                 if not data:
                     raise LinkLost("the port reports data but returned none (disconnected)")
             else:
@@ -150,6 +181,8 @@ def serial_tracker(address: str, open_port: Callable[[str, int], SerialPort] = o
     """An unconnected serial tracker for `URL[?profile=...&baud=...]`."""
     url, profile_name, baud = parse_serial_address(address)
     profile = load_profile(profile_name)
+    if wait_read is None:
+        log.warning(WAIT_READ_MISSING)
     if profile.format == "hid":
         raise ConfigError(f"profile {profile.name} describes HID reports; a serial tracker needs a text or binary profile")
     return TrackerStream(

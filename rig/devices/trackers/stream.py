@@ -6,11 +6,11 @@ chunk with its arrival time and queues it: that is all the thread does per wake-
 1000 records a second the wake-ups are most of the cost, and code run once per wake-up runs
 cold, several times slower than the same code run over a batch. The consumer's `poll()` (the
 session's render loop, or `rig record-tracker`), which never blocks, or `wait(timeout)`, decodes
-the queued chunks into records: each is checked, its device time mapped onto the rig clock,
-what was wrong counted, in arrival order. A record is available to a predictor from its arrival
-time, when the reader queued its chunk. A lost link is logged, leaves a gap, and is
-reopened until the stream is closed; everything that happened is in `report()`. One thread
-consumes a stream.
+the queued chunks into records: each is checked and what was wrong counted, in arrival order,
+then the device times of all it took are mapped onto the rig clock in one call. A record is
+available to a predictor from its arrival time, when the reader queued its chunk. A lost link is
+logged, leaves a gap, and is reopened until the stream is closed; everything that happened is in
+`report()`. One thread consumes a stream.
 """
 
 from __future__ import annotations
@@ -64,11 +64,6 @@ class Link(Protocol):
         """Forgets a partial record: what follows comes from a reopened device."""
 
     def close(self) -> None: ...
-
-
-class _Chunk(NamedTuple):
-    payload: Any
-    t_arrival: float
 
 
 _RESTORED = object()
@@ -140,7 +135,8 @@ class TrackerStream:
         self._sequence = SequenceCheck(self.counters, sequence_bits)
         self._describe = describe
         self._clock: Clock | None = None
-        self._chunks: deque[_Chunk | object] = deque()
+        self._chunks: deque[tuple[Any, float] | object] = deque()
+        """(payload, arrival time) as received, and the markers below, in order."""
         self._ready = threading.Condition()
         self._waiting = False
         self._stop = threading.Event()
@@ -177,15 +173,20 @@ class TrackerStream:
         started = time.thread_time()
         chunks = self._chunks
         records: list[TrackerRecord] = []
+        possible: list[Reading] = []
         while chunks:
             chunk = chunks.popleft()
-            if chunk is _RESTORED:
-                self._restart()
-            elif chunk is _CLOSED:
-                self.link.restart()
-                self._count_corrupt()
+            if chunk is _RESTORED or chunk is _CLOSED:
+                self._map(possible, records)
+                possible = []
+                if chunk is _RESTORED:
+                    self._restart()
+                else:
+                    self.link.restart()
+                    self._count_corrupt()
             else:
-                self._accept(chunk, records)
+                self._accept(*chunk, possible)  # type: ignore[misc]
+        self._map(possible, records)
         self.decode_cpu_s += time.thread_time() - started
         return records
 
@@ -234,19 +235,22 @@ class TrackerStream:
             self._sequence.discarded(new)
 
     def _read_loop(self) -> None:
+        """Receives, stamps and queues until the stream is closed; run once per wake-up, so it
+        touches as little as it can (bound methods, a plain tuple per chunk)."""
         started = time.thread_time()
-        clock, link, chunks = self._clock, self.link, self._chunks
+        clock = self._clock
+        receive, now, queue, stopped = self.link.receive, clock.now, self._chunks.append, self._stop.is_set
         try:
-            while not self._stop.is_set():
+            while not stopped():
                 try:
-                    payload = link.receive(clock)
+                    payload = receive(clock)
                 except LinkLost as lost:
                     self._lost(str(lost))
                     if not self._reopen():
                         return
                     continue
                 if payload is not None:
-                    chunks.append(_Chunk(payload, clock.now()))
+                    queue((payload, now()))
                     if self._waiting:
                         self._wake()
         except BaseException as error:  # noqa: BLE001 - handed to the consumer's thread, never lost
@@ -255,16 +259,15 @@ class TrackerStream:
         finally:
             self.reader_cpu_s += time.thread_time() - started
 
-    def _accept(self, chunk: _Chunk, records: list[TrackerRecord]) -> None:
-        """Decodes, checks and counts one chunk's readings and adds their records to `records`; the
-        clock mapping learns from all of them before it maps any, so records that came together
-        keep their order in sensor time."""
-        readings = self.link.decode(chunk.payload, chunk.t_arrival)
+    def _accept(self, payload: Any, t_arrival: float, possible: list[Reading]) -> None:
+        """Decodes, checks and counts one chunk's readings, in order, and adds the possible ones to
+        `possible`, which the clock mapping learns from before `_map` maps them."""
+        readings = self.link.decode(payload, t_arrival)
         self._count_corrupt()
         if not readings:
             return
         counters, mapping, sequence = self.counters, self.mapping, self._sequence
-        possible = []
+        taken = len(possible)
         for reading in readings:
             problem = check_reading(reading, self._unit_tolerance)
             if problem is not None:
@@ -276,20 +279,26 @@ class TrackerStream:
             sequence.accept(reading.seq, reading.device_time)
             mapping.observe(reading.device_time, reading.t_arrival)
             possible.append(reading)
+        if len(possible) == taken:
+            return
+        counters.received += len(possible) - taken
+        if self._last_arrival is not None and t_arrival - self._last_arrival > GAP_S:
+            self._event("gap", f"no samples for {t_arrival - self._last_arrival:.3f} s", t_arrival)
+        self._last_arrival = t_arrival
+
+    def _map(self, possible: list[Reading], records: list[TrackerRecord]) -> None:
+        """Maps the clock of readings taken together, in one call (so they keep their order in sensor
+        time), and adds their records to `records`."""
         if not possible:
             return
-        latency = self.latency if mapping.latency_known else None
-        for reading in possible:
-            t_sensor = mapping.sensor_time(reading.device_time, reading.t_arrival)
-            if latency is not None:
-                latency.add(reading.t_arrival - t_sensor)
-            records.append(
-                TrackerRecord(t_sensor, reading.t_arrival, reading.position, reading.orientation, reading.device_time, reading.seq, reading.angular_rate)
-            )
-        counters.received += len(possible)
-        if self._last_arrival is not None and chunk.t_arrival - self._last_arrival > GAP_S:
-            self._event("gap", f"no samples for {chunk.t_arrival - self._last_arrival:.3f} s", chunk.t_arrival)
-        self._last_arrival = chunk.t_arrival
+        arrivals = [reading.t_arrival for reading in possible]
+        sensor_times = self.mapping.sensor_times([reading.device_time for reading in possible], arrivals)
+        if self.mapping.latency_known:
+            self.latency.add_many([t_arrival - t_sensor for t_arrival, t_sensor in zip(arrivals, sensor_times)])
+        records.extend(
+            TrackerRecord(t_sensor, r.t_arrival, r.position, r.orientation, r.device_time, r.seq, r.angular_rate)  # type: ignore[arg-type]
+            for t_sensor, r in zip(sensor_times, possible)
+        )
 
     def _wake(self) -> None:
         """Wakes a consumer in `wait_records`: the reader appends without the lock (a deque's append

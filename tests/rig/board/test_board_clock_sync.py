@@ -80,6 +80,16 @@ def test_board_to_rig_time_inverts_the_offset(offset: float, rig_time: float) ->
     assert model.to_rig_time(board_time) == pytest.approx(rig_time, abs=1e-9)
 
 
+@given(st.lists(st.floats(-10.0, 40.0), max_size=30), st.integers(1, 4))
+def test_offsets_of_many_times_are_the_offsets_of_each(times: list[float], measurements: int) -> None:
+    model = ClockModel()
+    for k in range(measurements):
+        offset = 5.0 + 40e-6 * 10.0 * k
+        model.add(OffsetInterval(offset - 20e-6, offset + 20e-6, 10.0 * k))
+    assert model.offsets_at(times) == [model.offset_at(t) for t in times]
+    assert model.to_rig_times(times) == [model.to_rig_time(t) for t in times]
+
+
 def test_a_board_clock_restart_starts_a_new_run() -> None:
     model = ClockModel()
     model.add(OffsetInterval(100.0, 100.0001, 0.0))

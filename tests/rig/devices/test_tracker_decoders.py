@@ -11,7 +11,7 @@ import pytest
 from rig.devices.trackers.clock_mapping import WINDOW_S, CorrectedMapping, OneWayMapping
 from rig.devices.trackers.counters import LatencyHistogram, SequenceCheck, TrackerCounters
 from rig.devices.trackers.decoders import decoder_for
-from rig.devices.trackers.profile import load_profile
+from rig.devices.trackers.profile import load_profile, parse_profile
 from rig.devices.trackers.readings import Reading, check_reading
 from rig.emulate.encode import Emission, RecordEncoder
 from rig.emulate.faults import ByteFaults, parse_faults
@@ -96,6 +96,19 @@ def test_one_way_mapping_removes_jitter_and_finds_drift() -> None:
     assert described["drift_ppm"] == pytest.approx(drift * 1e6, abs=max(5.0, 3 * described["drift_uncertainty_ppm"]))
 
 
+def test_records_mapped_together_get_the_times_each_would_get_alone() -> None:
+    rng = np.random.default_rng(5)
+    sensed = np.arange(2000) / 500.0
+    device = 1000.0 + sensed * (1.0 + 80e-6)
+    arrival = sensed + 0.004 + rng.exponential(0.0005, sensed.size)
+    mapping = OneWayMapping(1e-6)
+    for d, a in zip(device, arrival):
+        mapping.observe(d, a)
+    together = mapping.sensor_times(device.tolist(), arrival.tolist())
+    assert together == [mapping.sensor_time(d, a) for d, a in zip(device, arrival)]
+    assert np.all(np.diff(together) > 0), "records taken together keep their order in sensor time"
+
+
 def test_one_way_mapping_follows_a_device_clock_that_restarts() -> None:
     mapping = OneWayMapping(1e-6)
     for k in range(1000):
@@ -113,6 +126,26 @@ def test_corrected_mapping_applies_the_round_trip_offset() -> None:
     # The sender's time 50.75 is local time 51.0, which is rig time 51.0 - 100.0.
     assert mapping.sensor_time(50.75, 0.0) == pytest.approx(-49.0)
     assert mapping.describe()["offset_interval_s"] == pytest.approx([100.0 - 0.25 - 1e-4, 100.0 - 0.25 + 1e-4])
+
+
+def test_the_latency_histogram_keeps_impossible_latencies_in_its_end_bins() -> None:
+    histogram = LatencyHistogram()
+    histogram.add_many([-0.5, 1e12, 0.001055])
+    assert histogram.count == 3
+    assert histogram.quantile_ms(0.0) == pytest.approx(0.005), "a negative latency counts in the first bin"
+    assert histogram.quantile_ms(0.5) == pytest.approx(1.055), "1.055 ms falls in the bin from 1.05 to 1.06 ms"
+    assert histogram.quantile_ms(1.0) == pytest.approx(2000.0 - 0.005), "beyond 2 s counts in the last bin"
+
+
+def test_integer_fields_with_unit_scale_decode_to_floats() -> None:
+    profile = parse_profile(
+        'format = "binary"\nsync = "a5"\nfields = ["px:i16", "py:i16", "pz:i16", "qw:f32", "qx:f32", "qy:f32", "qz:f32"]\n',
+        "test", "integer-position",
+    )
+    sent = Emission(0, 0.0, (3.0, -2.0, 1.0), (1.0, 0.0, 0.0, 0.0))
+    (reading,) = decoder_for(profile).feed(RecordEncoder(profile).encode(sent), 1.0)
+    assert reading.position == (3.0, -2.0, 1.0) and all(type(v) is float for v in reading.position)
+    assert reading.orientation == (1.0, 0.0, 0.0, 0.0) and reading.device_time is None
 
 
 def test_the_latency_histogram_gives_median_and_95th_percentile() -> None:
