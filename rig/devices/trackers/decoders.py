@@ -29,9 +29,22 @@ from rig.devices.trackers.readings import Reading, ReadingMaker
 MAX_LINE = 4096
 
 
-class TextDecoder:
-    def __init__(self, profile: Profile) -> None:
+class _DamageSince:
+    """Counts damaged records (`corrupt`) and tells each reading how many came since the last one."""
+
+    def __init__(self) -> None:
         self.corrupt = 0
+        self._told = 0
+
+    def _placed(self, reading: Reading) -> Reading:
+        reading.damaged_before = self.corrupt - self._told
+        self._told = self.corrupt
+        return reading
+
+
+class TextDecoder(_DamageSince):
+    def __init__(self, profile: Profile) -> None:
+        super().__init__()
         self._maker = ReadingMaker(profile)
         self._terminator = profile.terminator
         self._separator = profile.separator
@@ -66,7 +79,7 @@ class TextDecoder:
         except ValueError:
             self.corrupt += [part.strip() for part in parts] != self._header
             return None
-        return self._maker.make(values, t_arrival)
+        return self._placed(self._maker.make(values, t_arrival))
 
     def reset(self) -> None:
         self.corrupt += bool(self._buffer.strip())
@@ -74,9 +87,9 @@ class TextDecoder:
         self._maker.reset()
 
 
-class BinaryDecoder:
+class BinaryDecoder(_DamageSince):
     def __init__(self, profile: Profile) -> None:
-        self.corrupt = 0
+        super().__init__()
         self._maker = ReadingMaker(profile)
         self._sync = profile.sync
         self._body = struct.Struct(profile.struct_format)
@@ -112,7 +125,7 @@ class BinaryDecoder:
                 continue
             self._end_stretch()
             values = self._body.unpack(body)
-            readings.append(self._maker.make(values, t_arrival))
+            readings.append(self._placed(self._maker.make(values, t_arrival)))
             start += size
         del buffer[:start]
         return readings
@@ -129,9 +142,9 @@ class BinaryDecoder:
         self._maker.reset()
 
 
-class HidReportDecoder:
+class HidReportDecoder(_DamageSince):
     def __init__(self, profile: Profile) -> None:
-        self.corrupt = 0
+        super().__init__()
         self._maker = ReadingMaker(profile)
         self._report_id = profile.report_id
         self._body = struct.Struct(profile.struct_format)
@@ -146,7 +159,7 @@ class HidReportDecoder:
             self.corrupt += 1
             return []
         values = self._body.unpack_from(report)
-        return [self._maker.make(values, t_arrival)]
+        return [self._placed(self._maker.make(values, t_arrival))]
 
     def reset(self) -> None:
         self._maker.reset()

@@ -44,6 +44,9 @@ class Reading:
     position: tuple[float, float, float]
     orientation: Quaternion
     angular_rate: tuple[float, float, float] | None = None
+    damaged_before: int = 0
+    """Damaged records the decoder counted since the reading before this one: where in the stream
+    they were, which a record counter's gaps are checked against."""
 
 
 def axis_quaternion(axis: str, angle: float) -> Quaternion:

@@ -228,11 +228,12 @@ class TrackerStream:
             raise RigError(f"tracker {self.name} stopped reading: {type(self._failure).__name__}: {self._failure}")
 
     def _count_corrupt(self) -> None:
+        """Adds the link's new damaged records to the counters; the record counter's check learns of
+        each where it was in the stream, from the reading after it (`Reading.damaged_before`)."""
         new = self.link.corrupt - self._corrupt_seen
         if new:
             self._corrupt_seen = self.link.corrupt
             self.counters.corrupt += new
-            self._sequence.discarded(new)
 
     def _read_loop(self) -> None:
         """Receives, stamps and queues until the stream is closed; run once per wake-up, so it
@@ -269,6 +270,8 @@ class TrackerStream:
         counters, mapping, sequence = self.counters, self.mapping, self._sequence
         taken = len(possible)
         for reading in readings:
+            if reading.damaged_before:
+                sequence.discarded(reading.damaged_before)
             problem = check_reading(reading, self._unit_tolerance)
             if problem is not None:
                 counters.rejected += 1

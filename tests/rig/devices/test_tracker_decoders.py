@@ -197,3 +197,21 @@ def test_a_damaged_last_record_is_counted_once_the_stream_is_closed() -> None:
     tracker.close()
     assert tracker.take_queued() == []
     assert (tracker.counters.received, tracker.report()["counters"]["corrupt"]) == (2, 1)
+
+
+def test_a_damaged_record_between_intact_ones_of_one_chunk_is_not_counted_dropped() -> None:
+    from rig.clock import MonotonicClock
+    from rig.devices.trackers.serial_tracker import serial_tracker
+
+    encoder = RecordEncoder(load_profile("binary-pose"))
+    records = [encoder.encode(e) for e in emissions(4)]
+    records[2] = records[2][:-1] + bytes([records[2][-1] ^ 0xFF])
+    tracker = serial_tracker("fake?profile=binary-pose", open_port=lambda url, baud: _OneReadPort(b"".join(records)))
+    tracker.connect(MonotonicClock())
+    received = []
+    while len(received) < 3:
+        received += tracker.wait_records(0.05)
+    tracker.close()
+    assert [r.seq for r in received] == [0, 1, 3]
+    counters = tracker.report()["counters"]
+    assert (counters["corrupt"], counters["dropped"]) == (1, 0), "record 2 arrived damaged: counted corrupt, not dropped"
