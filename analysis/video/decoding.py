@@ -9,15 +9,17 @@ with decoding whole frames alone). Where that extension is not built (no libjpeg
 package was installed) packets are decoded whole and cut: the same pixels, more slowly
 (``REGION_DECODER_MISSING`` says so once per video). Packets and image files are decoded a few
 frames ahead of the consumer by a few threads, the consumer's own among them (OpenCV and the
-region decoder release the GIL while decoding).
+region decoder release the GIL while decoding), as many as OpenCV's own thread count allows: a
+process meant to use one core (a Dask worker of one thread) sets that to 1 and decodes in the
+consumer alone.
 """
 
 from __future__ import annotations
 
+import contextlib
 import itertools
-import os
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Generator, Iterable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Generic, TypeVar
@@ -33,9 +35,9 @@ try:
 except ImportError:
     decode_grey = None
 
-# Threads decoding frames, the consumer's among them, and how many frames they may run ahead of the
-# consumer (enough to keep them busy while the consumer finds the ROIs in the first frames).
-DECODE_THREADS = min(4, os.cpu_count() or 1)
+# The most threads decoding frames, the consumer's among them, and how many frames they may run
+# ahead of the consumer (enough to keep them busy while the consumer finds the ROIs in the first frames).
+MAX_DECODE_THREADS = 4
 READ_AHEAD = 64
 # Frames handed to a thread at a time: threads exchange work once per batch, not once per frame.
 DECODE_BATCH = 8
@@ -50,6 +52,13 @@ _Item = TypeVar("_Item")
 def decodes_regions() -> bool:
     """Whether a JPEG's rectangle is decoded alone (the compiled region decoder is built)."""
     return decode_grey is not None
+
+
+def decode_threads() -> int:
+    """Threads that decode frames, the consumer's among them: OpenCV's thread count (the cores this
+    process may run on, unless ``cv2.setNumThreads`` or OPENCV_FOR_THREADS_NUM says otherwise), at
+    most ``MAX_DECODE_THREADS``."""
+    return max(1, min(MAX_DECODE_THREADS, cv2.getNumThreads()))
 
 
 def decode_jpeg(packet: np.ndarray, crop: Crop | None) -> np.ndarray | None:
@@ -76,14 +85,30 @@ class _Batch(Generic[_Item]):
 def ordered_map(
     function: Callable[[_Item], np.ndarray | None], items: Iterable[_Item], describe: Callable[[int], str]
 ) -> Iterator[np.ndarray]:
+    """function(item) for each item, in order: computed a few items ahead on ``decode_threads()``
+    threads, or by the consumer alone, one item at a time, where that is 1.
+
+    A None result is a frame that cannot be decoded: AnalysisError naming it via ``describe``.
+    """
+    threads = decode_threads()
+    mapped = _mapped_ahead(function, items, threads - 1) if threads > 1 else (function(item) for item in items)
+    with contextlib.closing(mapped):
+        for index, result in enumerate(mapped):
+            if result is None:
+                raise AnalysisError(f"{describe(index)} is corrupt; re-record it or leave it out")
+            yield result
+
+
+def _mapped_ahead(
+    function: Callable[[_Item], np.ndarray | None], items: Iterable[_Item], helpers: int
+) -> Generator[np.ndarray | None, None, None]:
     """function(item) for each item, computed a few items ahead, yielded in order.
 
-    Items are handed to worker threads DECODE_BATCH at a time. The consumer maps items too: while
-    the batch it needs next is still being mapped, it takes the earliest batch that no worker has
+    Items are handed to `helpers` threads DECODE_BATCH at a time. The consumer maps items too: while
+    the batch it needs next is still being mapped, it takes the earliest batch that no helper has
     started and maps it itself. So no core idles while the consumer works on a frame (tracking),
     and no more threads compete for the cores than there are (an extra one would be preempted
     while it holds the GIL, stalling the others).
-    A None result is a frame that cannot be decoded: AnalysisError naming it via ``describe``.
     """
 
     def run(batch: list[_Item]) -> list[np.ndarray | None]:
@@ -92,9 +117,8 @@ def ordered_map(
     iterator = iter(items)
     batches = iter(lambda: list(itertools.islice(iterator, DECODE_BATCH)), [])
     pending: deque[_Batch[_Item]] = deque()
-    pool = ThreadPoolExecutor(max_workers=max(1, DECODE_THREADS - 1))
+    pool = ThreadPoolExecutor(max_workers=helpers)
     try:
-        index = 0
         while True:
             while len(pending) * DECODE_BATCH < READ_AHEAD and (batch := next(batches, None)) is not None:
                 pending.append(_Batch(batch, pool.submit(run, batch)))
@@ -107,10 +131,6 @@ def ordered_map(
                     break
                 unstarted.results = run(unstarted.items)
             pending.popleft()
-            for frame in head.task.result() if head.results is None else head.results:
-                if frame is None:
-                    raise AnalysisError(f"{describe(index)} is corrupt; re-record it or leave it out")
-                yield frame
-                index += 1
+            yield from head.task.result() if head.results is None else head.results
     finally:
         pool.shutdown(cancel_futures=True)

@@ -9,11 +9,19 @@ import pytest
 
 from analysis import AnalysisError, analyse
 from analysis.video.array import FrameArray
-from analysis.video.decoding import DECODE_BATCH, READ_AHEAD, ordered_map
+from analysis.video.decoding import DECODE_BATCH, READ_AHEAD, decode_threads, ordered_map
 from analysis.video.file import VideoFile
 from analysis.video.frames import Crop
 from analysis.video.images import ImageFolder
 from analysis.video.sources import open_frames
+
+
+@pytest.fixture
+def opencv_threads():
+    """Sets OpenCV's thread count (which the decoder follows) for one test, then restores it."""
+    before = cv2.getNumThreads()
+    yield cv2.setNumThreads
+    cv2.setNumThreads(before)
 
 
 def moving_squares(count: int = 12, width: int = 48, height: int = 32) -> np.ndarray:
@@ -183,9 +191,10 @@ def test_corrupt_image_in_a_later_batch_is_named(tmp_path):
         list(frames)
 
 
-def test_items_come_in_order_when_the_consumer_maps_some_itself():
+def test_items_come_in_order_when_the_consumer_maps_some_itself(opencv_threads):
     # Each side's first item waits until the other side has mapped one: the consumer must then map
     # a batch that no worker had started, while a worker maps another.
+    opencv_threads(2)
     mapped_by = {}
     worker_started, consumer_started = threading.Event(), threading.Event()
 
@@ -201,6 +210,29 @@ def test_items_come_in_order_when_the_consumer_maps_some_itself():
     results = list(ordered_map(square, range(count), str))
     assert [int(r[0]) for r in results] == [i * i for i in range(count)]
     assert set(mapped_by.values()) == {True, False}
+
+
+def test_with_one_thread_the_consumer_maps_every_item_in_order(opencv_threads):
+    opencv_threads(1)
+    assert decode_threads() == 1
+    mapped_by = set()
+
+    def square(item: int) -> np.ndarray:
+        mapped_by.add(threading.current_thread())
+        return np.array([item * item])
+
+    count = 3 * READ_AHEAD + 5
+    results = list(ordered_map(square, range(count), str))
+    assert [int(r[0]) for r in results] == [i * i for i in range(count)]
+    assert mapped_by == {threading.main_thread()}
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_frame_that_cannot_be_decoded_is_named_on_any_number_of_threads(opencv_threads, threads):
+    opencv_threads(threads)
+    results = ordered_map(lambda item: None if item == 13 else np.array([item]), range(40), lambda i: f"frame {i}")
+    with pytest.raises(AnalysisError, match="frame 13 is corrupt"):
+        list(results)
 
 
 def test_closing_the_frames_early_stops_the_decoding():

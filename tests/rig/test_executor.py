@@ -1,0 +1,40 @@
+"""The local Dask cluster's workers: set up for one core each, without changing this process."""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+from rig.executor import executor
+
+
+def test_each_local_worker_decodes_on_one_thread_without_dasks_profiler_or_trim_threshold() -> None:
+    def worker_setup(_: Any) -> dict[str, Any]:
+        # Nested, so that Dask ships it by value: a worker cannot import the test modules.
+        import cv2
+        import dask
+
+        from analysis.video.decoding import decode_threads
+
+        return {
+            "opencv_threads": cv2.getNumThreads(),
+            "decode_threads": decode_threads(),
+            "blas_threads": os.environ.get("OPENBLAS_NUM_THREADS"),
+            "profiler": dask.config.get("distributed.worker.profile.enabled"),
+            "malloc_trim_threshold": os.environ.get("MALLOC_TRIM_THRESHOLD_"),
+            "pid": os.getpid(),
+        }
+
+    environment = dict(os.environ)
+    with executor(workers=2) as run:
+        seen = [setup for _, setup in run(worker_setup, [0, 1])]
+        assert dict(os.environ) == environment, "starting the workers changed this process's environment"
+    assert all(setup["pid"] != os.getpid() for setup in seen)
+    for setup in seen:
+        assert {key: value for key, value in setup.items() if key != "pid"} == {
+            "opencv_threads": int(environment.get("OPENCV_FOR_THREADS_NUM", 1)),
+            "decode_threads": int(environment.get("OPENCV_FOR_THREADS_NUM", 1)),
+            "blas_threads": environment.get("OPENBLAS_NUM_THREADS", "1"),
+            "profiler": False,
+            "malloc_trim_threshold": environment.get("MALLOC_TRIM_THRESHOLD_"),
+        }
