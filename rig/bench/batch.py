@@ -1,7 +1,8 @@
 """The batch bench (`rig bench batch`): what many measurements cost, serially and on Dask.
 
 * **Scale-out**: `rig analyse` of a batch of simulated videos in a fresh process, serially, then
-  on a local Dask cluster of two worker processes (the cluster's start included): the speed-up.
+  on a local Dask cluster of two worker processes (the cluster's start included), alternately a
+  few rounds: the speed-up of the medians, and of each round.
 * **Dask's overhead**: the same for a batch of one video.
 * **Fixed cost per video**: one longer clip analysed by `rig analyse` in a fresh process, against
   decoding it alone in a fresh process, with the compiled-fit cache empty (the first run on a
@@ -14,6 +15,7 @@ one run.
 from __future__ import annotations
 
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -59,23 +61,30 @@ def batch_seconds(videos: list[Path], workers: int | None) -> float:
         return _process_seconds([*command, *(["--workers", str(workers)] if workers else [])], dict(os.environ), allowed=(0, 3))
 
 
-def scale_out(paths: list[Path], workers: int, log: Log) -> dict[str, Any]:
+def scale_out(paths: list[Path], workers: int, rounds: int, log: Log) -> dict[str, Any]:
+    """The batch serially and on Dask, alternately `rounds` times (a shared machine's load drifts
+    between runs), and the one-video batch likewise; medians, and the speed-up of each round."""
     batch_seconds(paths[:1], None)  # fills the compiled-fit cache, as any earlier run on the machine has
-    serial = batch_seconds(paths, None)
-    log(f"{len(paths)} videos serially: {serial:.1f} s")
-    parallel = batch_seconds(paths, workers)
-    log(f"{len(paths)} videos on {workers} Dask workers: {parallel:.1f} s")
-    one_serial, one_dask = batch_seconds(paths[:1], None), batch_seconds(paths[:1], workers)
-    log(f"one video: {one_serial:.1f} s serially, {one_dask:.1f} s on Dask")
+    serial, parallel, one_serial, one_dask = [], [], [], []
+    for round_number in range(1, rounds + 1):
+        serial.append(batch_seconds(paths, None))
+        parallel.append(batch_seconds(paths, workers))
+        log(f"round {round_number}/{rounds}: {len(paths)} videos serially {serial[-1]:.1f} s, on {workers} Dask workers {parallel[-1]:.1f} s")
+        one_serial.append(batch_seconds(paths[:1], None))
+        one_dask.append(batch_seconds(paths[:1], workers))
+        log(f"round {round_number}/{rounds}: one video {one_serial[-1]:.1f} s serially, {one_dask[-1]:.1f} s on Dask")
+    median = statistics.median
     return {
         "videos": len(paths),
         "workers": workers,
-        "serial_s": serial,
-        "dask_s": parallel,
-        "speed_up": serial / parallel,
-        "one_video_serial_s": one_serial,
-        "one_video_dask_s": one_dask,
-        "dask_overhead_s": one_dask - one_serial,
+        "rounds": rounds,
+        "serial_s": median(serial),
+        "dask_s": median(parallel),
+        "speed_up": median(serial) / median(parallel),
+        "speed_up_per_round": [a / b for a, b in zip(serial, parallel)],
+        "one_video_serial_s": median(one_serial),
+        "one_video_dask_s": median(one_dask),
+        "dask_overhead_s": median(one_dask) - median(one_serial),
     }
 
 
@@ -98,18 +107,19 @@ def fixed_cost(clip: Path, log: Log) -> dict[str, Any]:
     }
 
 
-def run_bench(folder: Path, count: int, duration_s: float, clip_s: float, workers: int, log: Log) -> dict[str, Any]:
+def run_bench(folder: Path, count: int, duration_s: float, clip_s: float, workers: int, rounds: int, log: Log) -> dict[str, Any]:
     paths = videos(folder / "batch", count, duration_s, log)
     clip = simulate(replace(SimulationConfig(duration_s=clip_s), seed=99), folder / "clip", overwrite=True).video_path
-    return {"scale_out": scale_out(paths, workers, log), "fixed_cost": fixed_cost(clip, log)}
+    return {"scale_out": scale_out(paths, workers, rounds, log), "fixed_cost": fixed_cost(clip, log)}
 
 
 def table(report: dict[str, Any]) -> str:
     s, f = report["scale_out"], report["fixed_cost"]
     return "\n".join(
         [
-            f"batch of {s['videos']} videos: serial {s['serial_s']:.1f} s, {s['workers']} Dask workers {s['dask_s']:.1f} s, "
-            f"speed-up {s['speed_up']:.2f}",
+            f"batch of {s['videos']} videos (median of {s['rounds']} rounds): serial {s['serial_s']:.1f} s, "
+            f"{s['workers']} Dask workers {s['dask_s']:.1f} s, speed-up {s['speed_up']:.2f} "
+            f"(rounds: {', '.join(f'{r:.2f}' for r in s['speed_up_per_round'])})",
             f"Dask overhead for one video: {s['dask_overhead_s']:+.1f} s ({s['one_video_dask_s']:.1f} s against {s['one_video_serial_s']:.1f} s)",
             f"fixed cost of a clip in a fresh process: analyse / decode alone = {f['ratio_cold']:.2f} (empty cache), "
             f"{f['ratio_warm']:.2f} (filled cache); decode alone {f['decode_s']:.1f} s",

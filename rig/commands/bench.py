@@ -194,7 +194,7 @@ def _add_predictors(benchmarks: argparse._SubParsersAction) -> None:
 
 def _run_batch(args: argparse.Namespace) -> int:
     with tempfile.TemporaryDirectory(prefix="rig-bench-batch-") as scratch:
-        report = batch.run_bench(Path(scratch), args.videos, args.duration, args.clip_duration, args.workers, _log)
+        report = batch.run_bench(Path(scratch), args.videos, args.duration, args.clip_duration, args.workers, args.rounds, _log)
     writes = outputs.LateWrites()
     if args.json is not None:
         writes.json(args.json, report)
@@ -215,6 +215,8 @@ def _add_batch(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--duration", type=options.positive_float, default=6.0, help="seconds per batch video (default: %(default)s)")
     parser.add_argument("--clip-duration", type=options.positive_float, default=20.0, help="seconds of the fixed-cost clip (default: %(default)s)")
     parser.add_argument("--workers", type=options.positive_int, default=2, help="Dask worker processes (default: %(default)s)")
+    parser.add_argument("--rounds", type=options.positive_int, default=3,
+                        help="times the batch runs serially and on Dask, alternately (default: %(default)s)")  # fmt: skip
     parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the figures as JSON")
     parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="draw the wall times")
     parser.set_defaults(func=_run_batch)

@@ -6,7 +6,8 @@ from rig.bench import batch
 
 REPORT = {
     "scale_out": {
-        "videos": 24, "workers": 2, "serial_s": 120.0, "dask_s": 66.0, "speed_up": 120.0 / 66.0,
+        "videos": 24, "workers": 2, "rounds": 3, "serial_s": 120.0, "dask_s": 66.0, "speed_up": 120.0 / 66.0,
+        "speed_up_per_round": [1.5, 1.8, 1.9],
         "one_video_serial_s": 5.0, "one_video_dask_s": 7.5, "dask_overhead_s": 2.5,
     },
     "fixed_cost": {
@@ -18,7 +19,7 @@ REPORT = {
 
 def test_the_table_states_the_speed_up_the_overhead_and_the_fixed_cost_ratios() -> None:
     text = batch.table(REPORT)
-    assert "speed-up 1.82" in text
+    assert "(median of 3 rounds)" in text and "speed-up 1.82 (rounds: 1.50, 1.80, 1.90)" in text
     assert "Dask overhead for one video: +2.5 s" in text
     assert "= 3.00 (empty cache), 2.00 (filled cache)" in text
 
@@ -26,3 +27,20 @@ def test_the_table_states_the_speed_up_the_overhead_and_the_fixed_cost_ratios() 
 def test_the_plot_is_written(tmp_path: Path) -> None:
     batch.plot(REPORT, tmp_path / "batch.png")
     assert (tmp_path / "batch.png").stat().st_size > 10_000
+
+
+def test_the_scale_out_alternates_serial_and_dask_runs_and_reports_medians(monkeypatch) -> None:
+    """A drifting load hits serial and Dask rounds alike when they alternate."""
+    calls = []
+    times = iter([1.0, 10.0, 6.0, 1.0, 3.0, 12.0, 7.0, 1.5, 4.0, 14.0, 9.0, 2.0, 5.0])
+
+    def fake_batch_seconds(videos, workers):
+        calls.append((len(videos), workers))
+        return next(times)
+
+    monkeypatch.setattr(batch, "batch_seconds", fake_batch_seconds)
+    report = batch.scale_out([Path(f"v{i}.avi") for i in range(4)], 2, 3, lambda message: None)
+    assert calls == [(1, None)] + [(4, None), (4, 2), (1, None), (1, 2)] * 3
+    assert report["serial_s"] == 12.0 and report["dask_s"] == 7.0 and report["speed_up"] == 12.0 / 7.0
+    assert report["speed_up_per_round"] == [10 / 6, 12 / 7, 14 / 9]
+    assert report["one_video_serial_s"] == 1.5 and report["dask_overhead_s"] == 4.0 - 1.5
