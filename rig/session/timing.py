@@ -55,9 +55,9 @@ PLANNED_COST_WINDOW = 60
 """How many of the latest measured server costs the plan for the next one weighs."""
 MISS_PENALTY_REFRESHES = 3.0
 """What a missed refresh costs the plan, in refreshes: the one it repeats, and the compositions
-after it, which start late behind it and miss too when the machine's stall lasts. Replayed on
-composition costs measured on llvmpipe, 3 gave a lower mean delay than 1 or 5, and fewer misses
-than planning for the 90th percentile of the last 20 (3-10 % against 8-14 %)."""
+after it, which start late behind it and miss too while the machine's stall lasts. On llvmpipe's
+measured costs the plan misses 4 to 6 % of refreshes (`rig bench renderers --seed-table`), where
+planning for the 90th percentile of the last 20 costs missed about one in ten by construction."""
 SWAP_MARGIN_S = 2e-4
 """A composition aims to be ready this long before its blank: a swap at the blank misses it."""
 PHOTON_TARGETS = ("photons", "scanout")
