@@ -21,19 +21,24 @@ from typing import Any, Callable, Iterator, Sequence
 
 from rig.errors import ConfigError, RigError
 
-LOCAL_WORKER_SETUP: dict[str, Any] = {
-    # One core per worker process: OpenCV's parallel regions and the frame decoder that follows
-    # OpenCV's thread count (`analysis.video.decoding.decode_threads`) use one thread, as numpy's
-    # BLAS already does under Dask's own defaults.
-    "distributed.nanny.pre-spawn-environ.OPENCV_FOR_THREADS_NUM": 1,
-    # Dask's 64 KiB trim threshold also turns off glibc's adaptive mmap threshold, so every decoded
-    # frame (a few hundred KiB) is mapped and unmapped afresh: four times the page faults.
-    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
-    # The sampling profiler stops the job's thread 100 times a second to feed a dashboard we do not start.
-    "distributed.worker.profile.enabled": False,
-}
-"""How the local cluster's workers are set up: with Dask's defaults a video cost about 30% more CPU
-time on a worker than with these."""
+def local_worker_setup(workers: int) -> dict[str, Any]:
+    """How the local cluster's `workers` are set up: with Dask's defaults a video cost about 30% more
+    CPU time on a worker than with these."""
+    return {
+        # The cores shared out: OpenCV's parallel regions and the frame decoder that follows OpenCV's
+        # thread count (`analysis.video.decoding.decode_threads`) use this process's cores over the
+        # workers (one each on two cores, where the decoder then runs in the consumer alone), unless
+        # the user's environment says otherwise; numpy's BLAS keeps Dask's one thread.
+        "distributed.nanny.pre-spawn-environ.OPENCV_FOR_THREADS_NUM": os.environ.get(
+            "OPENCV_FOR_THREADS_NUM", max(1, len(os.sched_getaffinity(0)) // workers)
+        ),
+        # Dask's 64 KiB trim threshold also turns off glibc's adaptive mmap threshold, so every decoded
+        # frame (a few hundred KiB) is mapped and unmapped afresh: four times the page faults.
+        "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+        # The sampling profiler stops the job's thread 100 times a second to feed a dashboard we do not start.
+        "distributed.worker.profile.enabled": False,
+    }
+
 
 Jobs = Callable[[Callable[[Any], Any], Sequence[Any]], Iterator[tuple[int, Any]]]
 """Runs `function` on each item; yields (index of the item, its result) as each completes."""
@@ -93,8 +98,8 @@ def _environment_kept() -> Iterator[None]:
 
 @contextlib.contextmanager
 def executor(workers: int | None = None, scheduler: str | None = None) -> Iterator[Jobs]:
-    """Jobs run serially here (neither given), on a local Dask cluster of `workers` processes with
-    one thread each and no dashboard, or on the Dask scheduler at `scheduler` (tcp://HOST:PORT),
+    """Jobs run serially here (neither given), on a local Dask cluster of `workers` processes
+    running one job at a time each, with no dashboard, or on the Dask scheduler at `scheduler` (tcp://HOST:PORT),
     whose workers must reach the jobs' paths."""
     if workers is not None and scheduler is not None:
         raise ConfigError("give --workers or --scheduler, not both")
@@ -115,7 +120,7 @@ def executor(workers: int | None = None, scheduler: str | None = None) -> Iterat
             except OSError as error:
                 raise RigError(f"cannot reach the Dask scheduler at {scheduler}: {error}") from None
         else:
-            with dask.config.set(LOCAL_WORKER_SETUP), _environment_kept():
+            with dask.config.set(local_worker_setup(workers)), _environment_kept():
                 cluster = stack.enter_context(
                     LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
                 )

@@ -1,14 +1,15 @@
-"""The local Dask cluster's workers: set up for one core each, without changing this process."""
+"""The local Dask cluster's workers: the cores shared out between them, without changing this process."""
 
 from __future__ import annotations
 
 import os
 from typing import Any
 
+from analysis.video.decoding import MAX_DECODE_THREADS
 from rig.executor import executor
 
 
-def test_each_local_worker_decodes_on_one_thread_without_dasks_profiler_or_trim_threshold() -> None:
+def test_local_workers_share_the_cores_out_without_dasks_profiler_or_trim_threshold() -> None:
     def worker_setup(_: Any) -> dict[str, Any]:
         # Nested, so that Dask ships it by value: a worker cannot import the test modules.
         import cv2
@@ -30,10 +31,11 @@ def test_each_local_worker_decodes_on_one_thread_without_dasks_profiler_or_trim_
         seen = [setup for _, setup in run(worker_setup, [0, 1])]
         assert dict(os.environ) == environment, "starting the workers changed this process's environment"
     assert all(setup["pid"] != os.getpid() for setup in seen)
+    threads = int(environment.get("OPENCV_FOR_THREADS_NUM", max(1, len(os.sched_getaffinity(0)) // 2)))
     for setup in seen:
         assert {key: value for key, value in setup.items() if key != "pid"} == {
-            "opencv_threads": int(environment.get("OPENCV_FOR_THREADS_NUM", 1)),
-            "decode_threads": int(environment.get("OPENCV_FOR_THREADS_NUM", 1)),
+            "opencv_threads": threads,
+            "decode_threads": min(threads, MAX_DECODE_THREADS),
             "blas_threads": environment.get("OPENBLAS_NUM_THREADS", "1"),
             "profiler": False,
             "malloc_trim_threshold": environment.get("MALLOC_TRIM_THRESHOLD_"),
