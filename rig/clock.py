@@ -56,6 +56,9 @@ class MonotonicClock:
     ) -> None:
         self._read_ns = read_ns
         self._sleep = sleep
+        self.on_system_clock = read_ns is time.monotonic_ns
+        """Whether the time is the system's monotonic clock itself (CLOCK_MONOTONIC), which compiled
+        code can read on its own, without a call into Python, and put on this time line."""
         self.origin_ns = read_ns()
         """The system's monotonic time (ns) at the clock's zero: convert a host timestamp `ns` taken
         with the same system clock to rig time as (ns - origin_ns) / 1e9."""

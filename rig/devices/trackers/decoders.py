@@ -1,7 +1,9 @@
 """Records out of a tracker's byte stream, as its profile describes them, resynchronising after damage.
 
-Each decoder is fed bytes as they arrive (`feed(data, t_arrival)`) and returns the readings of the
-records completed by them; what it could not decode it discards and counts in `corrupt`:
+Each decoder is fed bytes as they arrive (`feed(data, t_arrival)`, or the chunks a reader queued
+since the last feed, each with its arrival: `feed_chunks(chunks, arrivals)`) and returns the
+readings of the records completed by them, each stamped with the arrival of the chunk that
+completed it; what it could not decode it discards and counts in `corrupt`:
 
 * `TextDecoder`: records end in the profile's terminator; a line with the wrong number of fields
   or a field that is not a number is one corrupt record. A line of the field names (a header) is
@@ -21,6 +23,9 @@ from __future__ import annotations
 
 import math
 import struct
+from bisect import bisect_left
+from itertools import accumulate
+from typing import Sequence
 
 from rig.devices.trackers.checksums import CHECK_BYTES, CHECKSUMS
 from rig.devices.trackers.profile import Profile
@@ -35,6 +40,15 @@ class _DamageSince:
     def __init__(self) -> None:
         self.corrupt = 0
         self._told = 0
+
+    def feed(self, data: bytes, t_arrival: float) -> list[Reading]:
+        """The readings of the records `data` completes, stamped `t_arrival`."""
+        return self.feed_chunks((data,), (t_arrival,))
+
+    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
+        """The readings of the records the chunks complete, in order, each stamped with the arrival of
+        the chunk that completed it."""
+        raise NotImplementedError
 
     def _placed(self, reading: Reading) -> Reading:
         reading.damaged_before = self.corrupt - self._told
@@ -52,17 +66,18 @@ class TextDecoder(_DamageSince):
         self._header = [name.encode("ascii", "replace") for name in profile.names]
         self._buffer = bytearray()
 
-    def feed(self, data: bytes, t_arrival: float) -> list[Reading]:
+    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
         buffer = self._buffer
-        buffer += data
+        ends = _append_chunks(buffer, chunks)
         readings = []
         terminator = self._terminator
         start = 0
         while (end := buffer.find(terminator, start)) >= 0:
-            reading = self._line(bytes(buffer[start:end]), t_arrival)
+            line = bytes(buffer[start:end])
+            start = end + len(terminator)
+            reading = self._line(line, arrivals[bisect_left(ends, start)])
             if reading is not None:
                 readings.append(reading)
-            start = end + len(terminator)
         del buffer[:start]
         if len(buffer) > MAX_LINE:
             buffer.clear()
@@ -100,9 +115,9 @@ class BinaryDecoder(_DamageSince):
         self._buffer = bytearray()
         self._discarded = 0
 
-    def feed(self, data: bytes, t_arrival: float) -> list[Reading]:
+    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
         buffer = self._buffer
-        buffer += data
+        ends = _append_chunks(buffer, chunks)
         readings = []
         sync, size = self._sync, self.record_bytes
         body_start, body_end = len(sync), size - self._check_bytes
@@ -125,8 +140,8 @@ class BinaryDecoder(_DamageSince):
                 continue
             self._end_stretch()
             values = self._body.unpack(body)
-            readings.append(self._placed(self._maker.make(values, t_arrival)))
             start += size
+            readings.append(self._placed(self._maker.make(values, arrivals[bisect_left(ends, start)])))
         del buffer[:start]
         return readings
 
@@ -150,7 +165,14 @@ class HidReportDecoder(_DamageSince):
         self._body = struct.Struct(profile.struct_format)
         self.report_bytes = self._body.size + (1 if self._report_id else 0)
 
-    def feed(self, report: bytes, t_arrival: float) -> list[Reading]:
+    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
+        """Each chunk is one report."""
+        readings = []
+        for report, t_arrival in zip(chunks, arrivals):
+            readings += self._report(report, t_arrival)
+        return readings
+
+    def _report(self, report: bytes, t_arrival: float) -> list[Reading]:
         if self._report_id:
             if not report or report[0] != self._report_id:
                 return []
@@ -166,6 +188,14 @@ class HidReportDecoder(_DamageSince):
 
 
 Decoder = TextDecoder | BinaryDecoder | HidReportDecoder
+
+
+def _append_chunks(buffer: bytearray, chunks: Sequence[bytes]) -> list[int]:
+    """Appends the chunks to `buffer`; where each ends in it, in order (a record whose last byte is
+    before the end of chunk k, and after that of chunk k - 1, was completed by chunk k)."""
+    ends = list(accumulate(map(len, chunks), initial=len(buffer)))
+    buffer += b"".join(chunks)
+    return ends[1:]
 
 
 def decoder_for(profile: Profile) -> Decoder:

@@ -81,6 +81,10 @@ class HidLink:
                 "what it sees) and that your user may read its /dev/hidraw* node (a udev rule)"
             ) from None
 
+    def native_reader(self, clock: Clock) -> None:
+        """None: hidapi's device is read through its Python binding, on the stream's thread."""
+        return None
+
     def receive(self, clock: Clock) -> bytes | None:
         device = self._device
         if device is None:
@@ -91,8 +95,8 @@ class HidLink:
             raise LinkLost(str(error)) from None
         return bytes(report) if report else None
 
-    def decode(self, chunk: bytes, t_arrival: float) -> list[Reading]:
-        return self._decoder.feed(chunk, t_arrival)
+    def decode(self, chunks: list[bytes], arrivals: list[float]) -> list[Reading]:
+        return self._decoder.feed_chunks(chunks, arrivals)
 
     def restart(self) -> None:
         self._decoder.reset()

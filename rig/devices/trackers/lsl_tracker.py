@@ -141,6 +141,10 @@ class LslLink:
         self._puller = SamplePuller(inlet, READ_TIMEOUT_S)
         self._inlet = inlet
 
+    def native_reader(self, clock: Clock) -> None:
+        """None: the inlet is pulled through liblsl's Python binding, on the stream's thread."""
+        return None
+
     def receive(self, clock: Clock) -> tuple[list, list, tuple[float, float, float] | None] | None:
         """(samples, their LSL stamps, a fresh clock correction (offset, uncertainty, rig time) or
         None), or None if nothing came in time."""
@@ -167,14 +171,13 @@ class LslLink:
         correction, self._correction = self._correction, None
         return [first, *rest], [stamp, *stamps], correction
 
-    def decode(self, chunk: tuple[list, list, tuple[float, float, float] | None], t_arrival: float) -> list[Reading]:
-        samples, stamps, correction = chunk
-        if correction is not None:
-            self.mapping.add_correction(*correction)
+    def decode(self, chunks: list[tuple[list, list, tuple[float, float, float] | None]], arrivals: list[float]) -> list[Reading]:
         readings = []
-        for values, device_time in zip(samples, stamps):
-            px, py, pz, qw, qx, qy, qz = values
-            readings.append(Reading(t_arrival, device_time, None, (px, py, pz), (qw, qx, qy, qz)))
+        for (samples, stamps, correction), t_arrival in zip(chunks, arrivals):
+            if correction is not None:
+                self.mapping.add_correction(*correction)
+            for (px, py, pz, qw, qx, qy, qz), device_time in zip(samples, stamps):
+                readings.append(Reading(t_arrival, device_time, None, (px, py, pz), (qw, qx, qy, qz)))
         return readings
 
     def restart(self) -> None:

@@ -20,7 +20,7 @@ from urllib.parse import parse_qsl, urlencode
 
 import serial
 
-from rig.clock import Clock
+from rig.clock import Clock, MonotonicClock
 from rig.devices.trackers.clock_mapping import mapping_for
 from rig.devices.trackers.decoders import BinaryDecoder, TextDecoder, decoder_for
 from rig.devices.trackers.profile import Profile, load_profile
@@ -29,9 +29,9 @@ from rig.devices.trackers.stream import LinkLost, TrackerStream
 from rig.errors import ConfigError, RigError
 
 try:
-    from rig.devices.trackers._fd_wait import wait_read
+    from rig.devices.trackers._fd_reader import FdReader, wait_read
 except ImportError:
-    wait_read = None
+    FdReader = wait_read = None
 
 log = logging.getLogger("rig.trackers")
 
@@ -41,8 +41,8 @@ READ_TIMEOUT_S = 0.05
 READ_TIMEOUT_MS = round(READ_TIMEOUT_S * 1000)
 # Most bytes taken from a port with a file descriptor in one read.
 CHUNK_BYTES = 65536
-WAIT_READ_MISSING = (
-    "rig.devices.trackers._fd_wait is not built, so serial ports are waited on and read through Python: "
+FD_READER_MISSING = (
+    "rig.devices.trackers._fd_reader is not built, so serial ports are waited on and read through Python: "
     "the same records, at more CPU per record; to build it, reinstall the package (pip install -e .)"
 )
 
@@ -90,7 +90,7 @@ def _file_descriptor(port: SerialPort) -> int | None:
 def waiting_reader(fd: int) -> Callable[[int, int], bytes | None]:
     """`read(timeout_ms, size)` for `fd`: waits up to timeout_ms for it to be readable and reads what
     it holds, up to `size` bytes; None if nothing came in time, b"" at its end, OSError as os.read.
-    The compiled `_fd_wait.wait_read` where it is built, else a poll object registered once."""
+    The compiled `_fd_reader.wait_read` where it is built, else a poll object registered once."""
     if wait_read is not None:
         return partial(wait_read, fd)
     poller = select.poll()
@@ -117,10 +117,12 @@ def _open_problem(url: str, error: Exception) -> RigError:
 class SerialLink:
     """A pyserial port read through the profile's decoder. A port with a file descriptor (a device, a
     pty, a socket; pyserial keeps no buffer of its own for these) is waited on and read straight
-    from the descriptor, whatever it holds (`waiting_reader`): pyserial's socket handler counts a
-    waiting socket as one byte, which would make reads byte by byte, and its read loop costs more
-    than the decoding. At 1000 records a second that wait and read is most of the reader thread's
-    cost. Others (loop://, rfc2217://) are read through pyserial with its timeout."""
+    from the descriptor, whatever it holds: pyserial's socket handler counts a waiting socket as one
+    byte, which would make reads byte by byte, and its read loop costs more than the decoding. On
+    the system's monotonic clock a compiled thread does that (`native_reader`), without waking
+    the interpreter per record; on another clock (a test's) the stream's Python thread does, one
+    compiled wait and read per wake-up (`waiting_reader`). Others (loop://, rfc2217://) are read
+    through pyserial with its timeout."""
 
     def __init__(self, url: str, baud: int, profile: Profile, open_port: Callable[[str, int], SerialPort]) -> None:
         self.url = url
@@ -129,6 +131,7 @@ class SerialLink:
         self._open_port = open_port
         self._decoder: TextDecoder | BinaryDecoder = decoder_for(profile)  # type: ignore[assignment]
         self._port: SerialPort | None = None
+        self._fd: int | None = None
         self._read: Callable[[int, int], bytes | None] | None = None
 
     @property
@@ -142,7 +145,15 @@ class SerialLink:
             raise _open_problem(self.url, error) from None
         fd = _file_descriptor(port)
         self._read = None if fd is None else waiting_reader(fd)
+        self._fd = fd
         self._port = port
+
+    def native_reader(self, clock: Clock) -> FdReader | None:
+        """The open port's descriptor read on a compiled thread, where it has one, the reader is
+        built and the stamps can be on `clock` (the system's monotonic clock, which C reads too)."""
+        if FdReader is None or self._fd is None or not (isinstance(clock, MonotonicClock) and clock.on_system_clock):
+            return None
+        return FdReader(self._fd, clock.origin_ns)
 
     def receive(self, clock: Clock) -> bytes | None:
         port = self._port
@@ -162,14 +173,15 @@ class SerialLink:
             raise LinkLost(str(error)) from None
         return data or None
 
-    def decode(self, chunk: bytes, t_arrival: float) -> list[Reading]:
-        return self._decoder.feed(chunk, t_arrival)
+    def decode(self, chunks: list[bytes], arrivals: list[float]) -> list[Reading]:
+        return self._decoder.feed_chunks(chunks, arrivals)
 
     def restart(self) -> None:
         self._decoder.reset()
 
     def close(self) -> None:
         port, self._port = self._port, None
+        self._fd = None
         if port is not None:
             try:
                 port.close()
@@ -181,8 +193,8 @@ def serial_tracker(address: str, open_port: Callable[[str, int], SerialPort] = o
     """An unconnected serial tracker for `URL[?profile=...&baud=...]`."""
     url, profile_name, baud = parse_serial_address(address)
     profile = load_profile(profile_name)
-    if wait_read is None:
-        log.warning(WAIT_READ_MISSING)
+    if FdReader is None:
+        log.warning(FD_READER_MISSING)
     if profile.format == "hid":
         raise ConfigError(f"profile {profile.name} describes HID reports; a serial tracker needs a text or binary profile")
     return TrackerStream(

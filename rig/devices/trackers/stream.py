@@ -1,21 +1,26 @@
 """One real tracker source: a link read by its own thread, samples handed over without blocking.
 
 `TrackerStream` is the `TrackerSource` (rig.devices.protocols) of every real tracker. Its link
-(serial, HID, LSL) receives what the device sends on the stream's reader thread, which stamps each
-chunk with its arrival time and queues it: that is all the thread does per wake-up, because at
-1000 records a second the wake-ups are most of the cost, and code run once per wake-up runs
-cold, several times slower than the same code run over a batch. The consumer's `poll()` (the
-session's render loop, or `rig record-tracker`), which never blocks, or `wait(timeout)`, decodes
-the queued chunks into records: each is checked and what was wrong counted, in arrival order,
-then the device times of all it took are mapped onto the rig clock in one call. A record is
-available to a predictor from its arrival time, when the reader queued its chunk. A lost link is
-logged, leaves a gap, and is reopened until the stream is closed; everything that happened is in
-`report()`. One thread consumes a stream.
+(serial, HID, LSL) receives what the device sends on a reader thread, which stamps each chunk with
+its arrival time and queues it: that is all the thread does per wake-up, because at 1000 records a
+second the wake-ups are most of the cost, and code run once per wake-up runs cold, several times
+slower than the same code run over a batch. Where the link has a compiled reader
+(`Link.native_reader`: a serial port with a file descriptor, on the system's monotonic clock), that
+thread is in C and never wakes the interpreter; the stream's own thread only supervises it, asleep
+in C until it ends, and reopens the link when it does. Elsewhere (a port without a descriptor, HID,
+LSL, a test's clock) the stream's thread is the reader, in Python, calling `Link.receive`. The
+consumer's `poll()` (the session's render loop, or `rig record-tracker`), which never blocks, or
+`wait(timeout)`, takes every queued chunk and decodes them together: each record is checked and
+what was wrong counted, in arrival order, then the device times of all it took are mapped onto the
+rig clock in one call. A record is available to a predictor from its arrival time, when the reader
+queued the chunk that completed it. A lost link is logged, leaves a gap, and is reopened until the
+stream is closed; everything that happened is in `report()`. One thread consumes a stream.
 """
 
 from __future__ import annotations
 
 import logging
+import os
 import threading
 import time
 from collections import deque
@@ -43,6 +48,30 @@ class LinkLost(Exception):
     """The device went away while reading (unplugged, the socket closed, the stream ended)."""
 
 
+class NativeReader(Protocol):
+    """A link's compiled reader (`_fd_reader.FdReader`), reading on a thread of its own from when it
+    is made: it queues what arrives, stamped on the rig clock, until the link ends or `stop()`."""
+
+    outcome: str | None
+    """None while it reads; then how it ended: "stopped", "end of file" or "error"."""
+    errno: int
+    """The failed call's errno where the outcome is "error"."""
+    cpu_s: float
+    """The CPU time its thread has used."""
+
+    def take(self) -> tuple[list[Any], list[float]]:
+        """Every chunk queued since the last take, in order, and their arrival times."""
+
+    def wait(self, timeout_s: float | None = None) -> bool:
+        """True once there is a chunk to take or the reader has ended, False after `timeout_s`."""
+
+    def wait_ended(self, timeout_s: float | None = None) -> bool:
+        """True once the reader has ended, False after `timeout_s` (None: no limit)."""
+
+    def stop(self) -> None:
+        """Ends the reader and joins its thread; what it queued stays to be taken."""
+
+
 class Link(Protocol):
     """What a stream reads: a device's transport and its decoder. `receive` runs on the reader
     thread and waits briefly (tens of ms) so that the reader notices close; `decode` and `restart`
@@ -54,11 +83,16 @@ class Link(Protocol):
     def open(self, clock: Clock) -> None:
         """Opens the device, its times to go on `clock`; RigError saying what to do if it cannot."""
 
+    def native_reader(self, clock: Clock) -> NativeReader | None:
+        """A compiled reader of the opened device, stamping on `clock`, or None where there is none
+        (then the stream's thread reads with `receive`)."""
+
     def receive(self, clock: Clock) -> Any:
         """What arrived (None if nothing did in time); raises LinkLost when the device went away."""
 
-    def decode(self, chunk: Any, t_arrival: float) -> list[Reading]:
-        """The readings a received chunk completes, stamped `t_arrival`."""
+    def decode(self, chunks: list[Any], arrivals: list[float]) -> list[Reading]:
+        """The readings that received chunks complete, in order, each stamped with the arrival of
+        the chunk that completed it."""
 
     def restart(self) -> None:
         """Forgets a partial record: what follows comes from a reopened device."""
@@ -135,8 +169,11 @@ class TrackerStream:
         self._sequence = SequenceCheck(self.counters, sequence_bits)
         self._describe = describe
         self._clock: Clock | None = None
-        self._chunks: deque[tuple[Any, float] | object] = deque()
-        """(payload, arrival time) as received, and the markers below, in order."""
+        self._chunks: deque[tuple[Any, float] | NativeReader | object] = deque()
+        """In order: (payload, arrival time) as the Python reader received it, a compiled reader that
+        has ended (what it read last is still in it), and the markers below."""
+        self._native: NativeReader | None = None
+        """The link's compiled reader, where it has one (the latest, after a reconnection)."""
         self._ready = threading.Condition()
         self._waiting = False
         self._stop = threading.Event()
@@ -152,7 +189,8 @@ class TrackerStream:
         self._clock = clock
         self.link.open(clock)
         self._stop.clear()
-        self._thread = threading.Thread(target=self._read_loop, name=f"tracker {self.name}", daemon=True)
+        self._native = self.link.native_reader(clock)
+        self._thread = threading.Thread(target=self._run, name=f"tracker {self.name}", daemon=True)
         self._thread.start()
 
     def poll(self) -> list[PoseSample]:
@@ -171,37 +209,63 @@ class TrackerStream:
     def take_queued(self) -> list[TrackerRecord]:
         """Every record received, whatever became of the reader (for the end of a run)."""
         started = time.thread_time()
-        chunks = self._chunks
+        # Looked at before the queue: a reader that replaced it comes after its marker in the queue.
+        native = self._native
+        queue = self._chunks
         records: list[TrackerRecord] = []
         possible: list[Reading] = []
-        while chunks:
-            chunk = chunks.popleft()
-            if chunk is _RESTORED or chunk is _CLOSED:
+        chunks: list[Any] = []
+        arrivals: list[float] = []
+        while queue:
+            entry = queue.popleft()
+            if type(entry) is tuple:
+                chunks.append(entry[0])
+                arrivals.append(entry[1])
+            elif entry is _RESTORED or entry is _CLOSED:
+                self._accept(chunks, arrivals, possible)
+                chunks, arrivals = [], []
                 self._map(possible, records)
                 possible = []
-                if chunk is _RESTORED:
+                if entry is _RESTORED:
                     self._restart()
                 else:
                     self.link.restart()
                     self._count_corrupt()
             else:
-                self._accept(*chunk, possible)  # type: ignore[misc]
+                taken, times = entry.take()  # type: ignore[union-attr]
+                chunks += taken
+                arrivals += times
+        if native is not None:
+            taken, times = native.take()
+            chunks += taken
+            arrivals += times
+        self._accept(chunks, arrivals, possible)
         self._map(possible, records)
         self.decode_cpu_s += time.thread_time() - started
         return records
 
     def wait_records(self, timeout_s: float) -> list[TrackerRecord]:
-        """As poll_records, after waiting up to `timeout_s` for something to arrive."""
+        """As poll_records, after waiting up to `timeout_s` for something to arrive: in the compiled
+        reader while it reads, else until the stream's thread queues something."""
+        native = self._native
+        reading = native is not None and native.outcome is None
         with self._ready:
             self._waiting = True
-            if not self._chunks and self._failure is None:
+            idle = not self._chunks and self._failure is None
+            if idle and not reading:
                 self._ready.wait(timeout_s)
             self._waiting = False
+        if idle and reading:
+            native.wait(timeout_s)  # type: ignore[union-attr]
         return self.poll_records()
 
     def close(self) -> None:
         """Stops the reader and closes the link; safe to call more than once."""
-        self._stop.set()
+        with self._ready:
+            self._stop.set()
+            native = self._native
+        if native is not None:
+            native.stop()
         thread, self._thread = self._thread, None
         if thread is not None:
             thread.join()
@@ -235,59 +299,81 @@ class TrackerStream:
             self._corrupt_seen = self.link.corrupt
             self.counters.corrupt += new
 
-    def _read_loop(self) -> None:
-        """Receives, stamps and queues until the stream is closed; run once per wake-up, so it
-        touches as little as it can (bound methods, a plain tuple per chunk)."""
+    def _run(self) -> None:
+        """The stream's thread: reads the link, or waits for its compiled reader to end, and
+        reopens the link whenever it is lost, until the stream is closed."""
         started = time.thread_time()
-        clock = self._clock
-        receive, now, queue, stopped = self.link.receive, clock.now, self._chunks.append, self._stop.is_set
         try:
-            while not stopped():
-                try:
-                    payload = receive(clock)
-                except LinkLost as lost:
-                    self._lost(str(lost))
-                    if not self._reopen():
-                        return
-                    continue
-                if payload is not None:
-                    queue((payload, now()))
-                    if self._waiting:
-                        self._wake()
+            while (lost := self._read() if self._native is None else self._supervise(self._native)) is not None:
+                self._lost(lost)
+                if not self._reopen():
+                    return
         except BaseException as error:  # noqa: BLE001 - handed to the consumer's thread, never lost
             self._failure = error
             self._wake()
         finally:
             self.reader_cpu_s += time.thread_time() - started
 
-    def _accept(self, payload: Any, t_arrival: float, possible: list[Reading]) -> None:
-        """Decodes, checks and counts one chunk's readings, in order, and adds the possible ones to
-        `possible`, which the clock mapping learns from before `_map` maps them."""
-        readings = self.link.decode(payload, t_arrival)
-        self._count_corrupt()
-        if not readings:
+    def _read(self) -> str | None:
+        """Receives, stamps and queues until the link is lost (what happened) or the stream is closed
+        (None); run once per wake-up, so it touches as little as it can (bound methods, a plain
+        tuple per chunk)."""
+        clock = self._clock
+        receive, now, queue, stopped = self.link.receive, clock.now, self._chunks.append, self._stop.is_set  # type: ignore[union-attr]
+        while not stopped():
+            try:
+                payload = receive(clock)
+            except LinkLost as lost:
+                return str(lost)
+            if payload is not None:
+                queue((payload, now()))
+                if self._waiting:
+                    self._wake()
+        return None
+
+    def _supervise(self, native: NativeReader) -> str | None:
+        """Sleeps (in C, the GIL released) until the compiled reader ends and queues it, for the
+        consumer to take what it read last; what happened to the link, or None if the stream was
+        closed."""
+        native.wait_ended()
+        self.reader_cpu_s += native.cpu_s
+        self._chunks.append(native)
+        self._wake()
+        if native.outcome == "stopped" or self._stop.is_set():
+            return None
+        if native.outcome == "error":
+            return str(OSError(native.errno, os.strerror(native.errno)))
+        return "the device closed the link (end of file)"
+
+    def _accept(self, chunks: list[Any], arrivals: list[float], possible: list[Reading]) -> None:
+        """Decodes, checks and counts the readings of chunks taken together, in order, and adds the
+        possible ones to `possible`, which the clock mapping learns from before `_map` maps them."""
+        if not chunks:
             return
-        counters, mapping, sequence = self.counters, self.mapping, self._sequence
+        readings = self.link.decode(chunks, arrivals)
+        self._count_corrupt()
+        counters, mapping, sequence, tolerance = self.counters, self.mapping, self._sequence, self._unit_tolerance
         taken = len(possible)
+        last_arrival = self._last_arrival
         for reading in readings:
             if reading.damaged_before:
                 sequence.discarded(reading.damaged_before)
-            problem = check_reading(reading, self._unit_tolerance)
+            problem = check_reading(reading, tolerance)
             if problem is not None:
                 counters.rejected += 1
                 sequence.discarded(1)
                 if counters.rejected <= LOGGED_REJECTIONS:
                     log.warning("tracker %s: impossible record discarded: %s", self.name, problem)
                 continue
+            t_arrival = reading.t_arrival
             sequence.accept(reading.seq, reading.device_time)
-            mapping.observe(reading.device_time, reading.t_arrival)
+            mapping.observe(reading.device_time, t_arrival)
             possible.append(reading)
-        if len(possible) == taken:
-            return
+            if last_arrival is not None and t_arrival - last_arrival > GAP_S:
+                self._event("gap", f"no samples for {t_arrival - last_arrival:.3f} s", t_arrival)
+            last_arrival = t_arrival
+        self._last_arrival = last_arrival
         counters.received += len(possible) - taken
-        if self._last_arrival is not None and t_arrival - self._last_arrival > GAP_S:
-            self._event("gap", f"no samples for {t_arrival - self._last_arrival:.3f} s", t_arrival)
-        self._last_arrival = t_arrival
 
     def _map(self, possible: list[Reading], records: list[TrackerRecord]) -> None:
         """Maps the clock of readings taken together, in one call (so they keep their order in sensor
@@ -336,8 +422,16 @@ class TrackerStream:
                 self._stop.wait(wait)
                 wait = min(2 * wait, RECONNECT_LONGEST_WAIT_S)
                 continue
+            native = self.link.native_reader(self._clock)
             self.counters.reconnects += 1
             self._chunks.append(_RESTORED)
+            with self._ready:
+                # Published after the marker: a consumer takes from it once it has taken the marker.
+                self._native = native
+                closed = self._stop.is_set()
+                self._ready.notify_all()
+            if closed and native is not None:
+                native.stop()  # close() stopped the reader it saw, the one before
             self._event("restored", self.link.description)
             return True
         return False

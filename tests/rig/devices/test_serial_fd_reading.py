@@ -1,11 +1,21 @@
-"""A serial port with a file descriptor is waited on and read in one call: the compiled
-`_fd_wait.wait_read` and its pure-Python fallback (a poll object) give the same bytes, None when
-nothing came, b"" at the end, OSError on a closed descriptor; a serial tracker reads the same
-records through either."""
+"""A serial port with a file descriptor is read in C: by a thread of its own (`_fd_reader.FdReader`,
+on the system's monotonic clock), or, for a reader thread in Python, one wait and read per call
+(the compiled `_fd_reader.wait_read` and its pure-Python fallback, a poll object). The thread
+queues every byte in order, stamped between the clock readings around its writing, and ends as the
+descriptor does; the wait-and-read gives the same bytes, None when nothing came, b"" at the end,
+OSError on a closed descriptor; a serial tracker reads the same records whichever reads it, and a
+clock of a test's own keeps it on the Python path."""
 
 from __future__ import annotations
 
+import errno
 import os
+import pty
+import socket
+import threading
+import time
+import tty
+from itertools import count
 from typing import Iterator
 
 import pytest
@@ -16,11 +26,20 @@ from rig.devices.trackers.profile import load_profile
 from rig.devices.trackers.serial_tracker import serial_tracker, waiting_reader
 from rig.emulate.encode import Emission, RecordEncoder
 
-@pytest.fixture(params=["compiled", "python"])
+# Long enough never to run out on a loaded machine; a reader that works returns far sooner.
+PATIENCE_S = 10.0
+
+FdReader = serial_module.FdReader
+
+
+@pytest.fixture(params=["thread", "compiled", "python"])
 def implementation(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
-    if request.param == "compiled":
-        assert serial_module.wait_read is not None, "rig.devices.trackers._fd_wait is built by pip install -e ."
-    else:
+    """thread: the compiled reader thread; compiled: a Python thread on the compiled wait-and-read;
+    python: a Python thread on a poll object."""
+    assert serial_module.FdReader is not None, "rig.devices.trackers._fd_reader is built by pip install -e ."
+    if request.param != "thread":
+        monkeypatch.setattr(serial_module, "FdReader", None)
+    if request.param == "python":
         monkeypatch.setattr(serial_module, "wait_read", None)
     return request.param
 
@@ -46,6 +65,145 @@ def pipe() -> Iterator[Pipe]:
     made.close(made.write_end)
 
 
+@pytest.fixture(params=["pipe", "pty", "socketpair"])
+def descriptors(request: pytest.FixtureRequest) -> Iterator[tuple[int, int]]:
+    """(read end, write end) of a pipe, a raw pseudo-terminal (the serial emulator's transport) or a
+    socket pair (a TCP port's), closed afterwards."""
+    if request.param == "pipe":
+        ends = os.pipe()
+    elif request.param == "pty":
+        leader, follower = pty.openpty()
+        tty.setraw(follower)
+        ends = (follower, leader)
+    else:
+        left, right = socket.socketpair()
+        ends = (left.detach(), right.detach())
+    yield ends
+    for fd in ends:
+        os.close(fd)
+
+
+def _take_all(reader: FdReader, size: int) -> tuple[list[bytes], list[float]]:
+    """What the reader queues until `size` bytes have come, taken as they come."""
+    chunks: list[bytes] = []
+    arrivals: list[float] = []
+    while sum(map(len, chunks)) < size:
+        assert reader.wait(PATIENCE_S), "the reader queued nothing"
+        taken, times = reader.take()
+        chunks += taken
+        arrivals += times
+    return chunks, arrivals
+
+
+def test_the_thread_queues_every_byte_in_order_stamped_on_the_rig_clock(descriptors: tuple[int, int]) -> None:
+    read_end, write_end = descriptors
+    clock = MonotonicClock()
+    reader = FdReader(read_end, clock.origin_ns)
+    pieces = [bytes([k]) * (1 + k % 7) for k in range(200)]
+    try:
+        before = clock.now()
+        for piece in pieces:
+            os.write(write_end, piece)
+        chunks, arrivals = _take_all(reader, sum(map(len, pieces)))
+        after = clock.now()
+    finally:
+        reader.stop()
+    assert b"".join(chunks) == b"".join(pieces)
+    assert all(chunks), "no empty chunk is queued"
+    assert len(arrivals) == len(chunks)
+    assert before <= arrivals[0] and arrivals[-1] <= after
+    assert arrivals == sorted(arrivals)
+    assert reader.outcome == "stopped" and reader.take() == ([], [])
+
+
+def test_a_stamp_is_the_monotonic_clock_counted_from_the_origin(pipe: Pipe) -> None:
+    origin_ns = time.monotonic_ns() - 5 * 10**9
+    reader = FdReader(pipe.read_end, origin_ns)
+    before_ns = time.monotonic_ns()
+    os.write(pipe.write_end, b"x")
+    (chunk,), (arrival,) = _take_all(reader, 1)
+    after_ns = time.monotonic_ns()
+    reader.stop()
+    assert chunk == b"x"
+    assert (before_ns - origin_ns) / 1e9 <= arrival <= (after_ns - origin_ns) / 1e9
+
+
+def test_the_end_of_the_file_ends_the_thread_after_what_came_before(pipe: Pipe) -> None:
+    reader = FdReader(pipe.read_end, 0)
+    os.write(pipe.write_end, b"last words")
+    pipe.close(pipe.write_end)
+    assert reader.wait_ended(PATIENCE_S)
+    assert (reader.outcome, reader.errno) == ("end of file", 0)
+    assert b"".join(reader.take()[0]) == b"last words"
+    assert reader.wait(0.0), "an ended reader is waited for no longer"
+    reader.stop()
+    assert reader.outcome == "end of file", "stopping an ended reader leaves how it ended"
+
+
+def test_a_failed_read_ends_the_thread_with_its_errno(tmp_path) -> None:
+    directory = os.open(tmp_path, os.O_RDONLY)
+    try:
+        reader = FdReader(directory, 0)
+        assert reader.wait_ended(PATIENCE_S)
+        assert (reader.outcome, reader.errno) == ("error", errno.EISDIR)
+        reader.stop()
+    finally:
+        os.close(directory)
+
+
+def test_a_closed_descriptor_is_refused(pipe: Pipe) -> None:
+    closed = pipe.read_end
+    pipe.close(closed)
+    with pytest.raises(OSError) as raised:
+        FdReader(closed, 0)
+    assert raised.value.errno == errno.EBADF
+
+
+def test_waiting_for_nothing_times_out_and_a_bad_timeout_is_refused(pipe: Pipe) -> None:
+    reader = FdReader(pipe.read_end, 0)
+    assert not reader.wait(0.0)
+    assert not reader.wait(0.01)
+    assert not reader.wait_ended(0.0)
+    assert reader.outcome is None and reader.take() == ([], [])
+    for bad in (-1.0, float("nan")):
+        with pytest.raises(ValueError):
+            reader.wait(bad)
+    reader.stop()
+
+
+def test_stop_wakes_a_thread_waiting_for_data(pipe: Pipe) -> None:
+    reader = FdReader(pipe.read_end, 0)
+    assert not reader.wait(0.01), "the thread is waiting: nothing was written"
+    stopper = threading.Thread(target=reader.stop)
+    stopper.start()
+    stopper.join(PATIENCE_S)
+    assert not stopper.is_alive(), "stop() did not return"
+    assert reader.outcome == "stopped" and reader.wait_ended(0.0)
+    reader.stop()
+
+
+def test_a_dropped_reader_stops_reading_and_its_thread_ends(pipe: Pipe) -> None:
+    threads = len(os.listdir("/proc/self/task"))
+    reader = FdReader(pipe.read_end, 0)
+    assert len(os.listdir("/proc/self/task")) == threads + 1
+    del reader
+    assert len(os.listdir("/proc/self/task")) == threads
+    os.write(pipe.write_end, b"after")
+    assert os.read(pipe.read_end, 16) == b"after", "nothing reads the descriptor any more"
+
+
+def test_the_threads_cpu_time_is_kept_once_it_has_ended(pipe: Pipe) -> None:
+    reader = FdReader(pipe.read_end, 0)
+    os.write(pipe.write_end, b"x")
+    _take_all(reader, 1)
+    running = reader.cpu_s
+    pipe.close(pipe.write_end)
+    assert reader.wait_ended(PATIENCE_S)
+    ended = reader.cpu_s
+    reader.stop()
+    assert 0.0 < running <= ended == reader.cpu_s
+
+
 def test_what_a_descriptor_holds_is_read_whole_and_nothing_more(implementation: str, pipe: Pipe) -> None:
     read = waiting_reader(pipe.read_end)
     data = bytes(range(256)) * 3
@@ -67,7 +225,7 @@ def test_a_closed_descriptor_raises_os_error(implementation: str, pipe: Pipe) ->
 
 def test_the_compiled_reader_refuses_a_negative_size() -> None:
     if serial_module.wait_read is None:
-        pytest.fail("rig.devices.trackers._fd_wait is built by pip install -e .")
+        pytest.fail("rig.devices.trackers._fd_reader is built by pip install -e .")
     with pytest.raises(ValueError):
         serial_module.wait_read(0, 0, -1)
 
@@ -92,16 +250,63 @@ class _PipePort:
         pass
 
 
+def _emissions(n: int) -> list[Emission]:
+    return [Emission(k, 1.0 + k * 1e-3, (0.01 * k, 0.0, 0.5), (1.0, 0.0, 0.0, 0.0)) for k in range(n)]
+
+
 def test_a_serial_tracker_reads_the_same_records_either_way(implementation: str, pipe: Pipe) -> None:
     encoder = RecordEncoder(load_profile("binary-pose"))
-    sent = [Emission(k, 1.0 + k * 1e-3, (0.01 * k, 0.0, 0.5), (1.0, 0.0, 0.0, 0.0)) for k in range(50)]
-    os.write(pipe.write_end, b"".join(encoder.encode(e) for e in sent))
+    sent = _emissions(50)
     tracker = serial_tracker("pipe?profile=binary-pose", open_port=lambda url, baud: _PipePort(pipe.read_end))
-    tracker.connect(MonotonicClock())
+    clock = MonotonicClock()
+    tracker.connect(clock)
+    before = clock.now()
+    for emission in sent:
+        os.write(pipe.write_end, encoder.encode(emission))
     records = []
     while len(records) < len(sent):
-        records += tracker.wait_records(1.0)
+        records += tracker.wait_records(PATIENCE_S)
+    after = clock.now()
     tracker.close()
     assert [r.seq for r in records] == [e.seq for e in sent]
     assert [r.device_time for r in records] == pytest.approx([e.device_time for e in sent], abs=1e-6)
+    assert all(before <= r.t_arrival <= after for r in records)
     assert tracker.report()["counters"]["corrupt"] == 0
+    assert tracker.reader_cpu_s > 0.0
+
+
+def test_a_serial_tracker_reads_records_cut_anywhere_and_its_last_ones_after_close(pipe: Pipe) -> None:
+    """On the compiled thread, records split across writes are whole once their last byte came,
+    and what was read before close() is still taken after it."""
+    encoder = RecordEncoder(load_profile("binary-pose"))
+    sent = _emissions(30)
+    wire = b"".join(encoder.encode(e) for e in sent)
+    tracker = serial_tracker("pipe?profile=binary-pose", open_port=lambda url, baud: _PipePort(pipe.read_end))
+    tracker.connect(MonotonicClock())
+    for start in range(0, len(wire), 7):
+        os.write(pipe.write_end, wire[start : start + 7])
+    records = []
+    while not records or records[-1].seq < len(sent) - 1:
+        records += tracker.wait_records(PATIENCE_S)
+    tracker.close()
+    records += tracker.take_queued()
+    assert [r.seq for r in records] == [e.seq for e in sent]
+    assert tracker.report()["counters"]["corrupt"] == 0
+
+
+def test_a_clock_of_the_tests_own_keeps_the_reading_in_python(pipe: Pipe) -> None:
+    """The compiled thread stamps on the system's monotonic clock; on another clock the stream's
+    own thread reads and stamps, so arrivals are that clock's times."""
+    ticks = count(start=10**9, step=1000)
+    clock = MonotonicClock(read_ns=lambda: next(ticks), sleep=lambda s: None)
+    encoder = RecordEncoder(load_profile("binary-pose"))
+    tracker = serial_tracker("pipe?profile=binary-pose", open_port=lambda url, baud: _PipePort(pipe.read_end))
+    tracker.connect(clock)
+    for emission in _emissions(5):
+        os.write(pipe.write_end, encoder.encode(emission))
+    records = []
+    while len(records) < 5:
+        records += tracker.wait_records(PATIENCE_S)
+    tracker.close()
+    assert [r.seq for r in records] == list(range(5))
+    assert all(r.t_arrival < 1.0 for r in records), "stamped by the test's clock, microseconds a reading"

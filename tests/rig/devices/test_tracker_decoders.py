@@ -55,6 +55,28 @@ def test_text_lines_skip_their_header_and_count_bad_lines() -> None:
     assert decoder.corrupt == 2
 
 
+@pytest.mark.parametrize("profile_name", ["binary-pose", "csv"])
+def test_chunks_fed_together_stamp_each_record_with_the_chunk_that_completed_it(profile_name: str) -> None:
+    """A reader's queued chunks decoded in one feed: the same records, in order, as fed one by one,
+    each with the arrival of the chunk holding its last byte, even where that chunk holds nothing
+    else of it (a record cut just before its last byte)."""
+    encoder = RecordEncoder(load_profile(profile_name))
+    records = [encoder.encode(e) for e in emissions(40)]
+    wire = b"".join(records)
+    record_ends = np.cumsum([len(r) for r in records])
+    cuts = sorted({*np.random.default_rng(4).integers(1, len(wire), 30).tolist(), *(record_ends[:5] - 1).tolist()})
+    chunks = [wire[a:b] for a, b in zip([0, *cuts], [*cuts, len(wire)])]
+    arrivals = [100.0 + k for k in range(len(chunks))]
+    chunk_ends = np.cumsum([len(c) for c in chunks])
+    together, apart = decoder_for(load_profile(profile_name)), decoder_for(load_profile(profile_name))
+    readings = together.feed_chunks(chunks[:17], arrivals[:17]) + together.feed_chunks(chunks[17:], arrivals[17:])
+    one_by_one = [r for chunk, t in zip(chunks, arrivals) for r in apart.feed(chunk, t)]
+    completed_by = [arrivals[int(np.searchsorted(chunk_ends, end))] for end in record_ends]
+    assert [r.t_arrival for r in readings] == [r.t_arrival for r in one_by_one] == completed_by
+    assert [r.device_time for r in readings] == pytest.approx([e.device_time for e in emissions(40)], abs=1e-6)
+    assert together.corrupt == apart.corrupt == 0
+
+
 def test_impossible_values_are_refused_and_possible_ones_normalised() -> None:
     def reading(q: tuple, position: tuple = (0.0, 0.0, 0.0)) -> Reading:
         return Reading(0.0, None, None, position, q)
