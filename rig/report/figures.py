@@ -105,6 +105,7 @@ def summary_figure(rows: Sequence[dict[str, Any]], group: str | None) -> Figure:
     for index, row in enumerate(rows):
         groups[str(row.get(group, "")) if group else ""].append(index)
     per_video = axes[0]
+    labelled: set[str] = set()
     for colour_index, (name, members) in enumerate(sorted(groups.items())):
         colour = f"C{colour_index}"
         for index in members:
@@ -116,13 +117,14 @@ def summary_figure(rows: Sequence[dict[str, Any]], group: str | None) -> Figure:
             low, high = row.get("ci95_low_ms"), row.get("ci95_high_ms")
             error = [[row["latency_ms"] - low], [high - row["latency_ms"]]] if low is not None and high is not None else None
             per_video.errorbar(row["latency_ms"], index, xerr=error, fmt="o", color=colour, capsize=3,
-                               label=name or None if index == members[0] else None)  # fmt: skip
+                               label=name if name and name not in labelled else None)  # fmt: skip
+            labelled.add(name)
     per_video.set_yticks(range(len(rows)), [_short(row["video"]) for row in rows], fontsize=7)
     per_video.invert_yaxis()
     per_video.set_xlabel("latency (ms), bars: 95 % interval")
     per_video.set_ylabel("video")
     per_video.set_title("latency per video")
-    if group:
+    if group and labelled - {""}:
         per_video.legend(title=group, **LEGEND_BESIDE)
     if panels == 2:
         against = axes[1]

@@ -71,6 +71,15 @@ def test_a_summary_report_compares_the_runs(small_runs, tmp_path: Path) -> None:
     _legend_clear_of_data(figure)
 
 
+def test_a_group_whose_first_video_failed_keeps_its_legend_entry_and_an_all_failed_batch_has_none() -> None:
+    failed = {"latency_ms": None, "error": "video file missing", "frequency_hz": None}
+    rows = [{**failed, "video": "a1.avi", "system": "a"}, {"video": "a2.avi", "latency_ms": 40.0, "ci95_low_ms": 39.0,
+            "ci95_high_ms": 41.0, "frequency_hz": 1.0, "system": "a"}, {**failed, "video": "b1.avi", "system": "b"}]  # fmt: skip
+    legend = summary_figure(rows, "system").axes[0].get_legend()
+    assert [text.get_text() for text in legend.get_texts()] == ["a"]
+    assert summary_figure([rows[0], rows[2]], "system").axes[0].get_legend() is None
+
+
 def test_a_report_needs_an_html_file_in_an_existing_folder(small_runs, tmp_path: Path) -> None:
     assert main(["report", str(small_runs["fast"]), "--out", str(tmp_path / "report.pdf")]) == 2
     assert main(["report", str(small_runs["fast"]), "--out", str(tmp_path / "no" / "report.html")]) == 2
