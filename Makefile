@@ -19,7 +19,7 @@ test-system:
 
 venv: $(STAMP)
 
-$(STAMP): pyproject.toml setup.py analysis/_jpeg_region.c rig/devices/trackers/_fd_reader.c constraints.txt
+$(STAMP): pyproject.toml setup.py analysis/_jpeg_region.c rig/devices/trackers/_readers.c constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet -c constraints.txt -e .
 	touch $(STAMP)

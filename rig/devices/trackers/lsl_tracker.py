@@ -4,10 +4,12 @@ qy, qz), each sample stamped on the sender's LSL clock.
 
 The sender's stamps are mapped onto the rig clock with liblsl's own clock offset, measured by round
 trips (`lsl_time_correction_ex`, which gives the offset's uncertainty beside it; pylsl exposes only
-the offset) and refreshed every CORRECTION_INTERVAL_S, so the tracker's latency to the host is
-known. The inlet recovers a sender that restarts (same source id) by itself. pylsl is imported only
-when an LSL stream is used or listed, and liblsl's own console log is kept to fatal errors: the rig
-logs what happens to the link itself.
+the offset) and refreshed every CORRECTION_INTERVAL_S by the consumer that decodes the samples, so
+the tracker's latency to the host is known. On the system's monotonic clock the inlet is pulled by
+a compiled thread (`_readers.LslReader`, calling liblsl's `lsl_pull_sample_d` as pylsl loaded it);
+elsewhere by the stream's Python thread. The inlet recovers a sender that restarts (same source
+id) by itself. pylsl is imported only when an LSL stream is used or listed, and liblsl's own
+console log is kept to fatal errors: the rig logs what happens to the link itself.
 """
 
 from __future__ import annotations
@@ -22,6 +24,11 @@ from rig.devices.trackers.profile import DEFAULT_UNIT_TOLERANCE
 from rig.devices.trackers.readings import Reading
 from rig.devices.trackers.stream import LinkLost, TrackerStream
 from rig.errors import ConfigError, RigError
+
+try:
+    from rig.devices.trackers._readers import LslReader
+except ImportError:
+    LslReader = None
 
 CHANNELS = ("px", "py", "pz", "qw", "qx", "qy", "qz")
 RESOLVE_TIMEOUT_S = 2.0
@@ -101,7 +108,8 @@ def lsl_origin(clock: Clock) -> float:
 
 
 class LslLink:
-    """The inlet of the LSL stream called `name`."""
+    """The inlet of the LSL stream called `name`. What its readers queue is (samples, their LSL
+    stamps): several samples a chunk from the Python reader, one from the compiled one."""
 
     def __init__(self, name: str) -> None:
         self.name = name
@@ -113,6 +121,7 @@ class LslLink:
         self._puller: SamplePuller | None = None
         self._next_correction = 0.0
         self._correction: tuple[float, float, float] | None = None
+        """The correction measured at open, for the consumer to hand the mapping with the first samples."""
 
     def open(self, clock: Clock) -> None:
         lsl = pylsl()
@@ -141,13 +150,18 @@ class LslLink:
         self._puller = SamplePuller(inlet, READ_TIMEOUT_S)
         self._inlet = inlet
 
-    def native_reader(self, clock: Clock) -> None:
-        """None: the inlet is pulled through liblsl's Python binding, on the stream's thread."""
-        return None
+    def native_reader(self, clock: Clock) -> LslReader | None:
+        """The open inlet pulled on a compiled thread, where the reader is built and the stamps can
+        be on `clock` (the system's monotonic clock, which C reads too); it holds the inlet until
+        its thread is joined."""
+        inlet = self._inlet
+        if LslReader is None or inlet is None or not (isinstance(clock, MonotonicClock) and clock.on_system_clock):
+            return None
+        pull = ctypes.cast(pylsl().lib.lib.lsl_pull_sample_d, ctypes.c_void_p).value
+        return LslReader(pull, inlet.obj.value, len(CHANNELS), clock.origin_ns, inlet)
 
-    def receive(self, clock: Clock) -> tuple[list, list, tuple[float, float, float] | None] | None:
-        """(samples, their LSL stamps, a fresh clock correction (offset, uncertainty, rig time) or
-        None), or None if nothing came in time."""
+    def receive(self, clock: Clock) -> tuple[list, list] | None:
+        """(samples, their LSL stamps), or None if nothing came in time."""
         lsl = pylsl()
         inlet, puller = self._inlet, self._puller
         if inlet is None or puller is None:
@@ -160,25 +174,35 @@ class LslLink:
             # A chunk pull allocates buffers for its largest size: asked only for what is waiting.
             waiting = puller.waiting()
             rest, stamps = inlet.pull_chunk(timeout=0.0, max_samples=waiting) if waiting else ([], [])
-            now = clock.now()
-            if now >= self._next_correction:
-                self._next_correction = now + CORRECTION_INTERVAL_S
-                self._correction = (*time_correction(inlet, 0.0), now)
-        except lsl.util.TimeoutError:
-            pass  # no fresh estimate yet (liblsl measures in the background): the mapping keeps the last
         except lsl.util.LostError as error:
             raise LinkLost(f"the sender is gone ({error})") from None
-        correction, self._correction = self._correction, None
-        return [first, *rest], [stamp, *stamps], correction
+        return [first, *rest], [stamp, *stamps]
 
-    def decode(self, chunks: list[tuple[list, list, tuple[float, float, float] | None]], arrivals: list[float]) -> list[Reading]:
+    def decode(self, chunks: list[tuple[list, list]], arrivals: list[float]) -> list[Reading]:
+        """The chunks' samples; first the clock corrections due, measured on this (the consumer's)
+        thread at the last arrival, while the reader goes on pulling."""
+        self._correct(arrivals[-1])
         readings = []
-        for (samples, stamps, correction), t_arrival in zip(chunks, arrivals):
-            if correction is not None:
-                self.mapping.add_correction(*correction)
+        for (samples, stamps), t_arrival in zip(chunks, arrivals):
             for (px, py, pz, qw, qx, qy, qz), device_time in zip(samples, stamps):
                 readings.append(Reading(t_arrival, device_time, None, (px, py, pz), (qw, qx, qy, qz)))
         return readings
+
+    def _correct(self, now: float) -> None:
+        """Hands the mapping the correction measured at open, and a fresh one every
+        CORRECTION_INTERVAL_S (liblsl's latest, without waiting for it)."""
+        correction, self._correction = self._correction, None
+        if correction is not None:
+            self.mapping.add_correction(*correction)
+        inlet = self._inlet
+        if inlet is None or now < self._next_correction:
+            return
+        self._next_correction = now + CORRECTION_INTERVAL_S
+        lsl = pylsl()
+        try:
+            self.mapping.add_correction(*time_correction(inlet, 0.0), now)
+        except (lsl.util.TimeoutError, lsl.util.LostError):
+            pass  # no fresh estimate yet (liblsl measures in the background), or the sender is gone: the mapping keeps the last
 
     def restart(self) -> None:
         pass

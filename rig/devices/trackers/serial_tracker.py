@@ -29,7 +29,7 @@ from rig.devices.trackers.stream import LinkLost, TrackerStream
 from rig.errors import ConfigError, RigError
 
 try:
-    from rig.devices.trackers._fd_reader import FdReader, wait_read
+    from rig.devices.trackers._readers import FdReader, wait_read
 except ImportError:
     FdReader = wait_read = None
 
@@ -42,7 +42,7 @@ READ_TIMEOUT_MS = round(READ_TIMEOUT_S * 1000)
 # Most bytes taken from a port with a file descriptor in one read.
 CHUNK_BYTES = 65536
 FD_READER_MISSING = (
-    "rig.devices.trackers._fd_reader is not built, so serial ports are waited on and read through Python: "
+    "rig.devices.trackers._readers is not built, so serial ports are waited on and read through Python: "
     "the same records, at more CPU per record; to build it, reinstall the package (pip install -e .)"
 )
 
@@ -90,7 +90,7 @@ def _file_descriptor(port: SerialPort) -> int | None:
 def waiting_reader(fd: int) -> Callable[[int, int], bytes | None]:
     """`read(timeout_ms, size)` for `fd`: waits up to timeout_ms for it to be readable and reads what
     it holds, up to `size` bytes; None if nothing came in time, b"" at its end, OSError as os.read.
-    The compiled `_fd_reader.wait_read` where it is built, else a poll object registered once."""
+    The compiled `_readers.wait_read` where it is built, else a poll object registered once."""
     if wait_read is not None:
         return partial(wait_read, fd)
     poller = select.poll()

@@ -5,10 +5,11 @@
 its arrival time and queues it: that is all the thread does per wake-up, because at 1000 records a
 second the wake-ups are most of the cost, and code run once per wake-up runs cold, several times
 slower than the same code run over a batch. Where the link has a compiled reader
-(`Link.native_reader`: a serial port with a file descriptor, on the system's monotonic clock), that
-thread is in C and never wakes the interpreter; the stream's own thread only supervises it, asleep
-in C until it ends, and reopens the link when it does. Elsewhere (a port without a descriptor, HID,
-LSL, a test's clock) the stream's thread is the reader, in Python, calling `Link.receive`. The
+(`Link.native_reader`: a serial port with a file descriptor, or an LSL inlet, on the system's
+monotonic clock), that thread is in C and never wakes the interpreter; the stream's own thread only
+supervises it, asleep in C until it ends, and reopens the link when it does. Elsewhere (a port
+without a descriptor, HID, a test's clock) the stream's thread is the reader, in Python, calling
+`Link.receive`. The
 consumer's `poll()` (the session's render loop, or `rig record-tracker`), which never blocks, or
 `wait(timeout)`, takes every queued chunk and decodes them together: each record is checked and
 what was wrong counted, in arrival order, then the device times of all it took are mapped onto the
@@ -49,13 +50,14 @@ class LinkLost(Exception):
 
 
 class NativeReader(Protocol):
-    """A link's compiled reader (`_fd_reader.FdReader`), reading on a thread of its own from when it
-    is made: it queues what arrives, stamped on the rig clock, until the link ends or `stop()`."""
+    """A link's compiled reader (`_readers.FdReader`, `_readers.LslReader`), reading on a thread of
+    its own from when it is made: it queues what arrives, stamped on the rig clock, until the link
+    ends or `stop()`."""
 
     outcome: str | None
     """None while it reads; then how it ended: "stopped", "end of file" or "error"."""
     errno: int
-    """The failed call's errno where the outcome is "error"."""
+    """Where the outcome is "error", the failed call's code (errno; liblsl's for an inlet)."""
     cpu_s: float
     """The CPU time its thread has used."""
 
@@ -342,7 +344,8 @@ class TrackerStream:
         if native.outcome == "stopped" or self._stop.is_set():
             return None
         if native.outcome == "error":
-            return str(OSError(native.errno, os.strerror(native.errno)))
+            code = native.errno
+            return str(OSError(code, os.strerror(code))) if code > 0 else f"the stream failed (liblsl error {code})"
         return "the device closed the link (end of file)"
 
     def _accept(self, chunks: list[Any], arrivals: list[float], possible: list[Reading]) -> None:

@@ -1,6 +1,6 @@
-"""A serial port with a file descriptor is read in C: by a thread of its own (`_fd_reader.FdReader`,
+"""A serial port with a file descriptor is read in C: by a thread of its own (`_readers.FdReader`,
 on the system's monotonic clock), or, for a reader thread in Python, one wait and read per call
-(the compiled `_fd_reader.wait_read` and its pure-Python fallback, a poll object). The thread
+(the compiled `_readers.wait_read` and its pure-Python fallback, a poll object). The thread
 queues every byte in order, stamped between the clock readings around its writing, and ends as the
 descriptor does; the wait-and-read gives the same bytes, None when nothing came, b"" at the end,
 OSError on a closed descriptor; a serial tracker reads the same records whichever reads it, and a
@@ -36,7 +36,7 @@ FdReader = serial_module.FdReader
 def implementation(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
     """thread: the compiled reader thread; compiled: a Python thread on the compiled wait-and-read;
     python: a Python thread on a poll object."""
-    assert serial_module.FdReader is not None, "rig.devices.trackers._fd_reader is built by pip install -e ."
+    assert serial_module.FdReader is not None, "rig.devices.trackers._readers is built by pip install -e ."
     if request.param != "thread":
         monkeypatch.setattr(serial_module, "FdReader", None)
     if request.param == "python":
@@ -225,7 +225,7 @@ def test_a_closed_descriptor_raises_os_error(implementation: str, pipe: Pipe) ->
 
 def test_the_compiled_reader_refuses_a_negative_size() -> None:
     if serial_module.wait_read is None:
-        pytest.fail("rig.devices.trackers._fd_reader is built by pip install -e .")
+        pytest.fail("rig.devices.trackers._readers is built by pip install -e .")
     with pytest.raises(ValueError):
         serial_module.wait_read(0, 0, -1)
 

@@ -1,12 +1,18 @@
-/* A tracker's file descriptor (a serial device, a pty, a socket) read in C, two ways:
+/* Tracker reader threads in C. Each reads its source on a thread of its own (pthreads), stamps
+ * what arrives with CLOCK_MONOTONIC and queues it, until the source ends, fails or stop(). They
+ * never touch the GIL, so at 1000 records a second the interpreter is not woken once per record:
+ * the Python side takes everything queued in one call. A stamp is a rig time, (monotonic ns -
+ * origin_ns) / 1e9, which is MonotonicClock's time line (the system's monotonic clock, counted
+ * from its origin_ns) to the last bit. The thread's CPU time and how it ended are kept for the
+ * Python side; stop(), or dropping the object, ends and joins it.
  *
- * FdReader(fd, origin_ns): a thread of its own (pthreads) that waits for fd to be readable, reads
- * what it holds, stamps the chunk with CLOCK_MONOTONIC and queues it, until the end of the file, a
- * read error or stop(). It never touches the GIL, so at 1000 records a second the interpreter is
- * not woken once per record: the Python side takes everything queued in one call. A chunk's stamp
- * is a rig time, (monotonic ns - origin_ns) / 1e9, which is MonotonicClock's time line (the
- * system's monotonic clock, counted from its origin_ns) to the last bit. The thread's CPU time and
- * how it ended are kept for the Python side; stop(), or dropping the object, ends and joins it.
+ * FdReader(fd, origin_ns): a file descriptor (a serial device, a pty, a socket), waited on with
+ * poll and read whole at each wake-up; a chunk is what one read gave.
+ *
+ * LslReader(pull_sample_d, inlet, channels, origin_ns, keep): an LSL inlet, pulled one sample at a
+ * time with liblsl's lsl_pull_sample_d (its address, from the library the caller loaded, and the
+ * inlet's handle); a chunk is one sample as LslLink queues samples, ([values], [LSL stamp]).
+ * `keep` (the Python inlet) is held until the thread is joined, so the inlet outlives it.
  *
  * wait_read(fd, timeout_ms, size): one wait and read in one call that releases the GIL once, for a
  * reader thread in Python (where the stamps are on another clock than the system's). The bytes,
@@ -28,6 +34,9 @@
 #define NS_PER_S 1000000000LL
 /* The longest a wait sleeps with the GIL released before it looks for a signal (Ctrl-C). */
 #define SIGNAL_CHECK_NS 100000000LL
+/* The longest an LSL pull waits, so that the thread notices stop(): liblsl's wait cannot be woken. */
+#define LSL_PULL_TIMEOUT_S 0.05
+#define MOST_CHANNELS 64
 
 static PyObject *wait_read(PyObject *self, PyObject *args) {
     int fd, timeout_ms;
@@ -67,6 +76,8 @@ static PyObject *wait_read(PyObject *self, PyObject *args) {
 enum outcome { RUNNING, STOPPED, END_OF_FILE, FAILED };
 static const char *OUTCOME_NAMES[] = {NULL, "stopped", "end of file", "error"};
 
+typedef double (*PullSample)(void *inlet, double *buffer, int32_t elements, double timeout, int32_t *error);
+
 /* Chunks queued by the thread, not yet taken: their bytes end to end, where each ends, its stamp. */
 typedef struct {
     char *bytes;
@@ -78,9 +89,17 @@ typedef struct {
 
 typedef struct {
     PyObject_HEAD
-    int fd;
     int64_t origin_ns;
+    /* An FdReader's: */
+    int fd;
     int wake[2]; /* stop() writes to wake[1]; the thread polls wake[0] beside fd */
+    /* An LslReader's: */
+    PullSample pull;
+    void *inlet;
+    int channels;
+    PyObject *keep;
+    int stop_requested; /* atomic: set by stop(), read by the pulling thread between pulls */
+    PyObject *(*chunk_of)(const void *self, const char *data, size_t size); /* a queued chunk as Python's */
     pthread_t thread;
     int started, joined, stopping; /* touched with the GIL held */
     pthread_mutex_t lock;
@@ -88,10 +107,10 @@ typedef struct {
     /* Under lock: */
     Queue queue;
     enum outcome outcome;
-    int error;     /* errno, where the outcome is FAILED */
+    int error;     /* where the outcome is FAILED: errno (FdReader), liblsl's error code (LslReader) */
     double cpu_s;  /* the thread's CPU time, once it has ended */
     int waiters;
-} FdReader;
+} Reader;
 
 static int64_t monotonic_ns(void) {
     struct timespec now;
@@ -140,8 +159,28 @@ static void queue_free(Queue *q) {
     memset(q, 0, sizeof *q);
 }
 
+/* Queues a chunk stamped now, waking a waiting consumer; 0 where memory ran out. */
+static int queue_chunk(Reader *r, const char *data, size_t size, int64_t stamp_ns) {
+    pthread_mutex_lock(&r->lock);
+    int queued = queue_append(&r->queue, data, size, stamp_ns);
+    if (r->waiters) pthread_cond_broadcast(&r->changed);
+    pthread_mutex_unlock(&r->lock);
+    return queued;
+}
+
+/* The thread's last act: how it ended, and the CPU time it used, for the Python side. */
+static void finish(Reader *r, enum outcome outcome, int error) {
+    double cpu_s = seconds_of(CLOCK_THREAD_CPUTIME_ID);
+    pthread_mutex_lock(&r->lock);
+    r->outcome = outcome;
+    r->error = error;
+    r->cpu_s = cpu_s;
+    pthread_cond_broadcast(&r->changed);
+    pthread_mutex_unlock(&r->lock);
+}
+
 static void *read_loop(void *arg) {
-    FdReader *r = arg;
+    Reader *r = arg;
     enum outcome outcome = RUNNING;
     int error = 0;
     char *buffer = malloc(MOST_BYTES);
@@ -170,29 +209,86 @@ static void *read_loop(void *arg) {
             error = errno;
         } else if (got == 0) {
             outcome = END_OF_FILE;
-        } else {
-            pthread_mutex_lock(&r->lock);
-            int queued = queue_append(&r->queue, buffer, (size_t)got, stamp_ns);
-            if (r->waiters) pthread_cond_broadcast(&r->changed);
-            pthread_mutex_unlock(&r->lock);
-            if (!queued) {
-                outcome = FAILED;
-                error = ENOMEM;
-            }
+        } else if (!queue_chunk(r, buffer, (size_t)got, stamp_ns)) {
+            outcome = FAILED;
+            error = ENOMEM;
         }
     }
     free(buffer);
-    double cpu_s = seconds_of(CLOCK_THREAD_CPUTIME_ID);
-    pthread_mutex_lock(&r->lock);
-    r->outcome = outcome;
-    r->error = error;
-    r->cpu_s = cpu_s;
-    pthread_cond_broadcast(&r->changed);
-    pthread_mutex_unlock(&r->lock);
+    finish(r, outcome, error);
     return NULL;
 }
 
-static int FdReader_init(FdReader *self, PyObject *args, PyObject *kwargs) {
+/* Pulls samples until stop() or an error; a chunk queued is the sample's LSL stamp, then its values. */
+static void *pull_loop(void *arg) {
+    Reader *r = arg;
+    double sample[1 + MOST_CHANNELS];
+    enum outcome outcome = RUNNING;
+    int32_t error = 0;
+    while (!__atomic_load_n(&r->stop_requested, __ATOMIC_ACQUIRE)) {
+        error = 0;
+        double stamp = r->pull(r->inlet, sample + 1, r->channels, LSL_PULL_TIMEOUT_S, &error);
+        int64_t stamp_ns = monotonic_ns();
+        if (error && error != -1) { /* -1: lsl_timeout_error, nothing came in time */
+            outcome = FAILED;
+            break;
+        }
+        if (stamp == 0.0) continue;
+        sample[0] = stamp;
+        if (!queue_chunk(r, (const char *)sample, (size_t)(1 + r->channels) * sizeof(double), stamp_ns)) {
+            outcome = FAILED;
+            error = ENOMEM;
+            break;
+        }
+    }
+    finish(r, outcome == RUNNING ? STOPPED : outcome, error);
+    return NULL;
+}
+
+static PyObject *bytes_of(const void *self, const char *data, size_t size) {
+    return PyBytes_FromStringAndSize(data, (Py_ssize_t)size);
+}
+
+/* ([values], [LSL stamp]): a pulled sample as LslLink queues samples. */
+static PyObject *sample_of(const void *self, const char *data, size_t size) {
+    const double *sample = (const double *)data;
+    Py_ssize_t channels = (Py_ssize_t)(size / sizeof(double)) - 1;
+    PyObject *values = PyList_New(channels);
+    PyObject *stamps = PyList_New(1);
+    PyObject *result = NULL;
+    if (!values || !stamps) goto done;
+    for (Py_ssize_t i = 0; i < channels; i++) {
+        PyObject *value = PyFloat_FromDouble(sample[1 + i]);
+        if (!value) goto done;
+        PyList_SET_ITEM(values, i, value);
+    }
+    PyObject *stamp = PyFloat_FromDouble(sample[0]);
+    if (!stamp) goto done;
+    PyList_SET_ITEM(stamps, 0, stamp);
+    PyObject *samples = PyList_New(1);
+    if (!samples) goto done;
+    PyList_SET_ITEM(samples, 0, values);
+    values = NULL;
+    result = PyTuple_Pack(2, samples, stamps);
+    Py_DECREF(samples);
+done:
+    Py_XDECREF(values);
+    Py_XDECREF(stamps);
+    return result;
+}
+
+static int start_thread(Reader *self, void *(*loop)(void *)) {
+    int failed = pthread_create(&self->thread, NULL, loop, self);
+    if (failed) {
+        errno = failed;
+        PyErr_SetFromErrno(PyExc_OSError);
+        return -1;
+    }
+    self->started = 1;
+    return 0;
+}
+
+static int FdReader_init(Reader *self, PyObject *args, PyObject *kwargs) {
     static char *keywords[] = {"fd", "origin_ns", NULL};
     long long origin_ns;
     if (self->started) {
@@ -207,21 +303,40 @@ static int FdReader_init(FdReader *self, PyObject *args, PyObject *kwargs) {
     }
     fcntl(self->wake[0], F_SETFD, FD_CLOEXEC);
     fcntl(self->wake[1], F_SETFD, FD_CLOEXEC);
-    int failed = pthread_create(&self->thread, NULL, read_loop, self);
-    if (failed) {
-        close(self->wake[0]);
-        close(self->wake[1]);
-        self->wake[0] = self->wake[1] = -1;
-        errno = failed;
-        PyErr_SetFromErrno(PyExc_OSError);
-        return -1;
-    }
-    self->started = 1;
-    return 0;
+    self->chunk_of = bytes_of;
+    return start_thread(self, read_loop);
 }
 
-static PyObject *FdReader_new(PyTypeObject *type, PyObject *args, PyObject *kwargs) {
-    FdReader *self = (FdReader *)type->tp_alloc(type, 0);
+static int LslReader_init(Reader *self, PyObject *args, PyObject *kwargs) {
+    static char *keywords[] = {"pull_sample_d", "inlet", "channels", "origin_ns", "keep", NULL};
+    unsigned long long pull, inlet;
+    long long origin_ns;
+    PyObject *keep;
+    if (self->started) {
+        PyErr_SetString(PyExc_RuntimeError, "an LslReader is started once");
+        return -1;
+    }
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "KKiLO:LslReader", keywords, &pull, &inlet, &self->channels, &origin_ns, &keep))
+        return -1;
+    if (!pull || !inlet) {
+        PyErr_SetString(PyExc_ValueError, "the function's address and the inlet's handle must not be null");
+        return -1;
+    }
+    if (self->channels < 1 || self->channels > MOST_CHANNELS) {
+        PyErr_Format(PyExc_ValueError, "channels must be 1 to %d", MOST_CHANNELS);
+        return -1;
+    }
+    self->pull = (PullSample)(uintptr_t)pull;
+    self->inlet = (void *)(uintptr_t)inlet;
+    self->origin_ns = origin_ns;
+    Py_INCREF(keep);
+    self->keep = keep;
+    self->chunk_of = sample_of;
+    return start_thread(self, pull_loop);
+}
+
+static PyObject *Reader_new(PyTypeObject *type, PyObject *args, PyObject *kwargs) {
+    Reader *self = (Reader *)type->tp_alloc(type, 0);
     if (!self) return NULL;
     self->wake[0] = self->wake[1] = -1;
     pthread_mutex_init(&self->lock, NULL);
@@ -234,7 +349,7 @@ static PyObject *FdReader_new(PyTypeObject *type, PyObject *args, PyObject *kwar
 }
 
 /* Ends the thread and joins it; the GIL is released while it waits. */
-static void stop_thread(FdReader *self) {
+static void stop_thread(Reader *self) {
     if (!self->started || self->joined) return;
     if (self->stopping) { /* another Python thread is joining it: wait for the end it is waiting for */
         Py_BEGIN_ALLOW_THREADS
@@ -245,17 +360,21 @@ static void stop_thread(FdReader *self) {
         return;
     }
     self->stopping = 1;
-    ssize_t written;
-    do written = write(self->wake[1], "x", 1);
-    while (written < 0 && errno == EINTR);
+    __atomic_store_n(&self->stop_requested, 1, __ATOMIC_RELEASE);
+    if (self->wake[1] >= 0) {
+        ssize_t written;
+        do written = write(self->wake[1], "x", 1);
+        while (written < 0 && errno == EINTR);
+    }
     Py_BEGIN_ALLOW_THREADS
     pthread_join(self->thread, NULL);
     Py_END_ALLOW_THREADS
     self->joined = 1;
 }
 
-static void FdReader_dealloc(FdReader *self) {
+static void Reader_dealloc(Reader *self) {
     stop_thread(self);
+    Py_CLEAR(self->keep);
     if (self->wake[0] >= 0) close(self->wake[0]);
     if (self->wake[1] >= 0) close(self->wake[1]);
     queue_free(&self->queue);
@@ -264,12 +383,12 @@ static void FdReader_dealloc(FdReader *self) {
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-static PyObject *FdReader_stop(FdReader *self, PyObject *unused) {
+static PyObject *Reader_stop(Reader *self, PyObject *unused) {
     stop_thread(self);
     Py_RETURN_NONE;
 }
 
-static PyObject *FdReader_take(FdReader *self, PyObject *unused) {
+static PyObject *Reader_take(Reader *self, PyObject *unused) {
     pthread_mutex_lock(&self->lock);
     Queue taken = self->queue;
     memset(&self->queue, 0, sizeof self->queue);
@@ -280,7 +399,7 @@ static PyObject *FdReader_take(FdReader *self, PyObject *unused) {
     if (!chunks || !arrivals) goto done;
     size_t start = 0;
     for (size_t i = 0; i < taken.count; i++) {
-        PyObject *chunk = PyBytes_FromStringAndSize(taken.bytes + start, (Py_ssize_t)(taken.ends[i] - start));
+        PyObject *chunk = self->chunk_of(self, taken.bytes + start, taken.ends[i] - start);
         if (!chunk) goto done;
         PyList_SET_ITEM(chunks, (Py_ssize_t)i, chunk);
         PyObject *arrival = PyFloat_FromDouble((double)(taken.stamps_ns[i] - self->origin_ns) / 1e9);
@@ -299,7 +418,7 @@ done:
 /* Waits up to timeout_s (forever if negative) until there is a chunk to take (`for_data`) or until
  * the thread has ended; 1 if so, 0 if the time ran out, -1 with an exception set by a signal's
  * handler (Ctrl-C). */
-static int wait_for(FdReader *self, double timeout_s, int for_data) {
+static int wait_for(Reader *self, double timeout_s, int for_data) {
     int64_t deadline_ns = timeout_s < 0 ? INT64_MAX : monotonic_ns() + (int64_t)(timeout_s * 1e9);
     for (;;) {
         int done;
@@ -322,7 +441,7 @@ static int wait_for(FdReader *self, double timeout_s, int for_data) {
     }
 }
 
-static PyObject *wait_method(FdReader *self, PyObject *args, int for_data) {
+static PyObject *wait_method(Reader *self, PyObject *args, int for_data) {
     PyObject *timeout = Py_None;
     if (!PyArg_ParseTuple(args, "|O", &timeout)) return NULL;
     double timeout_s = -1.0;
@@ -339,11 +458,11 @@ static PyObject *wait_method(FdReader *self, PyObject *args, int for_data) {
     return PyBool_FromLong(done);
 }
 
-static PyObject *FdReader_wait(FdReader *self, PyObject *args) { return wait_method(self, args, 1); }
+static PyObject *Reader_wait(Reader *self, PyObject *args) { return wait_method(self, args, 1); }
 
-static PyObject *FdReader_wait_ended(FdReader *self, PyObject *args) { return wait_method(self, args, 0); }
+static PyObject *Reader_wait_ended(Reader *self, PyObject *args) { return wait_method(self, args, 0); }
 
-static PyObject *FdReader_get_outcome(FdReader *self, void *unused) {
+static PyObject *Reader_get_outcome(Reader *self, void *unused) {
     pthread_mutex_lock(&self->lock);
     enum outcome outcome = self->outcome;
     pthread_mutex_unlock(&self->lock);
@@ -351,14 +470,14 @@ static PyObject *FdReader_get_outcome(FdReader *self, void *unused) {
     return PyUnicode_FromString(OUTCOME_NAMES[outcome]);
 }
 
-static PyObject *FdReader_get_errno(FdReader *self, void *unused) {
+static PyObject *Reader_get_errno(Reader *self, void *unused) {
     pthread_mutex_lock(&self->lock);
     int error = self->error;
     pthread_mutex_unlock(&self->lock);
     return PyLong_FromLong(error);
 }
 
-static PyObject *FdReader_get_cpu_s(FdReader *self, void *unused) {
+static PyObject *Reader_get_cpu_s(Reader *self, void *unused) {
     pthread_mutex_lock(&self->lock);
     double cpu_s = self->cpu_s;
     if (self->outcome == RUNNING) { /* still running, so its clock is still there */
@@ -369,42 +488,60 @@ static PyObject *FdReader_get_cpu_s(FdReader *self, void *unused) {
     return PyFloat_FromDouble(cpu_s);
 }
 
-static PyMethodDef FdReader_methods[] = {
-    {"take", (PyCFunction)FdReader_take, METH_NOARGS,
-     "take() -> (chunks, arrivals): every chunk read since the last take, as bytes, in order, and the\n"
-     "rig time (s) each was read at."},
-    {"wait", (PyCFunction)FdReader_wait, METH_VARARGS,
+static PyMethodDef Reader_methods[] = {
+    {"take", (PyCFunction)Reader_take, METH_NOARGS,
+     "take() -> (chunks, arrivals): every chunk queued since the last take, in order, and the rig\n"
+     "time (s) each arrived at."},
+    {"wait", (PyCFunction)Reader_wait, METH_VARARGS,
      "wait(timeout_s=None) -> bool: waits, the GIL released, until there is a chunk to take or the\n"
      "thread has ended (True), or the timeout passed (False; None waits forever)."},
-    {"wait_ended", (PyCFunction)FdReader_wait_ended, METH_VARARGS,
+    {"wait_ended", (PyCFunction)Reader_wait_ended, METH_VARARGS,
      "wait_ended(timeout_s=None) -> bool: waits, the GIL released, until the thread has ended (True)\n"
      "or the timeout passed (False; None waits forever)."},
-    {"stop", (PyCFunction)FdReader_stop, METH_NOARGS,
+    {"stop", (PyCFunction)Reader_stop, METH_NOARGS,
      "stop(): ends the thread, if it still runs, and joins it; what it read stays to be taken."},
     {NULL, NULL, 0, NULL},
 };
 
-static PyGetSetDef FdReader_getset[] = {
-    {"outcome", (getter)FdReader_get_outcome, NULL,
+static PyGetSetDef Reader_getset[] = {
+    {"outcome", (getter)Reader_get_outcome, NULL,
      "None while the thread runs; then how it ended: \"stopped\", \"end of file\" or \"error\".", NULL},
-    {"errno", (getter)FdReader_get_errno, NULL, "The read's or wait's errno where the outcome is \"error\", else 0.", NULL},
-    {"cpu_s", (getter)FdReader_get_cpu_s, NULL, "The CPU time (s) the thread has used.", NULL},
+    {"errno", (getter)Reader_get_errno, NULL,
+     "Where the outcome is \"error\", the failed call's errno (FdReader) or liblsl's error code\n"
+     "(LslReader); else 0.", NULL},
+    {"cpu_s", (getter)Reader_get_cpu_s, NULL, "The CPU time (s) the thread has used.", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };
 
 static PyTypeObject FdReaderType = {
     PyVarObject_HEAD_INIT(NULL, 0)
-    .tp_name = "rig.devices.trackers._fd_reader.FdReader",
-    .tp_doc = "FdReader(fd, origin_ns): reads fd on a thread of its own, each chunk stamped on the\n"
-              "monotonic clock as (ns - origin_ns) / 1e9, until its end, an error or stop().\n"
+    .tp_name = "rig.devices.trackers._readers.FdReader",
+    .tp_doc = "FdReader(fd, origin_ns): reads fd on a thread of its own, each chunk (bytes) stamped on\n"
+              "the monotonic clock as (ns - origin_ns) / 1e9, until its end, an error or stop().\n"
               "The descriptor stays the caller's: keep it open until the thread is stopped.",
-    .tp_basicsize = sizeof(FdReader),
+    .tp_basicsize = sizeof(Reader),
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_new = FdReader_new,
+    .tp_new = Reader_new,
     .tp_init = (initproc)FdReader_init,
-    .tp_dealloc = (destructor)FdReader_dealloc,
-    .tp_methods = FdReader_methods,
-    .tp_getset = FdReader_getset,
+    .tp_dealloc = (destructor)Reader_dealloc,
+    .tp_methods = Reader_methods,
+    .tp_getset = Reader_getset,
+};
+
+static PyTypeObject LslReaderType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "rig.devices.trackers._readers.LslReader",
+    .tp_doc = "LslReader(pull_sample_d, inlet, channels, origin_ns, keep): pulls the LSL inlet (liblsl's\n"
+              "lsl_pull_sample_d at that address, the inlet's handle) on a thread of its own, each sample\n"
+              "a chunk ([values], [LSL stamp]) stamped on the monotonic clock as (ns - origin_ns) /\n"
+              "1e9, until liblsl reports an error or stop(); `keep` (the inlet) is held until then.",
+    .tp_basicsize = sizeof(Reader),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_new = Reader_new,
+    .tp_init = (initproc)LslReader_init,
+    .tp_dealloc = (destructor)Reader_dealloc,
+    .tp_methods = Reader_methods,
+    .tp_getset = Reader_getset,
 };
 
 static PyMethodDef methods[] = {
@@ -414,17 +551,23 @@ static PyMethodDef methods[] = {
 };
 
 static struct PyModuleDef module = {
-    PyModuleDef_HEAD_INIT, "_fd_reader", "A tracker's file descriptor read in C: by a thread of its own, or one wait and read per call.", -1,
-    methods,
+    PyModuleDef_HEAD_INIT, "_readers", "Tracker reader threads in C, and a wait and read in one call.", -1, methods,
 };
 
-PyMODINIT_FUNC PyInit__fd_reader(void) {
-    if (PyType_Ready(&FdReaderType) < 0) return NULL;
+static int add_type(PyObject *m, PyTypeObject *type, const char *name) {
+    if (PyType_Ready(type) < 0) return -1;
+    Py_INCREF(type);
+    if (PyModule_AddObject(m, name, (PyObject *)type) < 0) {
+        Py_DECREF(type);
+        return -1;
+    }
+    return 0;
+}
+
+PyMODINIT_FUNC PyInit__readers(void) {
     PyObject *m = PyModule_Create(&module);
     if (!m) return NULL;
-    Py_INCREF(&FdReaderType);
-    if (PyModule_AddObject(m, "FdReader", (PyObject *)&FdReaderType) < 0) {
-        Py_DECREF(&FdReaderType);
+    if (add_type(m, &FdReaderType, "FdReader") < 0 || add_type(m, &LslReaderType, "LslReader") < 0) {
         Py_DECREF(m);
         return NULL;
     }
