@@ -2,7 +2,11 @@
 
 * **Scale-out**: `rig analyse` of a batch of simulated videos in a fresh process, serially, then
   on a local Dask cluster of two worker processes (the cluster's start included), alternately a
-  few rounds: the speed-up of the medians, and of each round.
+  few rounds: the speed-up of the medians, and of each round. Beside them, the serial run with
+  the threads a worker gets (`rig.executor.worker_environment`): `workers` times the serial run
+  over that one is the most the workers could gain with nothing else to pay (the ceiling). A
+  serial run decodes ahead on a thread of its own, so where the cores are too few to give each
+  worker one too, the ceiling is under `workers`.
 * **Dask's overhead**: the same for a batch of one video.
 * **Fixed cost per video**: one longer clip analysed by `rig analyse` in a fresh process, against
   decoding it alone in a fresh process, with the compiled-fit cache empty (the first run on a
@@ -24,6 +28,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
+from rig.executor import worker_environment
 from rig.service.simulate import simulate
 from rig.sim.config import SimulationConfig
 from rig.sim.pendulum import PendulumConfig
@@ -52,24 +57,29 @@ def videos(folder: Path, count: int, duration_s: float, log: Log) -> list[Path]:
     return made
 
 
-def batch_seconds(videos: list[Path], workers: int | None) -> float:
+def batch_seconds(videos: list[Path], workers: int | None, environment: dict[str, str] | None = None) -> float:
     """`rig analyse VIDEOS --summary` in a fresh process, serially or on a local Dask cluster of
-    `workers` (its start included): what a user waits for either way, compiled fits cached alike."""
+    `workers` (its start included): what a user waits for either way, compiled fits cached alike;
+    `environment` adds to this process's variables."""
     rig = str(Path(sys.executable).with_name("rig"))
     with tempfile.TemporaryDirectory(prefix="rig-bench-batch-") as folder:
         command = [rig, "analyse", *map(str, videos), "--summary", str(Path(folder) / "summary.csv")]
-        return _process_seconds([*command, *(["--workers", str(workers)] if workers else [])], dict(os.environ), allowed=(0, 3))
+        return _process_seconds([*command, *(["--workers", str(workers)] if workers else [])], {**os.environ, **(environment or {})},
+                                allowed=(0, 3))  # fmt: skip
 
 
 def scale_out(paths: list[Path], workers: int, rounds: int, log: Log) -> dict[str, Any]:
     """The batch serially and on Dask, alternately `rounds` times (a shared machine's load drifts
     between runs), and the one-video batch likewise; medians, and the speed-up of each round."""
     batch_seconds(paths[:1], None)  # fills the compiled-fit cache, as any earlier run on the machine has
-    serial, parallel, one_serial, one_dask = [], [], [], []
+    as_worker = worker_environment(workers)
+    serial, parallel, serial_as_worker, one_serial, one_dask = [], [], [], [], []
     for round_number in range(1, rounds + 1):
         serial.append(batch_seconds(paths, None))
         parallel.append(batch_seconds(paths, workers))
-        log(f"round {round_number}/{rounds}: {len(paths)} videos serially {serial[-1]:.1f} s, on {workers} Dask workers {parallel[-1]:.1f} s")
+        serial_as_worker.append(batch_seconds(paths, None, as_worker))
+        log(f"round {round_number}/{rounds}: {len(paths)} videos serially {serial[-1]:.1f} s, on {workers} Dask workers {parallel[-1]:.1f} s, "
+            f"serially with a worker's threads {serial_as_worker[-1]:.1f} s")  # fmt: skip
         one_serial.append(batch_seconds(paths[:1], None))
         one_dask.append(batch_seconds(paths[:1], workers))
         log(f"round {round_number}/{rounds}: one video {one_serial[-1]:.1f} s serially, {one_dask[-1]:.1f} s on Dask")
@@ -82,6 +92,9 @@ def scale_out(paths: list[Path], workers: int, rounds: int, log: Log) -> dict[st
         "dask_s": median(parallel),
         "speed_up": median(serial) / median(parallel),
         "speed_up_per_round": [a / b for a, b in zip(serial, parallel)],
+        "worker_opencv_threads": int(as_worker.get("OPENCV_FOR_THREADS_NUM", 0)) or None,
+        "serial_as_worker_s": median(serial_as_worker),
+        "ceiling_speed_up": workers * median(serial) / median(serial_as_worker),
         "one_video_serial_s": median(one_serial),
         "one_video_dask_s": median(one_dask),
         "dask_overhead_s": median(one_dask) - median(one_serial),
@@ -120,6 +133,8 @@ def table(report: dict[str, Any]) -> str:
             f"batch of {s['videos']} videos (median of {s['rounds']} rounds): serial {s['serial_s']:.1f} s, "
             f"{s['workers']} Dask workers {s['dask_s']:.1f} s, speed-up {s['speed_up']:.2f} "
             f"(rounds: {', '.join(f'{r:.2f}' for r in s['speed_up_per_round'])})",
+            f"ceiling: serially with a worker's threads (OpenCV {s['worker_opencv_threads']}) {s['serial_as_worker_s']:.1f} s, so "
+            f"{s['workers']} workers can be at most {s['ceiling_speed_up']:.2f} times as fast as serially, before the cluster's start",
             f"Dask overhead for one video: {s['dask_overhead_s']:+.1f} s ({s['one_video_dask_s']:.1f} s against {s['one_video_serial_s']:.1f} s)",
             f"fixed cost of a clip in a fresh process: analyse / decode alone = {f['ratio_cold']:.2f} (empty cache), "
             f"{f['ratio_warm']:.2f} (filled cache); decode alone {f['decode_s']:.1f} s",
@@ -134,10 +149,11 @@ def plot(report: dict[str, Any], path: Path) -> None:
     s, f = report["scale_out"], report["fixed_cost"]
     figure = Figure(figsize=(10, 3.8), layout="constrained")
     batch, clip = figure.subplots(1, 2)
-    batch.bar(["serial", f"{s['workers']} Dask workers"], [s["serial_s"], s["dask_s"]], color=["C0", "C1"])
+    batch.bar(["serial", "serial with\na worker's threads", f"{s['workers']} Dask workers"],
+              [s["serial_s"], s["serial_as_worker_s"], s["dask_s"]], color=["C0", "grey", "C1"])  # fmt: skip
     batch.set_ylabel("wall time (s)")
     batch.set_xlabel(f"batch of {s['videos']} videos")
-    batch.set_title(f"speed-up {s['speed_up']:.2f}")
+    batch.set_title(f"speed-up {s['speed_up']:.2f}, ceiling {s['ceiling_speed_up']:.2f}")
     clip.bar(["decode alone", "analyse,\nempty cache", "analyse,\nfilled cache"],
              [f["decode_s"], f["analyse_cold_cache_s"], f["analyse_warm_cache_s"]], color=["grey", "C3", "C2"])  # fmt: skip
     clip.set_ylabel("wall time in a fresh process (s)")

@@ -6,7 +6,7 @@ import os
 from typing import Any
 
 from analysis.video.decoding import MAX_DECODE_THREADS
-from rig.executor import executor
+from rig.executor import executor, worker_environment
 
 
 def test_local_workers_share_the_cores_out_without_dasks_profiler_or_trim_threshold() -> None:
@@ -40,3 +40,14 @@ def test_local_workers_share_the_cores_out_without_dasks_profiler_or_trim_thresh
             "profiler": False,
             "malloc_trim_threshold": environment.get("MALLOC_TRIM_THRESHOLD_"),
         }
+
+
+def test_worker_environment_is_what_a_local_worker_starts_with() -> None:
+    expected = worker_environment(2)
+
+    def seen(names: list[str]) -> dict[str, str | None]:
+        return {name: os.environ.get(name) for name in names}
+
+    with executor(workers=2) as run:
+        [(_, variables)] = list(run(seen, [sorted(expected)]))
+    assert variables == expected and "OPENCV_FOR_THREADS_NUM" in expected
