@@ -34,12 +34,15 @@ from rig.devices.trackers.readings import Reading, ReadingMaker
 MAX_LINE = 4096
 
 
-class _DamageSince:
-    """Counts damaged records (`corrupt`) and tells each reading how many came since the last one."""
+class _RecordDecoder:
+    """What every decoder does: counts damaged records (`corrupt`), makes the readings of the
+    records a subclass decoded from one feed (`_made`), and tells each how many damaged records
+    came since the reading before it."""
 
-    def __init__(self) -> None:
+    def __init__(self, profile: Profile) -> None:
         self.corrupt = 0
         self._told = 0
+        self._maker = ReadingMaker(profile)
 
     def feed(self, data: bytes, t_arrival: float) -> list[Reading]:
         """The readings of the records `data` completes, stamped `t_arrival`."""
@@ -50,16 +53,22 @@ class _DamageSince:
         the chunk that completed it."""
         raise NotImplementedError
 
-    def _placed(self, reading: Reading) -> Reading:
-        reading.damaged_before = self.corrupt - self._told
-        self._told = self.corrupt
-        return reading
+    def _made(self, records: list, arrivals: list[float], corrupt_at: list[int]) -> list[Reading]:
+        """The readings of records decoded in one feed, each told the damaged records counted since
+        the reading before it (`corrupt_at`: the count `corrupt` had when each was decoded)."""
+        readings = self._maker.make_many(records, arrivals)
+        if corrupt_at and corrupt_at[-1] != self._told:
+            told = self._told
+            for reading, corrupt in zip(readings, corrupt_at):
+                reading.damaged_before = corrupt - told
+                told = corrupt
+            self._told = told
+        return readings
 
 
-class TextDecoder(_DamageSince):
+class TextDecoder(_RecordDecoder):
     def __init__(self, profile: Profile) -> None:
-        super().__init__()
-        self._maker = ReadingMaker(profile)
+        super().__init__(profile)
         self._terminator = profile.terminator
         self._separator = profile.separator
         self._count = len(profile.fields)
@@ -69,32 +78,35 @@ class TextDecoder(_DamageSince):
     def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
         buffer = self._buffer
         ends = _append_chunks(buffer, chunks)
-        readings = []
+        records: list[list[float]] = []
+        times: list[float] = []
+        corrupt_at: list[int] = []
         terminator = self._terminator
         start = 0
         while (end := buffer.find(terminator, start)) >= 0:
-            line = bytes(buffer[start:end])
+            values = self._values(bytes(buffer[start:end]))
             start = end + len(terminator)
-            reading = self._line(line, arrivals[bisect_left(ends, start)])
-            if reading is not None:
-                readings.append(reading)
+            if values is not None:
+                records.append(values)
+                times.append(arrivals[bisect_left(ends, start)])
+                corrupt_at.append(self.corrupt)
         del buffer[:start]
         if len(buffer) > MAX_LINE:
             buffer.clear()
             self.corrupt += 1
-        return readings
+        return self._made(records, times, corrupt_at)
 
-    def _line(self, line: bytes, t_arrival: float) -> Reading | None:
+    def _values(self, line: bytes) -> list[float] | None:
+        """A line's numbers, or None (counted corrupt unless it is blank or the header)."""
         parts = line.split(self._separator.encode("ascii")) if self._separator else line.split()
         if len(parts) != self._count:
             self.corrupt += bool(line.strip())
             return None
         try:
-            values = list(map(float, parts))
+            return list(map(float, parts))
         except ValueError:
             self.corrupt += [part.strip() for part in parts] != self._header
             return None
-        return self._placed(self._maker.make(values, t_arrival))
 
     def reset(self) -> None:
         self.corrupt += bool(self._buffer.strip())
@@ -102,10 +114,9 @@ class TextDecoder(_DamageSince):
         self._maker.reset()
 
 
-class BinaryDecoder(_DamageSince):
+class BinaryDecoder(_RecordDecoder):
     def __init__(self, profile: Profile) -> None:
-        super().__init__()
-        self._maker = ReadingMaker(profile)
+        super().__init__(profile)
         self._sync = profile.sync
         self._body = struct.Struct(profile.struct_format)
         self._check = CHECKSUMS[profile.checksum]
@@ -118,9 +129,12 @@ class BinaryDecoder(_DamageSince):
     def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
         buffer = self._buffer
         ends = _append_chunks(buffer, chunks)
-        readings = []
+        records: list[tuple] = []
+        times: list[float] = []
+        corrupt_at: list[int] = []
         sync, size = self._sync, self.record_bytes
         body_start, body_end = len(sync), size - self._check_bytes
+        check, check_bytes, order, unpack_from = self._check, self._check_bytes, self._order, self._body.unpack_from
         start = 0
         while True:
             found = buffer.find(sync, start)
@@ -131,57 +145,58 @@ class BinaryDecoder(_DamageSince):
                 break
             self._discarded += found - start
             start = found
-            if len(buffer) - start < size:
+            end = start + size
+            if len(buffer) < end:
                 break
-            body = bytes(buffer[start + body_start : start + body_end])
-            if self._check_bytes and self._check(body, self._order) != buffer[start + body_end : start + size]:
+            if check_bytes and check(buffer[start + body_start : start + body_end], order) != buffer[start + body_end : end]:
                 self._discarded += 1
                 start += 1
                 continue
-            self._end_stretch()
-            values = self._body.unpack(body)
-            start += size
-            readings.append(self._placed(self._maker.make(values, arrivals[bisect_left(ends, start)])))
+            if self._discarded:
+                self._end_stretch()
+            records.append(unpack_from(buffer, start + body_start))
+            times.append(arrivals[bisect_left(ends, end)])
+            corrupt_at.append(self.corrupt)
+            start = end
         del buffer[:start]
-        return readings
+        return self._made(records, times, corrupt_at)
 
     def _end_stretch(self) -> None:
-        if self._discarded:
-            self.corrupt += math.ceil(self._discarded / self.record_bytes)
-            self._discarded = 0
+        self.corrupt += math.ceil(self._discarded / self.record_bytes)
+        self._discarded = 0
 
     def reset(self) -> None:
         self._discarded += len(self._buffer)
-        self._end_stretch()
+        if self._discarded:
+            self._end_stretch()
         self._buffer.clear()
         self._maker.reset()
 
 
-class HidReportDecoder(_DamageSince):
+class HidReportDecoder(_RecordDecoder):
     def __init__(self, profile: Profile) -> None:
-        super().__init__()
-        self._maker = ReadingMaker(profile)
+        super().__init__(profile)
         self._report_id = profile.report_id
         self._body = struct.Struct(profile.struct_format)
         self.report_bytes = self._body.size + (1 if self._report_id else 0)
 
     def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
         """Each chunk is one report."""
-        readings = []
+        records: list[tuple] = []
+        times: list[float] = []
+        corrupt_at: list[int] = []
         for report, t_arrival in zip(chunks, arrivals):
-            readings += self._report(report, t_arrival)
-        return readings
-
-    def _report(self, report: bytes, t_arrival: float) -> list[Reading]:
-        if self._report_id:
-            if not report or report[0] != self._report_id:
-                return []
-            report = report[1:]
-        if len(report) < self._body.size:
-            self.corrupt += 1
-            return []
-        values = self._body.unpack_from(report)
-        return [self._placed(self._maker.make(values, t_arrival))]
+            if self._report_id:
+                if not report or report[0] != self._report_id:
+                    continue
+                report = report[1:]
+            if len(report) < self._body.size:
+                self.corrupt += 1
+                continue
+            records.append(self._body.unpack_from(report))
+            times.append(t_arrival)
+            corrupt_at.append(self.corrupt)
+        return self._made(records, times, corrupt_at)
 
     def reset(self) -> None:
         self._maker.reset()
