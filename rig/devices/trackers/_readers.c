@@ -278,8 +278,10 @@ done:
 }
 
 static int start_thread(Reader *self, void *(*loop)(void *)) {
+    self->outcome = RUNNING;
     int failed = pthread_create(&self->thread, NULL, loop, self);
     if (failed) {
+        self->outcome = STOPPED;
         errno = failed;
         PyErr_SetFromErrno(PyExc_OSError);
         return -1;
@@ -339,6 +341,7 @@ static PyObject *Reader_new(PyTypeObject *type, PyObject *args, PyObject *kwargs
     Reader *self = (Reader *)type->tp_alloc(type, 0);
     if (!self) return NULL;
     self->wake[0] = self->wake[1] = -1;
+    self->outcome = STOPPED; /* until a thread is started: nothing to wait for */
     pthread_mutex_init(&self->lock, NULL);
     pthread_condattr_t attributes;
     pthread_condattr_init(&attributes);
@@ -419,7 +422,8 @@ done:
  * the thread has ended; 1 if so, 0 if the time ran out, -1 with an exception set by a signal's
  * handler (Ctrl-C). */
 static int wait_for(Reader *self, double timeout_s, int for_data) {
-    int64_t deadline_ns = timeout_s < 0 ? INT64_MAX : monotonic_ns() + (int64_t)(timeout_s * 1e9);
+    /* Longer than a few decades is as good as forever (and keeps the sum in range). */
+    int64_t deadline_ns = timeout_s < 0 || timeout_s > 1e9 ? INT64_MAX : monotonic_ns() + (int64_t)(timeout_s * 1e9);
     for (;;) {
         int done;
         int64_t now_ns;
