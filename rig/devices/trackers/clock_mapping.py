@@ -114,9 +114,16 @@ class OneWayMapping:
         if self.model.latest is None:
             return [min(d - best, t) for d, t in zip(device_times, arrivals)]  # type: ignore[operator]
         times = []
+        restarted = self._fresh
         for d, t, modelled in zip(device_times, arrivals, self.model.offsets_at(arrivals)):
-            offset = best if self._fresh and abs(best - modelled) > CLOCK_RESTART_S else max(modelled, d - t)  # type: ignore[operator]
-            times.append(min(d - offset, t))  # type: ignore[operator]
+            # Conditional expressions rather than min and max: this runs once per record.
+            if restarted and abs(best - modelled) > CLOCK_RESTART_S:
+                offset = best
+            else:
+                bound = d - t  # type: ignore[operator]
+                offset = modelled if modelled > bound else bound
+            mapped = d - offset  # type: ignore[operator]
+            times.append(mapped if mapped < t else t)
         return times
 
     def _close_window(self) -> None:

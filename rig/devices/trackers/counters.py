@@ -75,13 +75,15 @@ class SequenceCheck:
                     full = self._unwrap.unwrap(seq)
                 elif step <= 0:
                     counters.out_of_order += 1
-                else:
-                    counters.dropped += max(0, step - 1 - self._discarded_since)
-            self._last_seq = full if self._last_seq is None or restored else max(full, self._last_seq)
+                elif step - 1 > self._discarded_since:
+                    counters.dropped += step - 1 - self._discarded_since
+            if self._last_seq is None or restored or full > self._last_seq:
+                self._last_seq = full
         elif device_time is not None:
             if self._last_time is not None and device_time <= self._last_time and not restored:
                 counters.out_of_order += 1
-            self._last_time = device_time if self._last_time is None or restored else max(device_time, self._last_time)
+            if self._last_time is None or restored or device_time > self._last_time:
+                self._last_time = device_time
         self._discarded_since = 0
 
 

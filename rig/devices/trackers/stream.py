@@ -26,6 +26,8 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass
+from functools import partial
+from operator import attrgetter
 from typing import Any, Callable, NamedTuple, Protocol
 
 from predictors import PoseSample
@@ -134,6 +136,12 @@ class TrackerRecord(NamedTuple):
     def sample_row(self) -> tuple[float, ...]:
         """The sample's values in the trace format's order (`predictors.SAMPLE_COLUMNS`)."""
         return (self.t_sensor, self.t_arrival, *self.position, *self.orientation)
+
+
+_T_ARRIVAL, _DEVICE_TIME, _SEQ = attrgetter("t_arrival"), attrgetter("device_time"), attrgetter("seq")
+_POSITION, _ORIENTATION, _RATE = attrgetter("position"), attrgetter("orientation"), attrgetter("angular_rate")
+_record = partial(tuple.__new__, TrackerRecord)
+"""A TrackerRecord of the tuple of its fields, as its `_make` makes one, without a Python call."""
 
 
 @dataclass(frozen=True)
@@ -383,14 +391,13 @@ class TrackerStream:
         time), and adds their records to `records`."""
         if not possible:
             return
-        arrivals = [reading.t_arrival for reading in possible]
-        sensor_times = self.mapping.sensor_times([reading.device_time for reading in possible], arrivals)
+        arrivals = list(map(_T_ARRIVAL, possible))
+        device_times = list(map(_DEVICE_TIME, possible))
+        sensor_times = self.mapping.sensor_times(device_times, arrivals)
         if self.mapping.latency_known:
             self.latency.add_many([t_arrival - t_sensor for t_arrival, t_sensor in zip(arrivals, sensor_times)])
-        records.extend(
-            TrackerRecord(t_sensor, r.t_arrival, r.position, r.orientation, r.device_time, r.seq, r.angular_rate)  # type: ignore[arg-type]
-            for t_sensor, r in zip(sensor_times, possible)
-        )
+        fields = (map(_POSITION, possible), map(_ORIENTATION, possible), device_times, map(_SEQ, possible), map(_RATE, possible))
+        records.extend(map(_record, zip(sensor_times, arrivals, *fields)))
 
     def _wake(self) -> None:
         """Wakes a consumer in `wait_records`: the reader appends without the lock (a deque's append
