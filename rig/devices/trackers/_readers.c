@@ -37,6 +37,9 @@
 /* The longest an LSL pull waits, so that the thread notices stop(): liblsl's wait cannot be woken. */
 #define LSL_PULL_TIMEOUT_S 0.05
 #define MOST_CHANNELS 64
+/* The threads' names, as top -H and /proc/PID/task/TID/comm show them (15 characters at most). */
+#define FD_THREAD_NAME "rig fd reader"
+#define LSL_THREAD_NAME "rig lsl reader"
 
 static PyObject *wait_read(PyObject *self, PyObject *args) {
     int fd, timeout_ms;
@@ -181,6 +184,7 @@ static void finish(Reader *r, enum outcome outcome, int error) {
 
 static void *read_loop(void *arg) {
     Reader *r = arg;
+    pthread_setname_np(pthread_self(), FD_THREAD_NAME);
     enum outcome outcome = RUNNING;
     int error = 0;
     char *buffer = malloc(MOST_BYTES);
@@ -222,6 +226,7 @@ static void *read_loop(void *arg) {
 /* Pulls samples until stop() or an error; a chunk queued is the sample's LSL stamp, then its values. */
 static void *pull_loop(void *arg) {
     Reader *r = arg;
+    pthread_setname_np(pthread_self(), LSL_THREAD_NAME);
     double sample[1 + MOST_CHANNELS];
     enum outcome outcome = RUNNING;
     int32_t error = 0;

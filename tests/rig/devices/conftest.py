@@ -1,11 +1,13 @@
-"""Shared by the tracker tests: an emulated tracker streaming on a thread of the test's process."""
+"""Shared by the tracker tests: an emulated tracker streaming on a thread of the test's process, and
+the compiled reader threads this process has."""
 
 from __future__ import annotations
 
 import csv
+import os
 import threading
 from contextlib import contextmanager
-from typing import Iterator
+from typing import Callable, Iterator
 
 import pytest
 
@@ -55,3 +57,22 @@ def emulated_tracker() -> Iterator:
     for tracker in started:
         tracker._thread.join(timeout=120)
         tracker.sink.close()
+
+
+@pytest.fixture
+def reader_threads() -> Callable[[str], set[str]]:
+    """reader_threads(name): the ids of this process's threads called `name` (the compiled readers
+    name theirs: "rig fd reader", "rig lsl reader"), so a test tells its own from others' (liblsl's)."""
+
+    def named(name: str) -> set[str]:
+        threads = set()
+        for tid in os.listdir("/proc/self/task"):
+            try:
+                with open(f"/proc/self/task/{tid}/comm") as comm:
+                    if comm.read().strip() == name:
+                        threads.add(tid)
+            except FileNotFoundError:  # a thread that ended meanwhile
+                pass
+        return threads
+
+    return named

@@ -10,7 +10,7 @@ import ctypes
 import os
 import time
 from itertools import count
-from typing import Any
+from typing import Any, Callable
 
 import pytest
 
@@ -81,13 +81,13 @@ def test_every_sample_pushed_is_pulled_once_in_order_stamped_on_the_rig_clock(ou
     assert reader.cpu_s > 0.0
 
 
-def test_a_dropped_reader_ends_its_thread(outlet: Any) -> None:
+def test_a_dropped_reader_ends_its_thread(outlet: Any, reader_threads: Callable[[str], set[str]]) -> None:
     inlet = _inlet(outlet)
-    threads = len(os.listdir("/proc/self/task"))
+    before = reader_threads("rig lsl reader")
     reader = _reader(inlet, MonotonicClock())
-    assert len(os.listdir("/proc/self/task")) == threads + 1
+    (started,) = reader_threads("rig lsl reader") - before
     del reader
-    assert len(os.listdir("/proc/self/task")) == threads
+    assert started not in reader_threads("rig lsl reader")
     outlet.push_sample(_samples(1)[0], 5.0)
     assert inlet.pull_sample(timeout=PATIENCE_S)[1] == pytest.approx(5.0), "nothing else pulls the inlet any more"
 

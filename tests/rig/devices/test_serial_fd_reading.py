@@ -16,7 +16,7 @@ import threading
 import time
 import tty
 from itertools import count
-from typing import Iterator
+from typing import Callable, Iterator
 
 import pytest
 
@@ -182,12 +182,12 @@ def test_stop_wakes_a_thread_waiting_for_data(pipe: Pipe) -> None:
     reader.stop()
 
 
-def test_a_dropped_reader_stops_reading_and_its_thread_ends(pipe: Pipe) -> None:
-    threads = len(os.listdir("/proc/self/task"))
+def test_a_dropped_reader_stops_reading_and_its_thread_ends(pipe: Pipe, reader_threads: Callable[[str], set[str]]) -> None:
+    before = reader_threads("rig fd reader")
     reader = FdReader(pipe.read_end, 0)
-    assert len(os.listdir("/proc/self/task")) == threads + 1
+    (started,) = reader_threads("rig fd reader") - before
     del reader
-    assert len(os.listdir("/proc/self/task")) == threads
+    assert started not in reader_threads("rig fd reader")
     os.write(pipe.write_end, b"after")
     assert os.read(pipe.read_end, 16) == b"after", "nothing reads the descriptor any more"
 
