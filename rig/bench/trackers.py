@@ -9,11 +9,13 @@ an LSL outlet, with the emulator's log of every record's fate) and records it in
 * missing: intact records sent that are not in tracker.csv; fabricated: rows that match no intact
   record sent (a damaged record let through); in_order: the rows' device times only increase;
 * corrupt: what the source counted as damaged, beside damaged_sent, what the emulator damaged;
-* us_per_sample: this process's CPU time over the run (the reader thread, liblsl's threads, the
+* us_per_sample: this process's CPU time over the run (the reader, liblsl's threads, the
   recording loop decoding and writing both files), per recorded sample; reading_us_per_sample:
-  what it takes to have the sample for a predictor (the reader thread's CPU, and the consumer's
-  decoding, checking and clock mapping), without the files; reader_us_per_sample: the reader
-  thread's alone (waiting, reading, stamping, queueing);
+  what it takes to have the sample for a predictor (the reader's CPU, and the consumer's
+  decoding, checking and clock mapping), without the files; reader_us_per_sample: the reader's
+  alone: its compiled thread (`rig.devices.trackers._readers`: waiting, reading, stamping,
+  queueing) and the stream's Python thread that supervises it and reconnects, which every case
+  here has (a pty, a TCP socket and an LSL inlet on the monotonic clock);
 * latency_ms_median, latency_ms_p95: from the emulator's write of a record to its arrival, when
   the reader has queued it and a predictor's `poll()` gets it, both on the monotonic clock.
 
@@ -21,8 +23,9 @@ Rows are keyed by the device's time (to the microsecond), which every emulated r
 
 The machine's share of the CPU figures is measured beside them, before each case (`wake_floor`,
 2 s): the CPU a bare Python thread spends per record reading the serial emulator's pty at the
-same rate (select, read, nothing else). Waking once per record costs that much whatever the
-reader does; on a shared virtual machine it varies from run to run.
+same rate (select, read, nothing else). The kernel's part of it (the wake-up, the poll and the
+read) is paid by any reader woken once per record, the compiled one too, which saves only the
+interpreter's part; on a shared virtual machine it varies from run to run.
 """
 
 from __future__ import annotations
