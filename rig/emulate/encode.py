@@ -8,6 +8,7 @@ fields are rounded and wrap at their width, as a device's counters do.
 from __future__ import annotations
 
 import struct
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,7 +58,11 @@ class RecordEncoder:
         values.update({name: v / radians for name, v in zip(RATE, emission.angular_rate)})
         if profile.euler:
             w, x, y, z = emission.orientation
-            angles = Rotation.from_quat([x, y, z, w]).as_euler(profile.euler)
+            with warnings.catch_warnings():
+                # At gimbal lock (the middle angle at +-90 degrees) scipy warns and sets the third
+                # angle to zero; the three it gives still make the same rotation, as a device sends it.
+                warnings.filterwarnings("ignore", "Gimbal lock detected", UserWarning)
+                angles = Rotation.from_quat([x, y, z, w]).as_euler(profile.euler)
             values.update({name: float(a) / radians for name, a in zip(EULER, angles)})
         return values
 
