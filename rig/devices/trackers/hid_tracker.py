@@ -16,7 +16,8 @@ from rig.devices.trackers.clock_mapping import mapping_for
 from rig.devices.trackers.decoders import HidReportDecoder
 from rig.devices.trackers.profile import Profile, load_profile
 from rig.devices.trackers.readings import Reading
-from rig.devices.trackers.stream import LinkLost, TrackerStream
+from rig.devices.trackers.link import LinkLost
+from rig.devices.trackers.stream import TrackerStream
 from rig.errors import ConfigError, RigError
 
 DEFAULT_PROFILE = "hid-quat16"

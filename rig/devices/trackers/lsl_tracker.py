@@ -22,7 +22,8 @@ from rig.clock import Clock, MonotonicClock
 from rig.devices.trackers.clock_mapping import CorrectedMapping
 from rig.devices.trackers.profile import DEFAULT_UNIT_TOLERANCE
 from rig.devices.trackers.readings import Reading
-from rig.devices.trackers.stream import LinkLost, TrackerStream
+from rig.devices.trackers.link import LinkLost
+from rig.devices.trackers.stream import TrackerStream
 from rig.errors import ConfigError, RigError
 
 try:

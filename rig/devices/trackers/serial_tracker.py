@@ -25,7 +25,8 @@ from rig.devices.trackers.clock_mapping import mapping_for
 from rig.devices.trackers.decoders import BinaryDecoder, TextDecoder, decoder_for
 from rig.devices.trackers.profile import Profile, load_profile
 from rig.devices.trackers.readings import Reading
-from rig.devices.trackers.stream import LinkLost, TrackerStream
+from rig.devices.trackers.link import LinkLost
+from rig.devices.trackers.stream import TrackerStream
 from rig.errors import ConfigError, RigError
 
 try:
