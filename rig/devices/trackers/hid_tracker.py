@@ -86,6 +86,9 @@ class HidLink:
         """None: hidapi's device is read through its Python binding, on the stream's thread."""
         return None
 
+    def upkeep(self, clock: Clock) -> None:
+        """Nothing: the device's clock is mapped from its records alone."""
+
     def receive(self, clock: Clock) -> bytes | None:
         device = self._device
         if device is None:

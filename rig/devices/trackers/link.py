@@ -54,6 +54,11 @@ class Link(Protocol):
         """A compiled reader of the opened device, stamping on `clock`, or None where there is none
         (then the stream's thread reads with `receive`)."""
 
+    def upkeep(self, clock: Clock) -> None:
+        """Work beside the reading, on the reading side and never on the consumer's thread (it may
+        wait on the network): an LSL inlet measures its clock offset. The stream's supervisor calls
+        it every UPKEEP_INTERVAL_S while a compiled reader reads; a Python `receive` does its own."""
+
     def receive(self, clock: Clock) -> Any:
         """What arrived (None if nothing did in time); raises LinkLost when the device went away."""
 

@@ -4,8 +4,9 @@ qy, qz), each sample stamped on the sender's LSL clock.
 
 The sender's stamps are mapped onto the rig clock with liblsl's own clock offset, measured by round
 trips (`lsl_time_correction_ex`, which gives the offset's uncertainty beside it; pylsl exposes only
-the offset) and refreshed every CORRECTION_INTERVAL_S by the consumer that decodes the samples, so
-the tracker's latency to the host is known. On the system's monotonic clock the inlet is pulled by
+the offset) and refreshed every CORRECTION_INTERVAL_S on the reading side (the stream's thread,
+never the consumer's: liblsl's answer can wait on the network, and the consumer may be a render
+loop), so the tracker's latency to the host is known. On the system's monotonic clock the inlet is pulled by
 a compiled thread (`_readers.LslReader`, calling liblsl's `lsl_pull_sample_d` as pylsl loaded it);
 elsewhere by the stream's Python thread. The inlet recovers a sender that restarts (same source
 id) by itself. pylsl is imported only when an LSL stream is used or listed, and liblsl's own
@@ -15,6 +16,7 @@ console log is kept to fatal errors: the rig logs what happens to the link itsel
 from __future__ import annotations
 
 import ctypes
+from collections import deque
 from types import ModuleType
 from typing import Any
 
@@ -121,8 +123,9 @@ class LslLink:
         self._inlet: Any = None
         self._puller: SamplePuller | None = None
         self._next_correction = 0.0
-        self._correction: tuple[float, float, float] | None = None
-        """The correction measured at open, for the consumer to hand the mapping with the first samples."""
+        self._corrections: deque[tuple[float, float, float]] = deque()
+        """Corrections measured on the reading side, (offset, uncertainty, rig time), for the consumer
+        to hand the mapping with the samples, on the thread that maps them."""
 
     def open(self, clock: Clock) -> None:
         lsl = pylsl()
@@ -145,8 +148,7 @@ class LslLink:
             raise RigError(f"LSL stream {self.name!r} did not answer: {error}") from None
         if self.mapping.origin_s is None:
             self.mapping.origin_s = lsl_origin(clock)
-        # Handed to the mapping with the first samples, on the thread that maps them.
-        self._correction = (correction, uncertainty, clock.now())
+        self._corrections.append((correction, uncertainty, clock.now()))
         self._next_correction = clock.now() + CORRECTION_INTERVAL_S
         self._puller = SamplePuller(inlet, READ_TIMEOUT_S)
         self._inlet = inlet
@@ -167,6 +169,7 @@ class LslLink:
         inlet, puller = self._inlet, self._puller
         if inlet is None or puller is None:
             raise LinkLost("the inlet is closed")
+        self.upkeep(clock)
         try:
             pulled = puller.pull()
             if pulled is None:
@@ -180,28 +183,27 @@ class LslLink:
         return [first, *rest], [stamp, *stamps]
 
     def decode(self, chunks: list[tuple[list, list]], arrivals: list[float]) -> list[Reading]:
-        """The chunks' samples; first the clock corrections due, measured on this (the consumer's)
-        thread at the last arrival, while the reader goes on pulling."""
-        self._correct(arrivals[-1])
+        """The chunks' samples; first the clock corrections measured since the last call go to the
+        mapping, on this (the consumer's) thread."""
+        corrections, add = self._corrections, self.mapping.add_correction
+        while corrections:
+            add(*corrections.popleft())
         readings = []
         for (samples, stamps), t_arrival in zip(chunks, arrivals):
             for (px, py, pz, qw, qx, qy, qz), device_time in zip(samples, stamps):
                 readings.append(Reading(t_arrival, device_time, None, (px, py, pz), (qw, qx, qy, qz)))
         return readings
 
-    def _correct(self, now: float) -> None:
-        """Hands the mapping the correction measured at open, and a fresh one every
-        CORRECTION_INTERVAL_S (liblsl's latest, without waiting for it)."""
-        correction, self._correction = self._correction, None
-        if correction is not None:
-            self.mapping.add_correction(*correction)
-        inlet = self._inlet
+    def upkeep(self, clock: Clock) -> None:
+        """A fresh clock correction every CORRECTION_INTERVAL_S (liblsl's latest, without asking it to
+        wait), queued for the consumer."""
+        inlet, now = self._inlet, clock.now()
         if inlet is None or now < self._next_correction:
             return
         self._next_correction = now + CORRECTION_INTERVAL_S
         lsl = pylsl()
         try:
-            self.mapping.add_correction(*time_correction(inlet, 0.0), now)
+            self._corrections.append((*time_correction(inlet, 0.0), now))
         except (lsl.util.TimeoutError, lsl.util.LostError):
             pass  # no fresh estimate yet (liblsl measures in the background), or the sender is gone: the mapping keeps the last
 

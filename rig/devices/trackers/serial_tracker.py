@@ -156,6 +156,9 @@ class SerialLink:
             return None
         return FdReader(self._fd, clock.origin_ns)
 
+    def upkeep(self, clock: Clock) -> None:
+        """Nothing: the device's clock is mapped from its records alone."""
+
     def receive(self, clock: Clock) -> bytes | None:
         port = self._port
         if port is None:

@@ -46,6 +46,8 @@ RECONNECT_LONGEST_WAIT_S = 0.5
 LOGGED_REJECTIONS = 5
 # A silence this long between samples is logged as a gap (a stall, a sender that went away).
 GAP_S = 0.25
+# How often the supervisor of a compiled reader lets the link do its upkeep (`Link.upkeep`).
+UPKEEP_INTERVAL_S = 0.25
 
 
 _RESTORED = object()
@@ -286,10 +288,11 @@ class TrackerStream:
         return None
 
     def _supervise(self, native: NativeReader) -> str | None:
-        """Sleeps (in C, the GIL released) until the compiled reader ends and queues it, for the
-        consumer to take what it read last; what happened to the link, or None if the stream was
-        closed."""
-        native.wait_ended()
+        """Sleeps (in C, the GIL released) until the compiled reader ends, waking for the link's
+        upkeep, and queues the reader for the consumer to take what it read last; what happened to
+        the link, or None if the stream was closed."""
+        while not native.wait_ended(UPKEEP_INTERVAL_S):
+            self.link.upkeep(self._clock)  # type: ignore[arg-type]
         self.reader_cpu_s += native.cpu_s
         self._chunks.append(native)
         self._wake()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import ctypes
 import os
+import threading
 import time
 from itertools import count
 from typing import Any, Callable
@@ -15,6 +16,8 @@ from typing import Any, Callable
 import pytest
 
 from rig.clock import MonotonicClock
+from rig.devices.trackers import lsl_tracker as lsl_tracker_module
+from rig.devices.trackers import stream as stream_module
 from rig.devices.trackers._readers import LslReader
 from rig.devices.trackers.lsl_tracker import CHANNELS, OPEN_TIMEOUT_S, RESOLVE_TIMEOUT_S, LslLink, lsl_tracker, pylsl
 
@@ -128,3 +131,37 @@ def test_a_stream_reads_every_sample_on_either_path(outlet: Any, clock_kind: str
     assert [list(r.position) for r in records] == [values[:3] for values in sent]
     assert [r.device_time for r in records] == pytest.approx([200.0 + k * 1e-3 for k in range(len(sent))], abs=1e-9)
     assert tracker.report()["counters"]["received"] == len(sent)
+
+
+@pytest.mark.parametrize("clock_kind", ["system", "own"])
+def test_clock_corrections_are_measured_on_the_reading_side_never_by_the_consumer(
+    outlet: Any, clock_kind: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """liblsl's time correction can wait on the network: the consumer (a render loop) only hands the
+    mapping what the stream's thread measured."""
+    monkeypatch.setattr(lsl_tracker_module, "CORRECTION_INTERVAL_S", 0.02)
+    monkeypatch.setattr(stream_module, "UPKEEP_INTERVAL_S", 0.01)
+    measured_on: list[int] = []
+    measure = lsl_tracker_module.time_correction
+
+    def spy(inlet: Any, timeout_s: float) -> tuple[float, float]:
+        measured_on.append(threading.get_ident())
+        return measure(inlet, timeout_s)
+
+    monkeypatch.setattr(lsl_tracker_module, "time_correction", spy)
+    clock = MonotonicClock() if clock_kind == "system" else MonotonicClock(read_ns=lambda: time.monotonic_ns())
+    tracker = lsl_tracker(outlet.get_info().name())
+    tracker.connect(clock)
+    measured_on.clear()  # the first is measured by connect(), before any reading
+    added = []
+    mapping_add = tracker.mapping.add_correction
+    monkeypatch.setattr(tracker.mapping, "add_correction", lambda *args, **kwargs: (added.append(args), mapping_add(*args, **kwargs)))
+    deadline = time.monotonic() + PATIENCE_S
+    k = 0
+    while (len(added) < 2 or not measured_on) and time.monotonic() < deadline:
+        outlet.push_sample(_samples(1)[0], 300.0 + k * 1e-3)
+        k += 1
+        tracker.wait_records(0.01)
+    tracker.close()
+    assert measured_on and threading.get_ident() not in measured_on
+    assert len(added) >= 2, "the consumer handed the mapping no fresh correction"
