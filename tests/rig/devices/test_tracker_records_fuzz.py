@@ -47,7 +47,7 @@ emission = st.builds(
 )
 
 
-def _decodes_to_what_was_sent(name: str, sent: Emission) -> None:
+def _assert_decodes_to_what_was_sent(name: str, sent: Emission) -> None:
     profile = load_profile(name)
     readings = decoder_for(profile).feed(RecordEncoder(profile).encode(sent), 1.0)
     assert len(readings) == 1
@@ -62,11 +62,11 @@ def _decodes_to_what_was_sent(name: str, sent: Emission) -> None:
 @settings(max_examples=40)
 @given(sent=emission)
 def test_an_encoded_record_decodes_to_what_was_sent(name: str, sent: Emission) -> None:
-    _decodes_to_what_was_sent(name, sent)
+    _assert_decodes_to_what_was_sent(name, sent)
 
 
 @pytest.mark.parametrize("sign", [1.0, -1.0])
 def test_a_polhemus_record_at_gimbal_lock_decodes_to_the_orientation_sent(sign: float) -> None:
     """Elevation at +-90 degrees: the Euler angles are not unique, the rotation they make is."""
     half = math.sqrt(0.5)
-    _decodes_to_what_was_sent("polhemus-ascii", Emission(0, 0.0, (0.0, 0.0, 0.0), (half, 0.0, sign * half, 0.0)))
+    _assert_decodes_to_what_was_sent("polhemus-ascii", Emission(0, 0.0, (0.0, 0.0, 0.0), (half, 0.0, sign * half, 0.0)))
