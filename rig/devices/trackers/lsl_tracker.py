@@ -6,9 +6,9 @@ The sender's stamps are mapped onto the rig clock with liblsl's own clock offset
 trips (`lsl_time_correction_ex`, which gives the offset's uncertainty beside it; pylsl exposes only
 the offset) and refreshed every CORRECTION_INTERVAL_S on the reading side (the stream's thread,
 never the consumer's: liblsl's answer can wait on the network, and the consumer may be a render
-loop), so the tracker's latency to the host is known. On the system's monotonic clock the inlet is pulled by
-a compiled thread (`_readers.LslReader`, calling liblsl's `lsl_pull_sample_d` as pylsl loaded it);
-elsewhere by the stream's Python thread. The inlet recovers a sender that restarts (same source
+loop), so the tracker's latency to the host is known. On the system's monotonic clock the inlet
+is pulled by a compiled thread (`_readers.LslReader`, calling liblsl's `lsl_pull_sample_d` as
+pylsl loaded it); elsewhere by the stream's Python thread. The inlet recovers a sender that restarts (same source
 id) by itself. pylsl is imported only when an LSL stream is used or listed, and liblsl's own
 console log is kept to fatal errors: the rig logs what happens to the link itself.
 """

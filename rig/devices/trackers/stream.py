@@ -9,11 +9,10 @@ slower than the same code run over a batch. Where the link has a compiled reader
 monotonic clock), that thread is in C and never wakes the interpreter; the stream's own thread only
 supervises it, asleep in C until it ends, and reopens the link when it does. Elsewhere (a port
 without a descriptor, HID, a test's clock) the stream's thread is the reader, in Python, calling
-`Link.receive`. The
-consumer's `poll()` (the session's render loop, or `rig record-tracker`), which never blocks, or
-`wait(timeout)`, takes every queued chunk and decodes them together: each record is checked and
-what was wrong counted, in arrival order, then the device times of all it took are mapped onto the
-rig clock in one call. A record is available to a predictor from its arrival time, when the reader
+`Link.receive`. The consumer's `poll()` (the session's render loop, or `rig record-tracker`), which
+never blocks, or `wait(timeout)`, takes every queued chunk and decodes them together: each record
+is checked and what was wrong counted, in arrival order, then the device times of all it took are
+mapped onto the rig clock in one call. A record is available to a predictor from its arrival time, when the reader
 queued the chunk that completed it. A lost link is logged, leaves a gap, and is reopened until the
 stream is closed; everything that happened is in `report()`. One thread consumes a stream.
 """

@@ -20,7 +20,7 @@ def result(small_runs):
     return analyse(AnalysisRequest(small_runs["fast"])).result
 
 
-def _legend_clear_of_data(figure) -> None:
+def _assert_legend_clear_of_data(figure) -> None:
     """Every axis is labelled, and every legend lies outside its axes (so it covers no data)."""
     FigureCanvasAgg(figure).draw()
     renderer = figure.canvas.get_renderer()
@@ -36,7 +36,7 @@ def _legend_clear_of_data(figure) -> None:
 
 def test_run_figures_label_their_axes_and_keep_legends_off_the_data(result) -> None:
     for make in (tracks_figure, latency_over_time_figure, residuals_figure):
-        _legend_clear_of_data(make(result))
+        _assert_legend_clear_of_data(make(result))
 
 
 def test_the_tracks_show_the_whole_film(result) -> None:
@@ -68,7 +68,7 @@ def test_a_summary_report_compares_the_runs(small_runs, tmp_path: Path) -> None:
              "frequency_hz": frequency, "system": n} for n, value, frequency in (("fast", 40.0, 1.4), ("slow", 42.0, 0.8))]  # fmt: skip
     figure = summary_figure(rows, "system")
     assert len(figure.axes) == 2
-    _legend_clear_of_data(figure)
+    _assert_legend_clear_of_data(figure)
 
 
 def test_a_group_whose_first_video_failed_keeps_its_legend_entry_and_an_all_failed_batch_has_none() -> None:
