@@ -7,6 +7,10 @@ LATENCY_PERIOD_FRACTION of it (the analyser resolves latency only modulo a perio
 would need a period over the run's limit is reported as beyond range. The spread reported is the
 analyser's: the standard deviation of the latency measured swing by swing (as the seeds' Table 2
 gives the spread over repeated measurements); the truth's per-display-frame delay spread is beside it.
+
+A film is a sweep's point (`rig.service.sweep`), analysed within the regions the simulation put the
+LED and the sphere in: `film_latencies` films many as one sweep, written out as FILMS_SPEC so that
+`rig sweep` films them again, `film_latency` one at a time.
 """
 
 from __future__ import annotations
@@ -14,12 +18,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
-import analysis
-from analysis import AnalysisError
-from rig.service import SimulationConfig, simulate
+from rig.service.analyse import AnalysisRequest
+from rig.service.sweep import SIMULATED_ROIS, PointRun, Sweep, SweepPoint, run_sweep, settings_of, simulate_and_analyse, write_sweep
 from rig.sim.camera import CameraConfig
+from rig.sim.config import SimulationConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
 
@@ -32,6 +36,8 @@ LATENCY_PERIODS = 3.0
 """Swing periods filmed at least (the analyser needs two)."""
 BASE_LATENCY_S = 0.1
 """Transport, sampling, scan-out and hold, added to a renderer's own delays in the expected latency."""
+FILMS_SPEC = "films.toml"
+"""The sweep of a bench's films, written beside their runs (`film_latencies`)."""
 
 
 @dataclass(frozen=True)
@@ -56,13 +62,16 @@ class LatencyRun:
 
     @property
     def composes(self) -> bool:
-        return not self.renderer.startswith("direct")
+        return composes(self.renderer)
 
-    @property
-    def cost_source(self) -> str:
-        """Where the cost that sets the latency comes from: a direct renderer's application frame,
-        a compositing renderer's composed image."""
-        return "measured" if (self.server_ms if self.composes else self.app_frame_ms) is None else "modelled"
+
+def composes(renderer: str) -> bool:
+    """Whether a renderer spec composes images at refreshes (a warp) rather than drawing each frame (direct)."""
+    return not renderer.startswith("direct")
+
+
+Film = tuple[dict[str, Any], LatencyRun, float, float]
+"""A film to make: its labels, its run, and the application frame's and the server's expected costs (s)."""
 
 
 def expected_latency_s(run: LatencyRun, app_frame_s: float, server_s: float) -> float:
@@ -74,25 +83,18 @@ def expected_latency_s(run: LatencyRun, app_frame_s: float, server_s: float) -> 
     return (math.ceil(server_s / refresh_s) + 1) * refresh_s + BASE_LATENCY_S
 
 
-def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: Path) -> dict[str, Any]:
-    """Simulate `run` (with `app_frame_s` and `server_s` the costs expected, for the period), film it,
-    analyse the video; its figures. Latencies are None when the expected one needs too long a period
-    or the analyser fails, and the note says why."""
+def _period_s(run: LatencyRun, app_frame_s: float, server_s: float) -> tuple[float, float]:
+    """The expected latency (s) and the pendulum period that keeps it within LATENCY_PERIOD_FRACTION."""
     expected_s = expected_latency_s(run, app_frame_s, server_s)
-    period = max(PendulumConfig().period_s, expected_s / LATENCY_PERIOD_FRACTION)
-    figures: dict[str, Any] = {"renderer": run.renderer, "triangles": run.triangles, "width": run.size[0], "height": run.size[1],
-                               "predictor": run.predictor, "photon_target": run.photon_target, "cost_source": run.cost_source,
-                               "latency_measured_ms": None, "latency_true_ms": None, "latency_sd_ms": None,
-                               "frame_delay_sd_ms": None, "frame_ms_median": None, "missed_pct": None, "latency_period_s": None}  # fmt: skip
-    if period > run.max_period_s:
-        note = f"beyond range: about {expected_s:.1f} s expected, which needs a pendulum period over {run.max_period_s:g} s"
-        return {**figures, "latency_note": note}
+    return expected_s, max(PendulumConfig().period_s, expected_s / LATENCY_PERIOD_FRACTION)
+
+
+def run_config(run: LatencyRun) -> SimulationConfig:
+    """What `run` is, as a simulation: renderer, load, display, predictor, photon target and costs
+    (how it is filmed is `film_config`'s)."""
     width, height = run.size
-    config = SimulationConfig(
-        duration_s=max(run.min_duration_s, LATENCY_PERIODS * period),
-        pendulum=PendulumConfig(period_s=period),
+    return SimulationConfig(
         display=DisplayConfig(refresh_hz=run.refresh_hz, width=width, height=height),
-        camera=replace(run.camera, fps=min(240.0, max(MIN_CAMERA_FPS, CAMERA_FRAMES_PER_PERIOD / period))),
         renderer=run.renderer,
         predictor=run.predictor,
         predictor_params=dict(run.predictor_params),
@@ -101,32 +103,112 @@ def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: 
         app_frame_ms=run.app_frame_ms,
         warp_ms=run.server_ms,
         photon_target=run.photon_target,
+    )
+
+
+def film_config(run: LatencyRun, app_frame_s: float, server_s: float) -> SimulationConfig:
+    """The simulation that films `run`, with `app_frame_s` and `server_s` the costs expected (s):
+    they set the pendulum's period, the film's length and frame rate, and the warm-up."""
+    _, period = _period_s(run, app_frame_s, server_s)
+    return replace(
+        run_config(run),
+        duration_s=max(run.min_duration_s, LATENCY_PERIODS * period),
+        pendulum=PendulumConfig(period_s=period),
+        camera=replace(run.camera, fps=min(240.0, max(MIN_CAMERA_FPS, CAMERA_FRAMES_PER_PERIOD / period))),
         # the first frame must be on show when filming starts; and the truth's latency search looks
         # up to about a period back, which the session's pendulum covers only within its warm-up
         warmup_s=max(app_frame_s + 0.5, period),
     )
-    result = simulate(config, out_dir, overwrite=True)
-    truth = result.truth
+
+
+def _no_figures(config: SimulationConfig) -> dict[str, Any]:
+    """A run's figures with nothing filmed: what it is, every latency None."""
+    cost = config.warp_ms if composes(config.renderer) else config.app_frame_ms
+    return {"renderer": config.renderer, "triangles": config.scene_triangles, "width": config.display.width,
+            "height": config.display.height, "predictor": config.predictor, "photon_target": config.photon_target,
+            "cost_source": "measured" if cost is None else "modelled",
+            "latency_measured_ms": None, "latency_true_ms": None, "latency_sd_ms": None,
+            "frame_delay_sd_ms": None, "frame_ms_median": None, "missed_pct": None, "latency_period_s": None}  # fmt: skip
+
+
+def beyond_range_figures(run: LatencyRun, app_frame_s: float, server_s: float) -> dict[str, Any] | None:
+    """The figures of a run that cannot be filmed with these costs expected (its period would be
+    over the run's limit), the note saying why; None when it can be."""
+    expected_s, period = _period_s(run, app_frame_s, server_s)
+    if period <= run.max_period_s:
+        return None
+    note = f"beyond range: about {expected_s:.1f} s expected, which needs a pendulum period over {run.max_period_s:g} s"
+    return {**_no_figures(run_config(run)), "latency_note": note}
+
+
+def film_figures(filmed: PointRun) -> dict[str, Any]:
+    """A filmed run's figures: its costs, missed refreshes and frame delay spread from the truth,
+    the latency measured and its spread swing by swing from the analysis, and a note of the run."""
+    config, truth, row = filmed.simulation.truth.config, filmed.simulation.truth, filmed.row
     frame_cost = truth.display_frame_cost if truth.display_frame_cost is not None else truth.app_frame_cost
-    figures.update(
-        latency_true_ms=truth.latency_ms,
-        frame_delay_sd_ms=truth.display_frame_delay_ms.sd,
-        frame_ms_median=frame_cost.get("median_ms", frame_cost.get("ms")),
-        missed_pct=100.0 * truth.refreshes.missed / max(truth.refreshes.shown, 1),
-        latency_period_s=period,
-    )
-    note = f"{result.cost_line()}; simulated at {width}x{height}, predictor {run.predictor}, target {run.photon_target}"
-    try:
-        # the ROIs of the simulated bench, as a lab marks them once for its camera
-        measured = analysis.analyse(result.video_path, led_roi=truth.led_roi, sphere_roi=truth.sphere_roi)
-    except AnalysisError as error:
-        return {**figures, "latency_note": f"{note}; the analyser failed: {error}"}
-    if measured.ambiguous:
+    figures = _no_figures(config) | {
+        "latency_true_ms": truth.latency_ms,
+        "frame_delay_sd_ms": truth.display_frame_delay_ms.sd,
+        "frame_ms_median": frame_cost.get("median_ms", frame_cost.get("ms")),
+        "missed_pct": 100.0 * truth.refreshes.missed / max(truth.refreshes.shown, 1),
+        "latency_period_s": config.pendulum.period_s,
+    }
+    note = (f"{filmed.simulation.cost_line()}; simulated at {config.display.width}x{config.display.height}, "
+            f"predictor {config.predictor}, target {config.photon_target}")  # fmt: skip
+    if filmed.result is None:
+        return {**figures, "latency_note": f"{note}; the analyser failed: {row['error']}"}
+    if filmed.result.ambiguous:
         note += "; AMBIGUOUS (near half a period)"
-    windowed = measured.windowed
+    windowed = filmed.result.windowed
     return {
         **figures,
-        "latency_measured_ms": measured.latency_ms,
+        "latency_measured_ms": filmed.result.latency_ms,
         "latency_sd_ms": windowed.sd_s * 1e3 if windowed is not None and windowed.count > 1 else None,
         "latency_note": note,
     }
+
+
+def film_row(point: SweepPoint) -> dict[str, Any]:
+    """A sweep job: the point's summary row (simulated, then analysed within the simulation's
+    regions, as a lab marks them once for its camera), with its film's figures under "film"."""
+    filmed = simulate_and_analyse(point)
+    return filmed.row | {"film": film_figures(filmed)}
+
+
+def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: Path) -> dict[str, Any]:
+    """Simulate `run` (with `app_frame_s` and `server_s` the costs expected, for the period), film it,
+    analyse the video; its figures. Latencies are None when the expected one needs too long a period
+    or the analyser fails, and the note says why."""
+    unfilmed = beyond_range_figures(run, app_frame_s, server_s)
+    if unfilmed is not None:
+        return unfilmed
+    point = SweepPoint(0, film_config(run, app_frame_s, server_s), {}, out_dir, AnalysisRequest(out_dir / "video.avi"), simulated_rois=True)
+    return film_figures(simulate_and_analyse(point))
+
+
+def film_latencies(
+    films: list[Film],
+    runs_dir: Path,
+    comment: str,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: Callable[[float, float], object] | None = None,
+) -> list[dict[str, Any]]:
+    """Each film's figures, in order. A film beyond range is not filmed (its note says why); the
+    others are a sweep of explicit points with their labels, analysed within the simulation's
+    regions, written to runs_dir/FILMS_SPEC under `comment` and run by `rig.service.sweep` with
+    `film_row` into runs_dir (pointNNN, summary.csv and .json; on `rig.executor`'s workers when
+    asked), so that `rig sweep` on that file films exactly them again."""
+    figures = [beyond_range_figures(run, app_s, server_s) for _, run, app_s, server_s in films]
+    points = [
+        {"labels": labels, **settings_of(film_config(run, app_s, server_s))}
+        for (labels, run, app_s, server_s), unfilmed in zip(films, figures)
+        if unfilmed is None
+    ]
+    if not points:
+        return figures
+    sweep = Sweep({}, {}, {SIMULATED_ROIS: True}, points)
+    write_sweep(sweep, runs_dir / FILMS_SPEC, comment)
+    rows, _ = run_sweep(sweep, runs_dir, workers, scheduler, progress, overwrite=True, job=film_row)
+    filmed = iter(row["film"] for row in rows)
+    return [next(filmed) if unfilmed is None else unfilmed for unfilmed in figures]

@@ -19,7 +19,12 @@ shared with other work, wall times carry their load, CPU times hardly.
 Latency, at the first resolution: the rig is simulated, filmed and analysed
 (`rig.bench.renderer_latency`), its costs measured on the virtual clock as they happen (a frame
 that takes longer than a refresh misses refreshes), or the server's modelled where the grid says
-(`server_ms`, labelled). `rig.bench.seed_table` and `rig.bench.warp_variants` build on these parts.
+(`server_ms`, labelled). Once the timings have given each film its expected costs, the films are
+a sweep (`rig.service.sweep`) of explicit points, written beside the runs as films.toml, so that
+`rig sweep films.toml --out DIR` films exactly those again.
+
+The grid is data: `specs/renderers.toml` (the default) and `specs/renderers-quick.toml` (`--quick`),
+read by `read_grid`. `rig.bench.seed_table` and `rig.bench.warp_variants` build on these parts.
 """
 
 from __future__ import annotations
@@ -34,9 +39,9 @@ from typing import Any, Callable
 import numpy as np
 
 from predictors import Pose
-from rig.bench.renderer_latency import LatencyRun, film_latency
+from rig.bench.renderer_latency import LatencyRun, film_latencies
+from rig.bench.spec_reader import read_spec
 from rig.errors import ConfigError
-from rig.executor import executor
 from rig.render import gl, make_renderer
 from rig.render.direct import DirectRenderer
 from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
@@ -48,6 +53,9 @@ from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+SPECS = Path(__file__).parent / "specs"
+SPEC = SPECS / "renderers.toml"
+QUICK_SPEC = SPECS / "renderers-quick.toml"
 
 ROW_FIELDS = (
     "renderer", "spec", "reconstruction", "views", "triangles", "width", "height", "rate_ratio",
@@ -88,6 +96,18 @@ class BenchGrid:
     refresh_hz: float = 60.0
     server_ms: float | None = None
     """the warp server's modelled cost in the latency runs (ms), None: measured"""
+    predictor: str = "hold"
+    """the latency runs' predictor, both renderers alike (as the seeds' Table 2)"""
+    direct_predictor: str | None = None
+    """the direct renderer's predictor in the latency runs, where it differs"""
+
+    def __post_init__(self) -> None:
+        if not (self.triangles and self.resolutions and self.ratios):
+            raise ConfigError("a renderer bench grid needs at least one load size, resolution and rate ratio")
+        if min(self.ratios) < 1 or min(self.triangles) < 0:
+            raise ConfigError("rate ratios are display frames per client frame, at least 1; load sizes are at least 0")
+        if min(min(size) for size in self.resolutions) < 16:
+            raise ConfigError(f"a display is at least 16x16 pixels, got {self.resolutions}")
 
     def latency_run(
         self, renderer: str, triangles: int, predictor: str, photon_target: str = "photons", load: str = "soup"
@@ -101,19 +121,10 @@ class BenchGrid:
         )  # fmt: skip
 
 
-QUICK_GRID = BenchGrid(
-    triangles=(1_000, 8_000),
-    resolutions=((160, 120),),
-    ratios=(1, 3),
-    phases=1,
-    warp_rounds=3,
-    direct_frames=3,
-    direct_budget_s=1.0,
-    latency_triangles=(1_000,),
-    latency_camera=CameraConfig(width=320, height=240, subsamples=4),
-    latency_duration_s=2.5,
-    max_period_s=4.0,
-)
+def read_grid(path: Path) -> BenchGrid:
+    """A grid from its TOML spec (`rig.bench.spec_reader`: every key and type checked)."""
+    return read_spec(BenchGrid, path)
+
 
 Log = Callable[[str], None]
 
@@ -266,21 +277,10 @@ def warp_row(base: dict[str, Any], m: WarpMeasurement, triangles: int, size: tup
     }  # fmt: skip
 
 
-def _film_latency(job: tuple[LatencyRun, float, float, Path]) -> dict[str, Any]:
-    return film_latency(*job)
-
-
-def run_bench(
-    grid: BenchGrid,
-    predictors: dict[str, str],
-    runs_dir: Path,
-    log: Log,
-    workers: int | None = None,
-    scheduler: str | None = None,
-) -> list[dict[str, Any]]:
-    """Every row of the benchmark (see the module docstring); `predictors` names each renderer's
-    predictor in the latency runs ("direct", "warp"). The timings run here, one at a time; the
-    latency films (simulate, then analyse) on `rig.executor`'s workers when asked."""
+def run_bench(grid: BenchGrid, runs_dir: Path, log: Log, workers: int | None = None, scheduler: str | None = None) -> list[dict[str, Any]]:
+    """Every row of the benchmark (see the module docstring). The timings run here, one at a time;
+    the latency films (simulate, then analyse: a sweep into `runs_dir`) on `rig.executor`'s workers
+    when asked."""
     machine = machine_name()
     log(f"machine: {machine}")
     rows: list[dict[str, Any]] = []
@@ -318,19 +318,25 @@ def run_bench(
             if ("warp", triangles) in expected and resolution_index == 0:
                 expected["warp", triangles] = (expected["warp", triangles][0], float(np.median(m.wall_s)))
             rows += [warp_row(base, m, triangles, (width, height), ratio) for ratio in grid.ratios]
-    films = list(expected.items())
-    jobs = [
-        (grid.latency_run(grid.warp if renderer == "warp" else renderer, triangles, predictors[renderer]), app_s, server_s,
-         runs_dir / f"{renderer}-{triangles}")
-        for (renderer, triangles), (app_s, server_s) in films
+    predictors = {"direct": grid.direct_predictor or grid.predictor, "warp": grid.predictor}
+    films = [
+        ({"renderer": renderer, "triangles": triangles},
+         grid.latency_run(grid.warp if renderer == "warp" else renderer, triangles, predictors[renderer]), app_s, server_s)
+        for (renderer, triangles), (app_s, server_s) in expected.items()
     ]  # fmt: skip
-    with executor(workers, scheduler) as run:
-        for index, figures in run(_film_latency, jobs):
-            (renderer, triangles), _ = films[index]
-            measured = figures["latency_measured_ms"]
-            shown = f"{measured:.1f} ms measured, {figures['latency_true_ms']:.1f} ms true" if measured is not None else figures["latency_note"]
-            log(f"latency {renderer:6} {triangles:>9} triangles: {shown}")
-            for row in rows:
-                if (row["renderer"], row["triangles"], (row["width"], row["height"])) == (renderer, triangles, grid.resolutions[0]):
-                    row.update({name: figures[name] for name in LATENCY_FIELDS})
+    comment = (f"The latency films of `rig bench renderers`, timed on {machine}.\n"
+               "One renderer on one load each; the pendulum's period, the film's length and the camera's rate\n"
+               "were chosen from the costs the timings measured. `rig sweep films.toml --out DIR` films them\n"
+               "again, every cost measured again on the machine that runs it.")  # fmt: skip
+
+    def progress(done: float, total: float) -> None:
+        log(f"[{done}/{total} latency films]")
+
+    for (labels, *_), figures in zip(films, film_latencies(films, runs_dir, comment, workers, scheduler, progress)):
+        measured = figures["latency_measured_ms"]
+        shown = f"{measured:.1f} ms measured, {figures['latency_true_ms']:.1f} ms true" if measured is not None else figures["latency_note"]
+        log(f"latency {labels['renderer']:6} {labels['triangles']:>9} triangles: {shown}")
+        for row in rows:
+            if (row["renderer"], row["triangles"], (row["width"], row["height"])) == (labels["renderer"], labels["triangles"], grid.resolutions[0]):
+                row.update({name: figures[name] for name in LATENCY_FIELDS})
     return rows

@@ -22,11 +22,12 @@ import numpy as np
 from rig.bench.renderer_latency import film_latency
 from rig.bench.renderers import (
     QUALITY_FIGURES,
-    QUICK_GRID,
+    QUICK_SPEC,
     BenchGrid,
     machine_name,
     measure_warp_quality,
     open_warp,
+    read_grid,
     scene_setup,
     time_direct,
     time_warp_rounds,
@@ -55,7 +56,9 @@ class VariantSpec:
     predictor: str = "hold"
 
 
-QUICK_SPEC = VariantSpec(triangles=(1_000,), variants=("warp", "warp:views=2,recon=grid,holes=1"), grid=replace(QUICK_GRID, ratios=(3,)))
+def quick_spec() -> VariantSpec:
+    """A tiny run: one load, two variants, the quick grid's display and films at one rate ratio."""
+    return VariantSpec(triangles=(1_000,), variants=("warp", "warp:views=2,recon=grid,holes=1"), grid=replace(read_grid(QUICK_SPEC), ratios=(3,)))
 
 
 def run_variants(spec: VariantSpec, runs_dir: Path, log: Log) -> list[dict[str, Any]]:

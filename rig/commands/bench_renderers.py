@@ -1,7 +1,7 @@
 """`rig bench renderers`: the renderer bench's options, and what it prints and writes.
 
 Four kinds of run: the grid (cost, latency and image error of the direct and the warp renderer
-against scene size and resolution, `rig.bench.renderers`), `--seed-table` (the seeds' Table 2
+against scene size and resolution, `rig.bench.renderers`; a spec file, the options over it), `--seed-table` (the seeds' Table 2
 beside this machine's, `rig.bench.seed_table`), `--variants` (image error against latency saved per
 warp variant, `rig.bench.warp_variants`) and `--photon-residual` (how near zero prediction brings
 the latency, `rig.bench.photon_residual`).
@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Iterator
 
 from rig.bench import photon_residual, renderer_plots, renderer_report, renderers, seed_table, warp_variants
-from rig.bench.renderers import QUICK_GRID, BenchGrid
+from rig.bench.renderers import BenchGrid
 from rig.commands import options, outputs
 from rig.render.gl import LOAD_SHAPES
 
@@ -67,16 +67,20 @@ def _runs_folder(runs: Path | None) -> Iterator[Path]:
         yield Path(scratch)
 
 
+_GRID_OPTIONS = ("triangles", "resolutions", "ratios", "warp", "server_ms", "predictor", "direct_predictor")
+
+
 def _grid(args: argparse.Namespace) -> BenchGrid:
-    grid = QUICK_GRID if args.quick else BenchGrid()
-    chosen = {name: getattr(args, name) for name in ("triangles", "resolutions", "ratios", "warp") if getattr(args, name) is not None}
-    return replace(grid, server_ms=args.server_ms, **chosen)
+    """The spec's grid (the quick one with --quick), with the options given over it."""
+    grid = renderers.read_grid(renderers.QUICK_SPEC if args.quick else args.spec)
+    return replace(grid, **{name: getattr(args, name) for name in _GRID_OPTIONS if getattr(args, name) is not None})
 
 
 def _seed_table(args: argparse.Namespace, runs: Path) -> tuple[list[dict], str]:
     spec = seed_table.QUICK_SPEC if args.quick else seed_table.SeedTableSpec()
-    spec = replace(spec, predictor=args.predictor, server_ms=args.server_ms, max_frame_s=args.max_frame_s,
+    spec = replace(spec, server_ms=args.server_ms, max_frame_s=args.max_frame_s,
                    max_triangles=args.max_triangles if args.max_triangles is not None else spec.max_triangles,
+                   **({"predictor": args.predictor} if args.predictor else {}),
                    **({"warp": args.warp} if args.warp else {}), **({"load": args.load} if args.load else {}),
                    **({"size": args.resolutions[0]} if args.resolutions else {}))  # fmt: skip
     rows = seed_table.run_seed_table(spec, runs, _log)
@@ -86,9 +90,10 @@ def _seed_table(args: argparse.Namespace, runs: Path) -> tuple[list[dict], str]:
 
 
 def _variants(args: argparse.Namespace, runs: Path) -> tuple[list[dict], str]:
-    spec = warp_variants.QUICK_SPEC if args.quick else warp_variants.VariantSpec()
+    spec = warp_variants.quick_spec() if args.quick else warp_variants.VariantSpec()
     grid = replace(spec.grid, server_ms=args.server_ms, **({"resolutions": args.resolutions[:1]} if args.resolutions else {}))
-    spec = replace(spec, grid=grid, predictor=args.predictor, **({"variants": tuple(args.variant)} if args.variant else {}),
+    spec = replace(spec, grid=grid, **({"predictor": args.predictor} if args.predictor else {}),
+                   **({"variants": tuple(args.variant)} if args.variant else {}),
                    **({"triangles": args.triangles} if args.triangles else {}), **({"load": args.load} if args.load else {}))  # fmt: skip
     rows = warp_variants.run_variants(spec, runs, _log)
     if args.plot is not None:
@@ -112,10 +117,7 @@ def _run(args: argparse.Namespace) -> int:
         elif args.photon_residual:
             rows, text = _photon_residual(args, runs)
         else:
-            predictor = args.predictor
-            rows = renderers.run_bench(
-                _grid(args), {"direct": args.direct_predictor or predictor, "warp": predictor}, runs, _log, args.workers, args.scheduler
-            )
+            rows = renderers.run_bench(_grid(args), runs, _log, args.workers, args.scheduler)
             if args.plot is not None:
                 writes.write(args.plot, lambda: renderer_plots.plot_rows(rows, args.plot))
             text = renderer_report.table(rows)
@@ -137,8 +139,10 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
         "finds in simulated videos whose clock every frame's measured cost drives (--server-ms models the warp server "
         "instead, labelled). --seed-table sets this machine's latencies beside the seeds' Table 2; --variants plots "
         "image error against latency saved for each warp variant; --photon-residual films each predictor aimed at "
-        "the photons and at scan-out. The default grid takes several minutes, --seed-table up to an hour; --quick "
-        "runs a tiny one of each.",
+        "the photons and at scan-out. The grid is a spec file "
+        f"({renderers.SPEC.name}, in {renderers.SPECS}; --spec runs an edited copy), the grid's options override it; "
+        "its latency films are written beside the runs as films.toml, which `rig sweep` films again. The default grid "
+        "takes several minutes, --seed-table up to an hour; --quick runs a tiny one of each.",
     )
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--seed-table", action="store_true", help="the seeds' Table 2 beside this machine's (see rig.bench.seed_table)")
@@ -147,19 +151,23 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the rows as a JSON list")
     parser.add_argument("--csv", type=outputs.csv_file, metavar="OUT.csv", help="write the rows as CSV")
     parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="plot the run (latency against N, error against latency saved, ...)")
-    parser.add_argument("--quick", action="store_true", help="a tiny run (a smoke test, seconds not minutes)")
+    grid = parser.add_mutually_exclusive_group()
+    grid.add_argument("--spec", type=Path, default=renderers.SPEC, metavar="SPEC.toml",
+                      help="the grid, as a TOML file of rig.bench.renderers.BenchGrid's fields (default: the bench's own)")  # fmt: skip
+    grid.add_argument("--quick", action="store_true", help=f"a tiny run (a smoke test, seconds not minutes; {renderers.QUICK_SPEC.name})")
     parser.add_argument("--triangles", type=_int_list, metavar="N,N,...", help="load sizes (default 10000,100000,1000000,5000000; --variants 10000,200000)")
     parser.add_argument("--resolutions", type=_resolution_list, metavar="WxH,...", help="display sizes; the first is the latency runs' (default 320x240,640x480,1280x720)")
     parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
     parser.add_argument("--warp", metavar="SPEC", help="the warp renderer and its options, e.g. warp:recon=grid,views=2 (default: warp)")
     parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants, --seed-table: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
     parser.add_argument("--variant", action="append", metavar="SPEC", help="a warp variant for --variants; repeat for several (default: the seeds' features one by one)")
-    parser.add_argument("--predictor", default="hold", help="the predictor of every latency run, both renderers alike (default: %(default)s, as the seeds' Table 2)")
+    parser.add_argument("--predictor", help="the predictor of every latency run, both renderers alike (default: the spec's, hold, as the seeds' Table 2)")
     parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")
     parser.add_argument("--residual-predictor", action="append", metavar="NAME", help="a predictor for --photon-residual; repeat for several (default: adaptive, kalman-ca, kalman-cv, desp, slerp, hold)")
     parser.add_argument("--server-ms", type=options.positive_float, metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
     parser.add_argument("--max-frame-s", type=options.positive_float, default=seed_table.SeedTableSpec().max_frame_s, help="--seed-table: the largest direct frame, in seconds, a scene may take (default: %(default)s)")
     parser.add_argument("--max-triangles", type=options.positive_int, metavar="N", help="--seed-table: the largest load (default: 20000000, 720 MB and the GL driver's copy)")
-    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the latency runs' videos here (default: a temporary folder)")
+    parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR",
+                        help="keep the latency runs' videos here, and the grid's films.toml and summary (default: a temporary folder)")  # fmt: skip
     options.add_executor_options(parser, "the latency films")
     parser.set_defaults(func=_run)

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
+from analysis import LatencyResult
 from analysis.errors import AnalysisError
 from predictors import PredictorError
 from rig.errors import ConfigError, RigError
@@ -79,9 +80,15 @@ def labels_from(path: Path | None, videos: Sequence[Path]) -> dict[Path, dict[st
 
 def summary_row(item: BatchItem) -> dict[str, Any]:
     """Analyse one video into its summary row; a failure is a row too, never an exception."""
+    return analysed_row(item)[0]
+
+
+def analysed_row(item: BatchItem) -> tuple[dict[str, Any], LatencyResult | None]:
+    """`summary_row`, and the analyser's whole result (None where the row failed)."""
     started = time.perf_counter()
     row: dict[str, Any] = dict.fromkeys(SUMMARY_COLUMNS)
     row["video"] = str(item.request.video)
+    result = None
     try:
         result = analyse(item.request).result
     except USER_ERRORS as error:
@@ -110,7 +117,7 @@ def summary_row(item: BatchItem) -> dict[str, Any]:
             warnings="; ".join(result.warnings),
         )
     row["seconds"] = time.perf_counter() - started
-    return row | item.labels
+    return row | item.labels, result
 
 
 def check_summary_path(summary: Path, overwrite: bool) -> None:

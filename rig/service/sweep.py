@@ -18,41 +18,54 @@ A sweep is a TOML file:
 
     [analysis]                   # how each video is analysed (rig analyse's options)
     method = "sinefit"
+    simulated_rois = true        # the LED's and the sphere's regions the simulation knows
 
 A sweep needs a [grid] or [[points]] or both; each point is the base with its settings over it.
+A cost (app_frame_ms, warp_ms) given as "measured" is this machine's GL time, as `rig simulate
+--app-frame-ms measured` takes it. With `simulated_rois`, each video is analysed within the regions
+where its simulation put the LED and the sphere (truth.json), as a lab marks them once for its
+camera, instead of the analyser finding them. `write_sweep` writes a sweep in this form.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import itertools
+import json
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+from analysis import LatencyResult
 from rig.errors import ConfigError
 from rig.executor import executor
 from rig.service.analyse import AnalysisRequest
-from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, summary_row
-from rig.service.simulate import simulate
+from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, analysed_row
+from rig.service.simulate import SimulationResult, simulate
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.config import SimulationConfig
 
 ANALYSIS_OPTIONS = ("method", "latency_range_ms", "seed", "led_side")
+SIMULATED_ROIS = "simulated_rois"
+"""The [analysis] option that analyses each video within its simulation's regions."""
+MEASURED = "measured"
+MEASURED_COSTS = ("app_frame_ms", "warp_ms")
+"""SimulationConfig's costs, None (this machine's GL time) where a sweep says MEASURED."""
 _NESTED = {"board": SimulatedBoardConfig}
 
 
 @dataclass(frozen=True)
 class SweepPoint:
-    """One point of a sweep: its simulation, its labels (the grid's values, or an explicit point's)
-    and its run folder."""
+    """One point of a sweep: its simulation, its labels (the grid's values, or an explicit point's),
+    its run folder, its analysis, and whether that takes the simulation's regions (SIMULATED_ROIS)."""
 
     index: int
     config: SimulationConfig
     labels: dict[str, str]
     out_dir: Path
     analysis: AnalysisRequest
+    simulated_rois: bool = False
 
 
 @dataclass(frozen=True)
@@ -87,11 +100,14 @@ class Sweep:
         return Sweep({}, {}, self.analysis, [{**settings, "labels": labels} for settings, labels in self.settings() if keep(labels)])
 
     def points(self, out: Path) -> list[SweepPoint]:
-        template = AnalysisRequest(Path(), **{k: tuple(v) if isinstance(v, list) else v for k, v in self.analysis.items()})
+        options = {k: tuple(v) if isinstance(v, list) else v for k, v in self.analysis.items() if k != SIMULATED_ROIS}
+        template = AnalysisRequest(Path(), **options)
+        rois = bool(self.analysis.get(SIMULATED_ROIS, False))
         points = []
         for index, (settings, labels) in enumerate(self.settings()):
             folder = out / f"point{index:03d}"
-            points.append(SweepPoint(index, build(SimulationConfig, settings), labels, folder, dataclasses.replace(template, video=folder / "video.avi")))
+            request = dataclasses.replace(template, video=folder / "video.avi")
+            points.append(SweepPoint(index, build(SimulationConfig, settings), labels, folder, request, rois))
         return points
 
 
@@ -130,6 +146,8 @@ def build(kind: type, settings: Mapping[str, Any], prefix: str = "") -> Any:
             raise ConfigError(f"the sweep sets {prefix}{key}, but {kind.__name__} has no {head!r}; it has: {', '.join(fields)}")
         if rest:
             nested.setdefault(head, {})[rest] = value
+        elif kind is SimulationConfig and head in MEASURED_COSTS and value == MEASURED:
+            direct[head] = None
         else:
             direct[head] = _checked_number(fields[head], value, prefix)
     for head, values in nested.items():
@@ -145,6 +163,60 @@ def build(kind: type, settings: Mapping[str, Any], prefix: str = "") -> Any:
         return kind(**direct)
     except TypeError as error:
         raise ConfigError(f"bad sweep settings for {kind.__name__}: {error}") from None
+
+
+def settings_of(config: Any, default: Any = None) -> dict[str, Any]:
+    """A point's settings that make `config`: the fields that differ from the defaults (`default`,
+    else the config's class's), nested configs as tables; a measured cost as MEASURED."""
+    default = type(config)() if default is None else default
+    settings: dict[str, Any] = {}
+    for field_ in dataclasses.fields(config):
+        value, usual = getattr(config, field_.name), getattr(default, field_.name)
+        if value == usual:
+            continue
+        if dataclasses.is_dataclass(value):
+            settings[field_.name] = settings_of(value, usual if usual is not None else type(value)())
+        elif value is None and isinstance(config, SimulationConfig) and field_.name in MEASURED_COSTS:
+            settings[field_.name] = MEASURED
+        elif value is None:
+            raise ConfigError(f"a sweep cannot set {field_.name} back to None")
+        else:
+            settings[field_.name] = list(value) if isinstance(value, tuple) else value
+    return settings
+
+
+def _toml_value(value: Any) -> str:
+    """`value` in TOML: a table inline, a string as JSON writes it (TOML reads its escapes), a
+    number as Python writes it (it reads back as the same number)."""
+    if isinstance(value, Mapping):
+        return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items()) + " }" if value else "{}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, (int, float)):
+        return repr(value)
+    raise ConfigError(f"a sweep cannot hold {value!r}")
+
+
+def _toml_key(key: str) -> str:
+    return key if key.replace("_", "").replace("-", "").isalnum() and key.isascii() else json.dumps(key)
+
+
+def write_sweep(sweep: Sweep, path: Path, comment: str = "") -> None:
+    """The sweep as a TOML file `read_sweep` reads back as the same sweep, `comment` above it."""
+    lines = [f"# {line}".rstrip() for line in comment.splitlines()]
+    for table, values in (("base", sweep.base), ("grid", sweep.grid), ("analysis", sweep.analysis)):
+        if values:
+            lines += ["", f"[{table}]", *(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in values.items())]
+    for point in sweep.explicit:
+        lines += ["", "[[points]]", *(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in point.items())]
+    try:
+        Path(path).write_text("\n".join(lines).lstrip("\n") + "\n", encoding="utf-8")
+    except OSError as error:
+        raise ConfigError(f"cannot write the sweep {path}: {error.strerror}") from None
 
 
 def read_sweep(path: Path) -> Sweep:
@@ -171,20 +243,42 @@ def read_sweep(path: Path) -> Sweep:
         if "labels" in point and not isinstance(point["labels"], dict):
             raise ConfigError(f"{path}: point {number}'s labels must be a table of names and values")
     analysis = spec.get("analysis", {})
-    bad = set(analysis) - set(ANALYSIS_OPTIONS)
+    bad = set(analysis) - {*ANALYSIS_OPTIONS, SIMULATED_ROIS}
     if bad:
-        raise ConfigError(f"{path}: [analysis] takes {', '.join(ANALYSIS_OPTIONS)}, not {', '.join(sorted(bad))}")
+        raise ConfigError(f"{path}: [analysis] takes {', '.join((*ANALYSIS_OPTIONS, SIMULATED_ROIS))}, not {', '.join(sorted(bad))}")
+    if not isinstance(analysis.get(SIMULATED_ROIS, False), bool):
+        raise ConfigError(f"{path}: [analysis] {SIMULATED_ROIS} is true or false, not {analysis[SIMULATED_ROIS]!r}")
     return Sweep(spec.get("base", {}), grid, analysis, explicit)
+
+
+@dataclass(frozen=True)
+class PointRun:
+    """A point simulated and analysed: its summary row, the simulation, and the analyser's whole
+    result (None where the row failed)."""
+
+    row: dict[str, Any]
+    simulation: SimulationResult
+    result: LatencyResult | None
+
+
+def simulate_and_analyse(point: SweepPoint) -> PointRun:
+    """Simulate one point and analyse its video (within the simulation's regions where the point
+    says): its summary row, with the truth and the error, and what made it."""
+    simulation = simulate(point.config, point.out_dir, overwrite=True)
+    truth = simulation.truth
+    request = point.analysis
+    if point.simulated_rois:
+        request = dataclasses.replace(request, led_roi=tuple(truth.led_roi), sphere_roi=tuple(truth.sphere_roi))
+    row, result = analysed_row(BatchItem(request, point.labels))
+    row["index"] = point.index
+    row["truth_ms"] = truth.latency_ms
+    row["error_ms"] = row["latency_ms"] - truth.latency_ms if row["latency_ms"] is not None else None
+    return PointRun(row, simulation, result)
 
 
 def run_point(point: SweepPoint) -> dict[str, Any]:
     """Simulate one point and analyse its video: its summary row, with the truth and the error."""
-    simulation = simulate(point.config, point.out_dir, overwrite=True)
-    row = summary_row(BatchItem(point.analysis, point.labels)) | {"index": point.index}
-    truth = simulation.truth.latency_ms
-    row["truth_ms"] = truth
-    row["error_ms"] = row["latency_ms"] - truth if row["latency_ms"] is not None else None
-    return row
+    return simulate_and_analyse(point).row
 
 
 def run_sweep(

@@ -99,7 +99,7 @@ def test_the_specs_are_package_data() -> None:
     pyproject = tomllib.loads((Path(__file__).parents[3] / "pyproject.toml").read_text())
     patterns = pyproject["tool"]["setuptools"]["package-data"]["rig.bench"]
     shipped = {path.name for pattern in patterns for path in Path(analyser.__file__).parent.glob(pattern)}
-    assert shipped == {analyser.SPEC.name, analyser.QUICK_SPEC.name}
+    assert {analyser.SPEC.name, analyser.QUICK_SPEC.name} <= shipped
 
 
 @pytest.mark.parametrize(

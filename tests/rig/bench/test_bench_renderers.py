@@ -5,14 +5,22 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import re
+import tomllib
+from pathlib import Path
 
 import pytest
 
 from rig.bench import seed_table
-from rig.bench.renderer_latency import film_latency
-from rig.bench.renderers import QUICK_GRID, ROW_FIELDS, scene_setup
+from rig.bench.renderer_latency import FILMS_SPEC, film_latency
+from rig.bench.renderers import LATENCY_FIELDS, QUICK_SPEC, ROW_FIELDS, SPEC, BenchGrid, read_grid, scene_setup
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
+from rig.cli import EXIT_USER_ERROR, main
 from rig.commands import bench
+from rig.commands.bench_renderers import _grid
+from rig.sim.camera import CameraConfig
+
+QUICK_GRID = read_grid(QUICK_SPEC)
 
 
 def bench_parser() -> argparse.ArgumentParser:
@@ -25,8 +33,9 @@ def bench_parser() -> argparse.ArgumentParser:
 def quick_run(tmp_path_factory: pytest.TempPathFactory):
     out = tmp_path_factory.mktemp("bench")
     args = bench_parser().parse_args(
-        ["bench", "renderers", "--quick", "--json", str(out / "rows.json"), "--csv", str(out / "rows.csv"), "--plot", str(out / "bench.png")]
-    )
+        ["bench", "renderers", "--quick", "--json", str(out / "rows.json"), "--csv", str(out / "rows.csv"), "--plot", str(out / "bench.png"),
+         "--runs", str(out / "runs")]
+    )  # fmt: skip
     assert args.func(args) == 0
     return out, json.loads((out / "rows.json").read_text())
 
@@ -72,6 +81,92 @@ def test_csv_and_plot_are_written(quick_run):
     with (out / "rows.csv").open() as stream:
         assert len(list(csv.DictReader(stream))) == len(rows)
     assert (out / "bench.png").stat().st_size > 20_000
+
+
+def test_the_film_rows_are_the_sweeps_summary_rows(quick_run):
+    out, rows = quick_run
+    summary = json.loads((out / "runs" / "summary.json").read_text())
+    assert not summary["partial"]
+    swept = {(r["renderer"], int(r["triangles"])): r for r in summary["rows"]}
+    assert set(swept) == {(renderer, n) for renderer in ("direct", "warp") for n in QUICK_GRID.latency_triangles}
+    filmed = [r for r in rows if r["latency_measured_ms"] is not None]
+    assert {(r["renderer"], r["triangles"]) for r in filmed} == set(swept)
+    for r in filmed:
+        row = swept[r["renderer"], r["triangles"]]
+        assert (r["latency_measured_ms"], r["latency_true_ms"]) == (row["latency_ms"], row["truth_ms"])
+        assert {name: r[name] for name in LATENCY_FIELDS} == {name: row["film"][name] for name in LATENCY_FIELDS}
+
+
+@pytest.mark.slow
+def test_rig_sweep_of_the_films_spec_films_the_same_runs_again(quick_run, tmp_path, capsys):
+    """The same simulations, and the same latencies up to the refreshes each film's measured costs
+    missed: a missed refresh holds the last image one refresh longer."""
+    out, _ = quick_run
+    assert main(["sweep", str(out / "runs" / FILMS_SPEC), "--out", str(tmp_path / "again")]) == 0
+    first = json.loads((out / "runs" / "summary.json").read_text())["rows"]
+    again = json.loads((tmp_path / "again" / "summary.json").read_text())["rows"]
+    assert [(r["renderer"], r["triangles"]) for r in again] == [(r["renderer"], r["triangles"]) for r in first]
+    refresh_ms = 1e3 / QUICK_GRID.refresh_hz
+    for a, b in zip(first, again):
+        truths = [json.loads((Path(row["video"]).parent / "truth.json").read_text()) for row in (a, b)]
+        assert truths[0]["config"] == truths[1]["config"]
+        missed = sum(t["refreshes"]["missed"] / t["refreshes"]["shown"] for t in truths)
+        assert abs(a["latency_ms"] - b["latency_ms"]) <= refresh_ms * missed + 0.5
+        assert abs(b["latency_ms"] - b["truth_ms"]) < 1.5
+
+
+def test_the_specs_hold_the_grids_the_bench_had():
+    assert read_grid(SPEC) == BenchGrid()
+    assert read_grid(QUICK_SPEC) == BenchGrid(
+        triangles=(1_000, 8_000), resolutions=((160, 120),), ratios=(1, 3), phases=1, warp_rounds=3, direct_frames=3,
+        direct_budget_s=1.0, latency_triangles=(1_000,), latency_camera=CameraConfig(width=320, height=240, subsamples=4),
+        latency_duration_s=2.5, max_period_s=4.0,
+    )  # fmt: skip
+
+
+def test_the_specs_are_package_data():
+    pyproject = tomllib.loads((Path(__file__).parents[3] / "pyproject.toml").read_text())
+    patterns = pyproject["tool"]["setuptools"]["package-data"]["rig.bench"]
+    shipped = {path for pattern in patterns for path in SPEC.parents[1].glob(pattern)}
+    assert {SPEC, QUICK_SPEC} <= shipped
+
+
+def test_the_options_override_the_spec(tmp_path):
+    spec = tmp_path / "grid.toml"
+    spec.write_text('triangles = [500]\nwarp = "warp:recon=grid"\nserver_ms = 3.0\npredictor = "kalman-cv"\n')
+    args = bench_parser().parse_args(["bench", "renderers", "--spec", str(spec)])
+    assert _grid(args) == BenchGrid(triangles=(500,), warp="warp:recon=grid", server_ms=3.0, predictor="kalman-cv")
+    args = bench_parser().parse_args(["bench", "renderers", "--spec", str(spec), "--triangles", "7,9", "--resolutions", "64x48",
+                                      "--ratios", "2", "--warp", "warp", "--server-ms", "1", "--predictor", "hold", "--direct-predictor", "slerp"])  # fmt: skip
+    assert _grid(args) == BenchGrid(triangles=(7, 9), resolutions=((64, 48),), ratios=(2,), server_ms=1.0, predictor="hold", direct_predictor="slerp")
+    assert _grid(bench_parser().parse_args(["bench", "renderers", "--quick", "--ratios", "4"])).ratios == (4,)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("triangle = [1000]\n", "unknown key triangle; BenchGrid takes triangles, "),
+        ('triangles = "1000"\n', "triangles must be a list, each item a whole number, not '1000'"),
+        ("triangles = [1000, 2.5]\n", "triangles\\[1\\] must be a whole number, not 2.5"),
+        ('resolutions = ["320x240"]\n', "resolutions\\[0\\] must be a list of 2 items, each a whole number, not '320x240'"),
+        ("resolutions = [[320, 240, 1]]\n", "resolutions\\[0\\] must be a list of 2 items"),
+        ("phases = true\n", "phases must be a whole number, not True"),
+        ("server_ms = \"2\"\n", "server_ms must be a number"),
+        ("[latency_camera]\nwidht = 320\n", "unknown key latency_camera.widht; CameraConfig takes fps, "),
+        ("latency_camera = 320\n", "latency_camera must be a table of CameraConfig settings"),
+        ("ratios = [0]\n", "rate ratios are display frames per client frame, at least 1"),
+        ("ratios = []\n", "needs at least one"),
+        ("triangles = [\n", "is not valid TOML"),
+    ],
+)
+def test_a_bad_spec_is_one_line_and_exit_status_2(tmp_path, capsys, text, message):
+    spec = tmp_path / "grid.toml"
+    spec.write_text(text)
+    assert main(["bench", "renderers", "--spec", str(spec), "--runs", str(tmp_path / "runs")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and str(spec) in err
+    assert re.search(message, err), err
+    assert not (tmp_path / "runs" / FILMS_SPEC).exists()
 
 
 def test_bad_grid_options_are_rejected(capsys: pytest.CaptureFixture[str]):

@@ -2,13 +2,19 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
 
 from rig.errors import ConfigError
-from rig.service.sweep import build, read_sweep, run_sweep
+from rig.service import sweep as sweep_service
+from rig.service.sweep import SIMULATED_ROIS, Sweep, build, read_sweep, run_sweep, settings_of, write_sweep
+from rig.sim.board import SimulatedBoardConfig
+from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
+from rig.sim.impairments import FilmImpairments
+from rig.sim.pendulum import PendulumConfig
 
 SPEC = """
 [base]
@@ -47,6 +53,9 @@ def test_settings_are_checked_against_the_configs_fields() -> None:
         build(SimulationConfig, {"camera.fpss": 60.0})
     with pytest.raises(ConfigError, match="single value"):
         build(SimulationConfig, {"seed.x": 1})
+    assert build(SimulationConfig, {"app_frame_ms": "measured", "warp_ms": 2.0}) == SimulationConfig(app_frame_ms=None, warp_ms=2.0)
+    with pytest.raises(ConfigError, match="app_frame_ms to 'measure'; it takes a number"):
+        build(SimulationConfig, {"app_frame_ms": "measure"})
 
 
 def test_points_given_one_by_one_follow_the_grids_with_their_labels_or_their_settings(tmp_path: Path) -> None:
@@ -87,6 +96,7 @@ camera = { fps = 120.0, impairments = { dim_led = 0.35 } }
         ("[grid\n", "not valid TOML"),
         ("points = [1]\n", "list of tables"),
         ("[[points]]\nlabels = 3\n", "labels must be a table"),
+        ("[grid]\nseed = [1]\n[analysis]\nsimulated_rois = 1\n", "simulated_rois is true or false"),
     ],
 )
 def test_a_bad_sweep_file_says_what_is_wrong(tmp_path: Path, text: str, message: str) -> None:
@@ -94,3 +104,49 @@ def test_a_bad_sweep_file_says_what_is_wrong(tmp_path: Path, text: str, message:
     spec.write_text(text)
     with pytest.raises(ConfigError, match=message):
         read_sweep(spec)
+
+
+def test_a_config_written_as_a_points_settings_builds_back_the_same_config(tmp_path: Path) -> None:
+    config = SimulationConfig(
+        duration_s=4.5, pendulum=PendulumConfig(period_s=1.7), camera=CameraConfig(fps=90.0, impairments=FilmImpairments(dim_led=0.35)),
+        renderer="warp:recon=grid", predictor_params={"min_interval": 1e-6}, app_frame_ms=None, warp_ms=None,
+        board=SimulatedBoardConfig(blink_bits=8),
+    )  # fmt: skip
+    settings = settings_of(config)
+    assert settings["app_frame_ms"] == settings["warp_ms"] == "measured" and "seed" not in settings
+    assert settings["camera"] == {"fps": 90.0, "impairments": {"dim_led": 0.35}}
+    assert Sweep({}, {}, explicit=[settings]).points(tmp_path)[0].config == config
+    assert settings_of(SimulationConfig()) == {}
+
+
+def test_a_written_sweep_reads_back_as_the_same_sweep(tmp_path: Path) -> None:
+    sweep = Sweep(
+        {"duration_s": 3.0, "camera": {"fps": 120.0}},
+        {"pendulum.period_s": [0.7, 1.1], "predictor": ["hold", "slerp"]},
+        {"method": "sinefit", "latency_range_ms": [0.0, 200.0], SIMULATED_ROIS: True},
+        [{"labels": {"case": 'a "quoted" case', "n": 3}, "renderer": "warp", "app_frame_ms": "measured",
+          "camera": {"impairments": {"occluded": "led"}}}],
+    )  # fmt: skip
+    path = tmp_path / "sweep.toml"
+    write_sweep(sweep, path, "a sweep\nof two lines")
+    assert path.read_text().startswith("# a sweep\n# of two lines\n")
+    again = read_sweep(path)
+    assert again == sweep
+    assert [p.config for p in again.points(tmp_path)] == [p.config for p in sweep.points(tmp_path)]
+
+
+def test_a_sweep_with_simulated_rois_analyses_each_video_within_its_simulations_regions(tmp_path: Path, monkeypatch) -> None:
+    requests = []
+
+    def analysed(item):
+        requests.append(item.request)
+        return analysed_row(item)
+
+    analysed_row = sweep_service.analysed_row
+    monkeypatch.setattr(sweep_service, "analysed_row", analysed)
+    spec = tmp_path / "sweep.toml"
+    spec.write_text(SPEC.replace('method = "sinefit"', 'method = "sinefit"\nsimulated_rois = true').replace("[0.7, 1.1]", "[0.7]"))
+    rows, _ = run_sweep(read_sweep(spec), tmp_path / "out")
+    truth = json.loads((tmp_path / "out" / "point000" / "truth.json").read_text())
+    assert [(r.led_roi, r.sphere_roi) for r in requests] == [(tuple(truth["led_roi"]), tuple(truth["sphere_roi"]))]
+    assert abs(rows[0]["error_ms"]) < 1.0
