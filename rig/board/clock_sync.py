@@ -208,3 +208,20 @@ class TickUnwrapper:
             full += wrap
         self._reference = full
         return full
+
+    def unwrap_many(self, ticks: Sequence[int]) -> list[int]:
+        """`unwrap` of each of `ticks` in turn, the same numbers; where they lie in one wrap, within half
+        a wrap of each other and of the reference (a stream's batch, but for the rare one that
+        wraps), in one step for all."""
+        reference = self._reference
+        if reference is None or not ticks:
+            return [self.unwrap(tick) for tick in ticks]
+        wrap = self.wrap
+        low, high = min(ticks), max(ticks)
+        place = reference % wrap
+        if low < 0 or high >= wrap or max(high, place) - min(low, place) > wrap // 2:
+            return [self.unwrap(tick) for tick in ticks]
+        base = reference - place
+        fulls = [base + tick for tick in ticks] if base else list(ticks)
+        self._reference = fulls[-1]
+        return fulls

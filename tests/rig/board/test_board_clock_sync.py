@@ -115,3 +115,17 @@ def test_ticks_unwrap_across_the_32_bit_wrap() -> None:
     assert unwrap.unwrap(0xFFFF_FFFF) == (2 << 32) + 0xFFFF_FFFF  # slightly older: back across the wrap
     unwrap.reset()
     assert unwrap.unwrap(5) == 5
+
+
+@pytest.mark.parametrize("bits", [16, 32])
+def test_ticks_unwrapped_together_are_those_unwrapped_one_by_one(bits: int) -> None:
+    """Batches that wrap, go back a little, or jump, among many that do not."""
+    wrap = 1 << bits
+    rng = np.random.default_rng(bits)
+    steps = rng.choice([1, 1, 1, 7, -2, wrap // 2 - 1, wrap // 3], 4000)
+    ticks = [int(t) % wrap for t in np.cumsum(steps) + wrap - 50]
+    apart, together = TickUnwrapper(bits), TickUnwrapper(bits)
+    one_by_one = [apart.unwrap(tick) for tick in ticks]
+    bounds = [0, *sorted(set(rng.integers(0, len(ticks), 300).tolist())), len(ticks)]
+    batched = [full for a, b in zip(bounds, bounds[1:]) for full in together.unwrap_many(ticks[a:b])]
+    assert batched == one_by_one
