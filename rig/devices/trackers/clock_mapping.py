@@ -34,8 +34,8 @@ class ClockMapping(Protocol):
 
     latency_known: bool
 
-    def observe(self, device_time: float | None, t_arrival: float) -> None:
-        """Learn from a record, before `sensor_times` is asked for it and the others taken with it."""
+    def observe_many(self, device_times: list[float] | None, arrivals: list[float]) -> None:
+        """Learn from records taken together, before `sensor_times` is asked for them."""
 
     def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
         """The sensor times of records taken together (a consumer's batch), in one call."""
@@ -64,7 +64,7 @@ class ArrivalTime:
 
     latency_known = False
 
-    def observe(self, device_time: float | None, t_arrival: float) -> None:
+    def observe_many(self, device_times: list[float] | None, arrivals: list[float]) -> None:
         pass
 
     def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
@@ -91,17 +91,22 @@ class OneWayMapping:
         self._best_at = 0.0
         self._fresh = True
 
-    def observe(self, device_time: float | None, t_arrival: float) -> None:
-        assert device_time is not None
-        bound = device_time - t_arrival
-        if t_arrival >= self._window_end and self._best > -math.inf:
-            self._close_window()
-        if self._window_end == -math.inf:
-            self._window_end = t_arrival + WINDOW_S
-        if bound > self._best:
-            self._best, self._second, self._best_at = bound, self._best, t_arrival
-        elif bound > self._second:
-            self._second = bound
+    def observe_many(self, device_times: list[float] | None, arrivals: list[float]) -> None:
+        """Each record bounds the offset from below; its window keeps the largest bound, when it came,
+        and the largest of the rest."""
+        window_end, best, second, best_at = self._window_end, self._best, self._second, self._best_at
+        for device_time, t_arrival in zip(device_times, arrivals):  # type: ignore[arg-type]
+            if t_arrival >= window_end and best > -math.inf:
+                self._close_window(best, second, best_at)
+                window_end = best = second = -math.inf
+            if window_end == -math.inf:
+                window_end = t_arrival + WINDOW_S
+            bound = device_time - t_arrival
+            if bound > best:
+                best, second, best_at = bound, best, t_arrival
+            elif bound > second:
+                second = bound
+        self._window_end, self._best, self._second, self._best_at = window_end, best, second, best_at
 
     def sensor_time(self, device_time: float, t_arrival: float) -> float:
         return self.sensor_times([device_time], [t_arrival])[0]
@@ -126,11 +131,9 @@ class OneWayMapping:
             times.append(mapped if mapped < t else t)
         return times
 
-    def _close_window(self) -> None:
-        gap = self._best - self._second if self._second > -math.inf else 0.0
-        self.model.add(OffsetInterval(self._best, self._best + gap + self._resolution, self._best_at))
-        self._best = self._second = -math.inf
-        self._window_end = -math.inf
+    def _close_window(self, best: float, second: float, best_at: float) -> None:
+        gap = best - second if second > -math.inf else 0.0
+        self.model.add(OffsetInterval(best, best + gap + self._resolution, best_at))
         self._fresh = False
 
     def restart(self) -> None:
@@ -167,7 +170,7 @@ class CorrectedMapping:
         offset = self.origin_s - correction
         self.model.add(OffsetInterval(offset - uncertainty, offset + uncertainty, at))
 
-    def observe(self, device_time: float | None, t_arrival: float) -> None:
+    def observe_many(self, device_times: list[float] | None, arrivals: list[float]) -> None:
         pass
 
     def sensor_time(self, device_time: float, t_arrival: float) -> float:

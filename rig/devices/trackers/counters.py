@@ -16,11 +16,13 @@ from __future__ import annotations
 
 from array import array
 from dataclasses import asdict, dataclass
+from operator import lt
 from typing import Any, Iterable
 
 import numpy as np
 
 from rig.board.clock_sync import TickUnwrapper
+from rig.devices.trackers.readings import Readings
 
 # Latency histogram: 10 us bins up to 2 s; later ones count in the last bin.
 _BIN_S = 1e-5
@@ -54,37 +56,60 @@ class SequenceCheck:
         self._discarded_since = 0
         self._restored = False
 
-    def discarded(self, count: int) -> None:
-        """Records were discarded (corrupt or rejected) since the last one handed on."""
-        self._discarded_since += count
-
     def link_restored(self) -> None:
         """After a reconnection, records missing from a counter that went on count as dropped; a
         counter (or device clock) that starts again lower restarted, and counts nothing."""
         self._restored = True
 
-    def accept(self, seq: int | None, device_time: float | None) -> None:
-        counters = self._counters
-        restored, self._restored = self._restored, False
-        if self._unwrap is not None and seq is not None:
-            full = self._unwrap.unwrap(seq)
-            if self._last_seq is not None:
-                step = full - self._last_seq
-                if step <= 0 and restored:
-                    self._unwrap.reset()
-                    full = self._unwrap.unwrap(seq)
-                elif step <= 0:
-                    counters.out_of_order += 1
-                elif step - 1 > self._discarded_since:
-                    counters.dropped += step - 1 - self._discarded_since
-            if self._last_seq is None or restored or full > self._last_seq:
-                self._last_seq = full
-        elif device_time is not None:
-            if self._last_time is not None and device_time <= self._last_time and not restored:
+    def accept(self, readings: Readings) -> None:
+        """Readings handed on, in order, with the records discarded (corrupt or rejected) before each
+        (`Readings.discarded`). A batch in order, as nearly all are, is checked whole; the others
+        reading by reading."""
+        count = len(readings)
+        restored = self._restored and count > 0
+        if self._unwrap is not None and readings.seqs is not None:
+            self._count_gaps(readings.seqs, readings.discarded, restored)
+        elif readings.device_times is not None:
+            self._count_late(readings.device_times, restored)
+        if count:
+            self._restored = False
+            self._discarded_since = 0
+        self._discarded_since += readings.discarded.get(count, 0)
+
+    def _count_gaps(self, seqs: list[int], discarded: dict[int, int], restored: bool) -> None:
+        unwrap, counters = self._unwrap, self._counters
+        fulls = unwrap.unwrap_many(seqs)  # type: ignore[union-attr]
+        last = self._last_seq
+        if restored and last is not None and fulls[0] <= last:
+            unwrap.reset()  # type: ignore[union-attr]
+            fulls = unwrap.unwrap_many(seqs)  # type: ignore[union-attr]
+            last = None
+        if not fulls or (last is not None and fulls == list(range(last + 1, last + 1 + len(fulls)))):
+            self._last_seq = fulls[-1] if fulls else last
+            return
+        since = self._discarded_since
+        for index, full in enumerate(fulls):
+            since += discarded.get(index, 0)
+            if last is None or full > last:
+                if last is not None and full - last - 1 > since:
+                    counters.dropped += full - last - 1 - since  # type: ignore[operator]
+                last = full
+            else:
                 counters.out_of_order += 1
-            if self._last_time is None or restored or device_time > self._last_time:
-                self._last_time = device_time
-        self._discarded_since = 0
+            since = 0
+        self._last_seq = last
+
+    def _count_late(self, device_times: list[float], restored: bool) -> None:
+        last = None if restored else self._last_time
+        if device_times and (last is None or device_times[0] > last) and all(map(lt, device_times, device_times[1:])):
+            self._last_time = device_times[-1]
+            return
+        for device_time in device_times:
+            if last is None or device_time > last:
+                last = device_time
+            else:
+                self._counters.out_of_order += 1
+        self._last_time = last
 
 
 class LatencyHistogram:

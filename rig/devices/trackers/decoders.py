@@ -24,81 +24,100 @@ from __future__ import annotations
 import math
 import struct
 from bisect import bisect_left
-from itertools import accumulate
+from itertools import accumulate, chain, repeat
+from operator import add
 from typing import Sequence
 
-from rig.devices.trackers.checksums import CHECK_BYTES, CHECKSUMS
+from rig.devices.trackers.checksums import CHECK_BYTES, CHECK_CODES, CHECK_VALUES
 from rig.devices.trackers.profile import Profile
-from rig.devices.trackers.readings import Reading, ReadingMaker
+from rig.devices.trackers.readings import ReadingMaker, Readings
 
 MAX_LINE = 4096
 
 
 class _RecordDecoder:
-    """What every decoder does: counts damaged records (`corrupt`), makes the readings of the
-    records a subclass decoded from one feed (`_made`), and tells each how many damaged records
-    came since the reading before it."""
+    """What every decoder does: counts damaged records (`corrupt`), and tells the readings it makes
+    how many damaged records came before each (`Readings.discarded`)."""
 
     def __init__(self, profile: Profile) -> None:
         self.corrupt = 0
         self._told = 0
         self._maker = ReadingMaker(profile)
 
-    def feed(self, data: bytes, t_arrival: float) -> list[Reading]:
+    def feed(self, data: bytes, t_arrival: float) -> Readings:
         """The readings of the records `data` completes, stamped `t_arrival`."""
         return self.feed_chunks((data,), (t_arrival,))
 
-    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
+    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> Readings:
         """The readings of the records the chunks complete, in order, each stamped with the arrival of
         the chunk that completed it."""
         raise NotImplementedError
 
-    def _made(self, records: list, arrivals: list[float], corrupt_at: list[int]) -> list[Reading]:
-        """The readings of records decoded in one feed, each told the damaged records counted since
-        the reading before it (`corrupt_at`: the count `corrupt` had when each was decoded)."""
-        readings = self._maker.make_many(records, arrivals)
-        if corrupt_at and corrupt_at[-1] != self._told:
-            told = self._told
-            for reading, corrupt in zip(readings, corrupt_at):
-                reading.damaged_before = corrupt - told
-                told = corrupt
-            self._told = told
-        return readings
+    def _tell_damage(self, index: int, discarded: dict[int, int]) -> None:
+        """The damaged records counted since the last reading made came just before reading `index`."""
+        if self.corrupt != self._told:
+            discarded[index] = self.corrupt - self._told
+            self._told = self.corrupt
 
 
 class TextDecoder(_RecordDecoder):
+    """Splits what arrived into lines at once and reads all their numbers in one pass; a feed with a
+    line that does not read as a record (damage, a header, a blank) is read line by line."""
+
     def __init__(self, profile: Profile) -> None:
         super().__init__(profile)
         self._terminator = profile.terminator
-        self._separator = profile.separator
+        self._separator = profile.separator.encode("ascii") if profile.separator else None
         self._count = len(profile.fields)
         self._header = [name.encode("ascii", "replace") for name in profile.names]
-        self._buffer = bytearray()
+        self._rest = b""
 
-    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
-        buffer = self._buffer
-        ends = _append_chunks(buffer, chunks)
-        records: list[list[float]] = []
-        times: list[float] = []
-        corrupt_at: list[int] = []
+    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> Readings:
+        data, ends = _joined(self._rest, chunks)
         terminator = self._terminator
-        start = 0
-        while (end := buffer.find(terminator, start)) >= 0:
-            values = self._values(bytes(buffer[start:end]))
-            start = end + len(terminator)
-            if values is not None:
-                records.append(values)
-                times.append(arrivals[bisect_left(ends, start)])
-                corrupt_at.append(self.corrupt)
-        del buffer[:start]
-        if len(buffer) > MAX_LINE:
-            buffer.clear()
+        last = data.rfind(terminator)
+        lines = data[:last].split(terminator) if last >= 0 else []
+        self._rest = data[last + len(terminator) :] if last >= 0 else data
+        step = len(terminator)
+        line_ends = map(add, accumulate(map(len, lines)), range(step, (len(lines) + 1) * step, step))
+        times = list(map(arrivals.__getitem__, map(bisect_left, repeat(ends), line_ends)))
+        discarded: dict[int, int] = {}
+        records = self._read_all(lines)
+        if records is None:
+            records, times = self._read_each(lines, times, discarded)
+        elif records:
+            self._tell_damage(0, discarded)
+        if len(self._rest) > MAX_LINE:
+            self._rest = b""
             self.corrupt += 1
-        return self._made(records, times, corrupt_at)
+        return self._maker.make_many(records, times, discarded)
+
+    def _read_all(self, lines: list[bytes]) -> list[tuple[float, ...]] | None:
+        """Every line's numbers, or None unless each line has the profile's number of fields, all
+        numbers."""
+        rows = [line.split(self._separator) for line in lines]
+        count = self._count
+        if not all(map(count.__eq__, map(len, rows))):
+            return None
+        try:
+            values = list(map(float, chain.from_iterable(rows)))
+        except ValueError:
+            return None
+        return list(zip(*[iter(values)] * count))
+
+    def _read_each(self, lines: list[bytes], times: list[float], discarded: dict[int, int]) -> tuple[list, list[float]]:
+        records, kept_times = [], []
+        for line, t_arrival in zip(lines, times):
+            values = self._values(line)
+            if values is not None:
+                self._tell_damage(len(records), discarded)
+                records.append(values)
+                kept_times.append(t_arrival)
+        return records, kept_times
 
     def _values(self, line: bytes) -> list[float] | None:
         """A line's numbers, or None (counted corrupt unless it is blank or the header)."""
-        parts = line.split(self._separator.encode("ascii")) if self._separator else line.split()
+        parts = line.split(self._separator)
         if len(parts) != self._count:
             self.corrupt += bool(line.strip())
             return None
@@ -109,67 +128,79 @@ class TextDecoder(_RecordDecoder):
             return None
 
     def reset(self) -> None:
-        self.corrupt += bool(self._buffer.strip())
-        self._buffer.clear()
+        self.corrupt += bool(self._rest.strip())
+        self._rest = b""
         self._maker.reset()
 
 
 class BinaryDecoder(_RecordDecoder):
+    """Reads record after record in one loop that calls as few distinct functions as it can: the
+    consumer runs it every 20 ms or so, cold, and there every distinct function costs several
+    microseconds to bring back into the caches, more than a record's decoding (a batch of numpy
+    or itertools steps costs more than it saves)."""
+
     def __init__(self, profile: Profile) -> None:
         super().__init__(profile)
         self._sync = profile.sync
-        self._body = struct.Struct(profile.struct_format)
-        self._check = CHECKSUMS[profile.checksum]
-        self._check_bytes = CHECK_BYTES[profile.checksum]
-        self._order = profile.byte_order
-        self.record_bytes = len(self._sync) + self._body.size + self._check_bytes
-        self._buffer = bytearray()
+        body = profile.struct_format
+        self._record = struct.Struct(f"{body[0]}{len(self._sync)}x{body[1:]}{CHECK_CODES[profile.checksum]}")
+        """The whole record: the body's fields, then the check as a number (no field: sync, padding)."""
+        self._check = CHECK_VALUES[profile.checksum]
+        self.record_bytes = self._record.size
+        self._body_span = (len(self._sync), self.record_bytes - CHECK_BYTES[profile.checksum])
+        self._rest = b""
         self._discarded = 0
 
-    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
-        buffer = self._buffer
-        ends = _append_chunks(buffer, chunks)
+    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> Readings:
+        rest = self._rest
+        data = rest + b"".join(chunks)
         records: list[tuple] = []
         times: list[float] = []
-        corrupt_at: list[int] = []
-        sync, size = self._sync, self.record_bytes
-        body_start, body_end = len(sync), size - self._check_bytes
-        check, check_bytes, order, unpack_from = self._check, self._check_bytes, self._order, self._body.unpack_from
+        discarded: dict[int, int] = {}
+        sync, size, unpack, check = self._sync, self.record_bytes, self._record.unpack_from, self._check
+        body_start, body_end = self._body_span
+        # The chunk that holds the end of the record (`chunk`), and where that chunk ends in `data`.
+        chunk, chunk_end = 0, len(rest) + (len(chunks[0]) if chunks else 0)
         start = 0
         while True:
-            found = buffer.find(sync, start)
+            found = data.find(sync, start)
             if found < 0:
-                keep = max(start, len(buffer) - len(sync) + 1)
+                keep = max(start, len(data) - len(sync) + 1)
                 self._discarded += keep - start
                 start = keep
                 break
             self._discarded += found - start
             start = found
             end = start + size
-            if len(buffer) < end:
+            if len(data) < end:
                 break
-            if check_bytes and check(buffer[start + body_start : start + body_end], order) != buffer[start + body_end : end]:
+            values = unpack(data, start)
+            if check is not None and check(data[start + body_start : start + body_end]) != values[-1]:
                 self._discarded += 1
                 start += 1
                 continue
             if self._discarded:
                 self._end_stretch()
-            records.append(unpack_from(buffer, start + body_start))
-            times.append(arrivals[bisect_left(ends, end)])
-            corrupt_at.append(self.corrupt)
+            if self.corrupt != self._told:
+                self._tell_damage(len(records), discarded)
+            while chunk_end < end:
+                chunk += 1
+                chunk_end += len(chunks[chunk])
+            records.append(values)
+            times.append(arrivals[chunk])
             start = end
-        del buffer[:start]
-        return self._made(records, times, corrupt_at)
+        self._rest = data[start:]
+        return self._maker.make_many(records, times, discarded)
 
     def _end_stretch(self) -> None:
         self.corrupt += math.ceil(self._discarded / self.record_bytes)
         self._discarded = 0
 
     def reset(self) -> None:
-        self._discarded += len(self._buffer)
+        self._discarded += len(self._rest)
         if self._discarded:
             self._end_stretch()
-        self._buffer.clear()
+        self._rest = b""
         self._maker.reset()
 
 
@@ -180,11 +211,11 @@ class HidReportDecoder(_RecordDecoder):
         self._body = struct.Struct(profile.struct_format)
         self.report_bytes = self._body.size + (1 if self._report_id else 0)
 
-    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> list[Reading]:
+    def feed_chunks(self, chunks: Sequence[bytes], arrivals: Sequence[float]) -> Readings:
         """Each chunk is one report."""
         records: list[tuple] = []
         times: list[float] = []
-        corrupt_at: list[int] = []
+        discarded: dict[int, int] = {}
         for report, t_arrival in zip(chunks, arrivals):
             if self._report_id:
                 if not report or report[0] != self._report_id:
@@ -193,10 +224,10 @@ class HidReportDecoder(_RecordDecoder):
             if len(report) < self._body.size:
                 self.corrupt += 1
                 continue
+            self._tell_damage(len(records), discarded)
             records.append(self._body.unpack_from(report))
             times.append(t_arrival)
-            corrupt_at.append(self.corrupt)
-        return self._made(records, times, corrupt_at)
+        return self._maker.make_many(records, times, discarded)
 
     def reset(self) -> None:
         self._maker.reset()
@@ -205,12 +236,12 @@ class HidReportDecoder(_RecordDecoder):
 Decoder = TextDecoder | BinaryDecoder | HidReportDecoder
 
 
-def _append_chunks(buffer: bytearray, chunks: Sequence[bytes]) -> list[int]:
-    """Appends the chunks to `buffer`; where each ends in it, in order (a record whose last byte is
-    before the end of chunk k, and after that of chunk k - 1, was completed by chunk k)."""
-    ends = list(accumulate(map(len, chunks), initial=len(buffer)))
-    buffer += b"".join(chunks)
-    return ends[1:]
+def _joined(rest: bytes, chunks: Sequence[bytes]) -> tuple[bytes, list[int]]:
+    """What was left of earlier feeds with the chunks after it, and where each chunk ends in that (a
+    record whose last byte is before the end of chunk k, and after that of chunk k - 1, was
+    completed by chunk k)."""
+    ends = list(accumulate(map(len, chunks), initial=len(rest)))
+    return rest + b"".join(chunks), ends[1:]
 
 
 def decoder_for(profile: Profile) -> Decoder:

@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any, Protocol
 
 from rig.clock import Clock
-from rig.devices.trackers.readings import Reading
+from rig.devices.trackers.readings import Readings
 
 
 class LinkLost(Exception):
@@ -62,7 +62,7 @@ class Link(Protocol):
     def receive(self, clock: Clock) -> Any:
         """What arrived (None if nothing did in time); raises LinkLost when the device went away."""
 
-    def decode(self, chunks: list[Any], arrivals: list[float]) -> list[Reading]:
+    def decode(self, chunks: list[Any], arrivals: list[float]) -> Readings:
         """The readings that received chunks complete, in order, each stamped with the arrival of
         the chunk that completed it."""
 

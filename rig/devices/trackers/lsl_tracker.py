@@ -17,13 +17,15 @@ from __future__ import annotations
 
 import ctypes
 from collections import deque
+from itertools import chain, repeat
+from operator import itemgetter
 from types import ModuleType
 from typing import Any
 
 from rig.clock import Clock, MonotonicClock
 from rig.devices.trackers.clock_mapping import CorrectedMapping
 from rig.devices.trackers.profile import DEFAULT_UNIT_TOLERANCE
-from rig.devices.trackers.readings import Reading
+from rig.devices.trackers.readings import Readings
 from rig.devices.trackers.link import LinkLost
 from rig.devices.trackers.stream import TrackerStream
 from rig.errors import ConfigError, RigError
@@ -34,6 +36,7 @@ except ImportError:
     LslReader = None
 
 CHANNELS = ("px", "py", "pz", "qw", "qx", "qy", "qz")
+_POSITION, _ORIENTATION = itemgetter(0, 1, 2), itemgetter(3, 4, 5, 6)
 RESOLVE_TIMEOUT_S = 2.0
 OPEN_TIMEOUT_S = 2.0
 READ_TIMEOUT_S = 0.05
@@ -182,17 +185,16 @@ class LslLink:
             raise LinkLost(f"the sender is gone ({error})") from None
         return [first, *rest], [stamp, *stamps]
 
-    def decode(self, chunks: list[tuple[list, list]], arrivals: list[float]) -> list[Reading]:
+    def decode(self, chunks: list[tuple[list, list]], arrivals: list[float]) -> Readings:
         """The chunks' samples; first the clock corrections measured since the last call go to the
         mapping, on this (the consumer's) thread."""
         corrections, add = self._corrections, self.mapping.add_correction
         while corrections:
             add(*corrections.popleft())
-        readings = []
-        for (samples, stamps), t_arrival in zip(chunks, arrivals):
-            for (px, py, pz, qw, qx, qy, qz), device_time in zip(samples, stamps):
-                readings.append(Reading(t_arrival, device_time, None, (px, py, pz), (qw, qx, qy, qz)))
-        return readings
+        samples = list(chain.from_iterable(map(itemgetter(0), chunks)))
+        stamps = list(chain.from_iterable(map(itemgetter(1), chunks)))
+        times = list(chain.from_iterable(map(repeat, arrivals, map(len, map(itemgetter(1), chunks)))))
+        return Readings(times, stamps, None, list(map(_POSITION, samples)), list(map(_ORIENTATION, samples)))
 
     def upkeep(self, clock: Clock) -> None:
         """A fresh clock correction every CORRECTION_INTERVAL_S (liblsl's latest, without asking it to

@@ -1,24 +1,24 @@
-"""From a record's raw numbers to a reading in the rig's units, and the checks that keep impossible
+"""From records' raw numbers to readings in the rig's units, and the checks that keep impossible
 values away from a predictor.
 
-A `Reading` is one decoded record before its clock is mapped: the host's arrival time, the device's
-own time and record counter where it sends them, the position in metres, the orientation as it
-came (maybe not of unit norm), and the angular rate where the profile has one. `ReadingMaker` turns
-the records a decoder found in one feed, their fields in profile order, into readings column by
-column, picking and scaling with `map` and `itemgetter` rather than a Python loop per field or per
-record (at 1000 records a second the decoding is most of the consumer's cost, and it runs cold, a
-batch every few ms); `check_reading` says what is impossible about one.
-Euler angles become a quaternion with plain float arithmetic (a call into scipy per sample would
-cost more than the whole reading budget).
-"""
+`Readings` are the records a decoder found in one feed before their clock is mapped, column by
+column: the host's arrival times, the device's own times and record counters where it sends them,
+positions in metres, orientations as they came (maybe not of unit norm), and angular rates where
+the profile has them. `ReadingMaker` picks and scales the columns with `map` and `itemgetter`
+rather than a Python loop per field or per record (at 1000 records a second the decoding is most
+of the consumer's cost, and it runs cold, a batch every few ms); `keep_possible` removes the
+impossible ones, in one loop over the batch that normalises the quaternions as it checks them, and
+says what is wrong with each reading only where that loop finds something. Euler angles become a quaternion with plain float arithmetic (a call
+into scipy per sample would cost more than the whole reading budget)."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import partial
 from itertools import repeat
 from operator import itemgetter, mul
-from typing import Callable, Sequence
+from typing import Callable, Iterable, Sequence
 
 from predictors.scalar_quaternion import Quaternion, multiply
 from rig.board.clock_sync import TickUnwrapper
@@ -37,19 +37,26 @@ from rig.devices.trackers.profile import (
 
 
 @dataclass(slots=True)
-class Reading:
-    """One decoded record: times in seconds (arrival on the rig clock, device on its own), metres,
-    a (w, x, y, z) quaternion as received, rad/s."""
+class Readings:
+    """Records decoded together before their clock is mapped, column by column (a consumer takes
+    about twenty at a time, and a Python call or object per record would cost more than the
+    decoding): arrival times on the rig clock and the device's own times (s; None: it sends none),
+    record counters (None: none), positions (m), (w, x, y, z) quaternions as received, angular
+    rates (rad/s; None: none)."""
 
-    t_arrival: float
-    device_time: float | None
-    seq: int | None
-    position: tuple[float, float, float]
-    orientation: Quaternion
-    angular_rate: tuple[float, float, float] | None = None
-    damaged_before: int = 0
-    """Damaged records the decoder counted since the reading before this one: where in the stream
-    they were, which a record counter's gaps are checked against."""
+    arrivals: list[float]
+    device_times: list[float] | None
+    seqs: list[int] | None
+    positions: list[tuple[float, float, float]]
+    orientations: list[Quaternion]
+    rates: list[tuple[float, float, float]] | None = None
+    discarded: dict[int, int] = field(default_factory=dict)
+    """Records discarded (damaged, or impossible) just before the reading at an index, the index
+    after the last for those after it: where in the stream they were, which a record counter's
+    gaps are checked against."""
+
+    def __len__(self) -> int:
+        return len(self.arrivals)
 
 
 def axis_quaternion(axis: str, angle: float) -> Quaternion:
@@ -73,10 +80,10 @@ def euler_quaternion(sequence: str, angles: Sequence[float]) -> Quaternion:
 
 
 class ReadingMaker:
-    """Turns records' values, in the profile's field order, into `Reading`s. Each group of fields
+    """Turns records' values, in the profile's field order, into `Readings`. Each group of fields
     (position, orientation, angular rate) is picked by index and multiplied by one factor per field
     (scale times unit), skipped where every factor is 1 and the fields are floats; an integer time
-    field is unwrapped at its width (`reset` forgets its history)."""
+    field (integers, as struct reads them) is unwrapped at its width (`reset` forgets its history)."""
 
     def __init__(self, profile: Profile) -> None:
         self._euler = profile.euler
@@ -85,31 +92,39 @@ class ReadingMaker:
         self._euler_angles = _group(profile, EULER, RADIANS_PER[profile.angle_unit])
         self._rate = _group(profile, RATE, RADIANS_PER[profile.angle_unit])
         names = profile.names
-        self._seq = names.index(SEQUENCE) if SEQUENCE in names else None
-        self._time = names.index(TIME) if TIME in names else None
+        seq_field = profile.field(SEQUENCE)
+        self._seq = itemgetter(names.index(SEQUENCE)) if seq_field else None
+        self._seq_as_text = seq_field is not None and seq_field.integer_bits is None
+        """A text counter is read as a float, and made a whole number."""
+        self._time = itemgetter(names.index(TIME)) if TIME in names else None
         time_field = profile.field(TIME)
         bits = time_field.integer_bits if time_field else None
         self._unwrap = TickUnwrapper(bits) if bits else None
         self._time_scale = profile.scale.get(TIME, 1.0)
         self._seconds = SECONDS_PER[profile.time_unit]
 
-    def make_many(self, records: Sequence[Sequence[float]], arrivals: Sequence[float]) -> list[Reading]:
-        """The readings of records, in order, each with its arrival, time fields (unwrapped) in seconds."""
-        positions = repeat(_ORIGIN) if self._position is None else _column(self._position, records)
+    def make_many(self, records: Sequence[Sequence[float]], arrivals: list[float], discarded: dict[int, int]) -> Readings:
+        """The readings of records, in order, with their arrivals and the records discarded before
+        them (`Readings.discarded`), time fields (unwrapped) in seconds."""
+        positions = [_ORIGIN] * len(records) if self._position is None else _column(self._position, records)
         if self._quaternion is not None:
             orientations = _column(self._quaternion, records)
         else:
             orientations = [euler_quaternion(self._euler, angles) for angles in _column(self._euler_angles, records)]  # type: ignore[arg-type]
-        rates = repeat(None) if self._rate is None else _column(self._rate, records)
-        seqs = repeat(None) if self._seq is None else map(int, map(itemgetter(self._seq), records))
-        device_times: Sequence[float | None] | repeat[None] = repeat(None)
+        rates = None if self._rate is None else _column(self._rate, records)
+        seqs = None if self._seq is None else list(map(self._seq, records))
+        if self._seq_as_text:
+            seqs = list(map(int, seqs))  # type: ignore[arg-type]
+        device_times = None
         if self._time is not None:
-            raws = map(itemgetter(self._time), records)
+            raws: Iterable[float] = list(map(self._time, records))
             if self._unwrap is not None:
-                raws = map(self._unwrap.unwrap, map(int, raws))
+                raws = self._unwrap.unwrap_many(raws)  # type: ignore[arg-type]
             scale, seconds = self._time_scale, self._seconds
-            device_times = [raw * scale * seconds for raw in raws]
-        return list(map(Reading, arrivals, device_times, seqs, positions, orientations, rates))
+            if scale != 1.0:
+                raws = map(mul, raws, repeat(scale))
+            device_times = list(map(mul, raws, repeat(seconds)))
+        return Readings(arrivals, device_times, seqs, positions, orientations, rates, discarded)
 
     def reset(self) -> None:
         """What follows comes from a device whose time counter may have started again."""
@@ -140,17 +155,86 @@ def _column(group: _Group, records: Sequence[Sequence[float]]) -> list[tuple]:
     return [tuple(map(mul, pick(values), factors)) for values in records]
 
 
-def check_reading(reading: Reading, unit_tolerance: float) -> str | None:
-    """What makes the reading impossible (a number not finite, a quaternion not of unit norm within
-    `unit_tolerance`), or None; a possible reading gets its quaternion normalised in place."""
-    w, x, y, z = reading.orientation
-    px, py, pz = reading.position
-    wx, wy, wz = reading.angular_rate or (0.0, 0.0, 0.0)
-    device_time = 0.0 if reading.device_time is None else reading.device_time
-    if not math.isfinite(w + x + y + z + px + py + pz + wx + wy + wz + device_time):
-        return f"a value is not a finite number: position {reading.position}, orientation {reading.orientation}"
+def keep_possible(readings: Readings, unit_tolerance: float) -> list[str]:
+    """Removes the impossible readings (a number not finite, a quaternion not of unit norm within
+    `unit_tolerance`), each counted discarded before the next, and normalises the quaternions of the
+    rest, in place; what was wrong with each removed, in order."""
+    normalised = _normalised(readings, unit_tolerance)
+    if normalised is not None:
+        readings.orientations = normalised
+        return []
+    problems = _remove_impossible(readings, unit_tolerance)
+    readings.orientations = _normalised(readings, unit_tolerance)  # type: ignore[assignment]
+    return problems
+
+
+def _problem(
+    position: tuple[float, float, float],
+    orientation: Quaternion,
+    rate: tuple[float, float, float] | None,
+    device_time: float | None,
+    unit_tolerance: float,
+) -> str | None:
+    """What makes one reading impossible, or None."""
+    w, x, y, z = orientation
+    px, py, pz = position
+    wx, wy, wz = rate or (0.0, 0.0, 0.0)
+    if not math.isfinite(w + x + y + z + px + py + pz + wx + wy + wz + (device_time or 0.0)):
+        return f"a value is not a finite number: position {position}, orientation {orientation}"
     norm = math.sqrt(w * w + x * x + y * y + z * z)
     if abs(norm - 1.0) > unit_tolerance:
-        return f"the quaternion {reading.orientation} has norm {norm:.6g}, not 1 within {unit_tolerance:g}"
-    reading.orientation = (w / norm, x / norm, y / norm, z / norm)
+        return f"the quaternion {orientation} has norm {norm:.6g}, not 1 within {unit_tolerance:g}"
     return None
+
+
+def _normalised(readings: Readings, unit_tolerance: float) -> list[Quaternion] | None:
+    """The readings' quaternions normalised, or None if one of them is impossible (`_problem`
+    finds the same, reading by reading: absent rates and time add zeros); one loop, for the reason
+    in `rig.devices.trackers.decoders.BinaryDecoder`."""
+    normalised: list[Quaternion] = []
+    append, sqrt, isfinite = normalised.append, math.sqrt, math.isfinite
+    rates = readings.rates or repeat(_ORIGIN)
+    times = readings.device_times or repeat(0.0)
+    for (w, x, y, z), (px, py, pz), (wx, wy, wz), t in zip(readings.orientations, readings.positions, rates, times):
+        norm = sqrt(w * w + x * x + y * y + z * z)
+        if not (isfinite(w + x + y + z + px + py + pz + wx + wy + wz + t) and abs(norm - 1.0) <= unit_tolerance):
+            return None
+        append((w / norm, x / norm, y / norm, z / norm))
+    return normalised
+
+
+def _remove_impossible(readings: Readings, unit_tolerance: float) -> list[str]:
+    """`keep_possible`'s removal, reading by reading."""
+    count = len(readings)
+    rates = readings.rates or [None] * count
+    times = readings.device_times or [None] * count
+    columns = zip(readings.positions, readings.orientations, rates, times)
+    problems = [_problem(*values, unit_tolerance) for values in columns]  # type: ignore[misc]
+    kept: list[int] = []
+    discarded: dict[int, int] = {}
+    pending = 0
+    for index, problem in enumerate(problems):
+        pending += readings.discarded.get(index, 0)
+        if problem is not None:
+            pending += 1
+            continue
+        if pending:
+            discarded[len(kept)], pending = pending, 0
+        kept.append(index)
+    pending += readings.discarded.get(count, 0)
+    if pending:
+        discarded[len(kept)] = pending
+    pick = partial(_pick, kept)
+    readings.arrivals, readings.positions, readings.orientations = pick(readings.arrivals), pick(readings.positions), pick(readings.orientations)
+    if readings.device_times is not None:
+        readings.device_times = pick(readings.device_times)
+    if readings.seqs is not None:
+        readings.seqs = pick(readings.seqs)
+    if readings.rates is not None:
+        readings.rates = pick(readings.rates)
+    readings.discarded = discarded
+    return [problem for problem in problems if problem is not None]
+
+
+def _pick(indices: list[int], column: list) -> list:
+    return list(map(column.__getitem__, indices))

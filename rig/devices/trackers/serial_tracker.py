@@ -24,7 +24,7 @@ from rig.clock import Clock, MonotonicClock
 from rig.devices.trackers.clock_mapping import mapping_for
 from rig.devices.trackers.decoders import BinaryDecoder, TextDecoder, decoder_for
 from rig.devices.trackers.profile import Profile, load_profile
-from rig.devices.trackers.readings import Reading
+from rig.devices.trackers.readings import Readings
 from rig.devices.trackers.link import LinkLost
 from rig.devices.trackers.stream import TrackerStream
 from rig.errors import ConfigError, RigError
@@ -177,7 +177,7 @@ class SerialLink:
             raise LinkLost(str(error)) from None
         return data or None
 
-    def decode(self, chunks: list[bytes], arrivals: list[float]) -> list[Reading]:
+    def decode(self, chunks: list[bytes], arrivals: list[float]) -> Readings:
         return self._decoder.feed_chunks(chunks, arrivals)
 
     def restart(self) -> None:

@@ -10,10 +10,13 @@ monotonic clock), that thread is in C and never wakes the interpreter; the strea
 supervises it, asleep in C until it ends, and reopens the link when it does. Elsewhere (a port
 without a descriptor, HID, a test's clock) the stream's thread is the reader, in Python, calling
 `Link.receive`. The consumer's `poll()` (the session's render loop, or `rig record-tracker`), which
-never blocks, or `wait(timeout)`, takes every queued chunk and decodes them together: each record
-is checked and what was wrong counted, in arrival order, then the device times of all it took are
-mapped onto the rig clock in one call. A record is available to a predictor from its arrival time, when the reader
-queued the chunk that completed it. A lost link is logged, leaves a gap, and is reopened until the
+never blocks, or `wait(timeout)`, takes every queued chunk and decodes them together into columns
+(`Readings`), checked and counted a batch at a time, then maps the device times of all it took onto
+the rig clock in one call. It runs cold, every 20 ms or so, where each distinct function it calls
+costs several microseconds to bring back into the caches, more than a record's work: so each step
+is one loop over the batch (or one call that does the batch in C), not a chain of small batch
+operations, and no Python call or object per record beyond the record itself. A record is
+available to a predictor from its arrival time, when the reader queued the chunk that completed it. A lost link is logged, leaves a gap, and is reopened until the
 stream is closed; everything that happened is in `report()`. One thread consumes a stream.
 """
 
@@ -26,7 +29,8 @@ import time
 from collections import deque
 from dataclasses import dataclass
 from functools import partial
-from operator import attrgetter
+from itertools import repeat
+from operator import sub
 from typing import Any, Callable, NamedTuple
 
 from predictors import PoseSample
@@ -34,7 +38,7 @@ from rig.clock import Clock
 from rig.devices.trackers.clock_mapping import ClockMapping
 from rig.devices.trackers.counters import LatencyHistogram, SequenceCheck, TrackerCounters
 from rig.devices.trackers.link import Link, LinkLost, NativeReader
-from rig.devices.trackers.readings import Reading, check_reading
+from rig.devices.trackers.readings import keep_possible
 from rig.errors import RigError
 
 log = logging.getLogger("rig.trackers")
@@ -83,10 +87,10 @@ class TrackerRecord(NamedTuple):
         return (self.t_sensor, self.t_arrival, *self.position, *self.orientation)
 
 
-_T_ARRIVAL, _DEVICE_TIME, _SEQ = attrgetter("t_arrival"), attrgetter("device_time"), attrgetter("seq")
-_POSITION, _ORIENTATION, _RATE = attrgetter("position"), attrgetter("orientation"), attrgetter("angular_rate")
 _record = partial(tuple.__new__, TrackerRecord)
 """A TrackerRecord of the tuple of its fields, as its `_make` makes one, without a Python call."""
+_NONE = repeat(None)
+"""The column of a field the device does not send."""
 
 
 @dataclass(frozen=True)
@@ -168,7 +172,6 @@ class TrackerStream:
         native = self._native
         queue = self._chunks
         records: list[TrackerRecord] = []
-        possible: list[Reading] = []
         chunks: list[Any] = []
         arrivals: list[float] = []
         while queue:
@@ -177,10 +180,8 @@ class TrackerStream:
                 chunks.append(entry[0])
                 arrivals.append(entry[1])
             elif entry is _RESTORED or entry is _CLOSED:
-                self._accept(chunks, arrivals, possible)
+                self._decode(chunks, arrivals, records)
                 chunks, arrivals = [], []
-                self._map(possible, records)
-                possible = []
                 if entry is _RESTORED:
                     self._restart()
                 else:
@@ -194,8 +195,7 @@ class TrackerStream:
             taken, times = native.take()
             chunks += taken
             arrivals += times
-        self._accept(chunks, arrivals, possible)
-        self._map(possible, records)
+        self._decode(chunks, arrivals, records)
         self.decode_cpu_s += time.thread_time() - started
         return records
 
@@ -248,7 +248,7 @@ class TrackerStream:
 
     def _count_corrupt(self) -> None:
         """Adds the link's new damaged records to the counters; the record counter's check learns of
-        each where it was in the stream, from the reading after it (`Reading.damaged_before`)."""
+        each where it was in the stream, from the reading after it (`Readings.discarded`)."""
         new = self.link.corrupt - self._corrupt_seen
         if new:
             self._corrupt_seen = self.link.corrupt
@@ -302,48 +302,45 @@ class TrackerStream:
             return str(OSError(code, os.strerror(code))) if code > 0 else f"the stream failed (liblsl error {code})"
         return "the device closed the link (end of file)"
 
-    def _accept(self, chunks: list[Any], arrivals: list[float], possible: list[Reading]) -> None:
-        """Decodes, checks and counts the readings of chunks taken together, in order, and adds the
-        possible ones to `possible`, which the clock mapping learns from before `_map` maps them."""
+    def _decode(self, chunks: list[Any], arrivals: list[float], records: list[TrackerRecord]) -> None:
+        """Decodes, checks and counts the readings of chunks taken together, in order, lets the clock
+        mapping learn from the possible ones and then maps them in one call (so they keep their order
+        in sensor time), and adds their records to `records`."""
         if not chunks:
             return
         readings = self.link.decode(chunks, arrivals)
         self._count_corrupt()
-        counters, mapping, sequence, tolerance = self.counters, self.mapping, self._sequence, self._unit_tolerance
-        taken = len(possible)
-        last_arrival = self._last_arrival
-        for reading in readings:
-            if reading.damaged_before:
-                sequence.discarded(reading.damaged_before)
-            problem = check_reading(reading, tolerance)
-            if problem is not None:
-                counters.rejected += 1
-                sequence.discarded(1)
-                if counters.rejected <= LOGGED_REJECTIONS:
-                    log.warning("tracker %s: impossible record discarded: %s", self.name, problem)
-                continue
-            t_arrival = reading.t_arrival
-            sequence.accept(reading.seq, reading.device_time)
-            mapping.observe(reading.device_time, t_arrival)
-            possible.append(reading)
-            if last_arrival is not None and t_arrival - last_arrival > GAP_S:
-                self._event("gap", f"no samples for {t_arrival - last_arrival:.3f} s", t_arrival)
-            last_arrival = t_arrival
-        self._last_arrival = last_arrival
-        counters.received += len(possible) - taken
-
-    def _map(self, possible: list[Reading], records: list[TrackerRecord]) -> None:
-        """Maps the clock of readings taken together, in one call (so they keep their order in sensor
-        time), and adds their records to `records`."""
-        if not possible:
+        problems = keep_possible(readings, self._unit_tolerance)
+        if problems:
+            self._reject(problems)
+        self._sequence.accept(readings)
+        if not readings:
             return
-        arrivals = list(map(_T_ARRIVAL, possible))
-        device_times = list(map(_DEVICE_TIME, possible))
-        sensor_times = self.mapping.sensor_times(device_times, arrivals)
-        if self.mapping.latency_known:
-            self.latency.add_many([t_arrival - t_sensor for t_arrival, t_sensor in zip(arrivals, sensor_times)])
-        fields = (map(_POSITION, possible), map(_ORIENTATION, possible), device_times, map(_SEQ, possible), map(_RATE, possible))
+        mapping, arrivals, device_times = self.mapping, readings.arrivals, readings.device_times
+        mapping.observe_many(device_times, arrivals)
+        self._note_gaps(arrivals)
+        self.counters.received += len(arrivals)
+        sensor_times = mapping.sensor_times(device_times, arrivals)
+        if mapping.latency_known:
+            self.latency.add_many(map(sub, arrivals, sensor_times))
+        fields = (readings.positions, readings.orientations, device_times or _NONE, readings.seqs or _NONE, readings.rates or _NONE)
         records.extend(map(_record, zip(sensor_times, arrivals, *fields)))
+
+    def _reject(self, problems: list[str]) -> None:
+        counters = self.counters
+        for problem in problems:
+            counters.rejected += 1
+            if counters.rejected <= LOGGED_REJECTIONS:
+                log.warning("tracker %s: impossible record discarded: %s", self.name, problem)
+
+    def _note_gaps(self, arrivals: list[float]) -> None:
+        """A gap event for each silence longer than GAP_S before a sample."""
+        last = self._last_arrival
+        for t_arrival in arrivals:
+            if last is not None and t_arrival - last > GAP_S:
+                self._event("gap", f"no samples for {t_arrival - last:.3f} s", t_arrival)
+            last = t_arrival
+        self._last_arrival = last
 
     def _wake(self) -> None:
         """Wakes a consumer in `wait_records`: the reader appends without the lock (a deque's append

@@ -39,17 +39,17 @@ def test_a_shipped_profile_round_trips_a_pose_through_encoder_and_decoder(name: 
     emission = Emission(17, 123.456789, (0.1, -0.25, 0.5), tuple(turn), (0.2, -0.1, 1.5))
     decoder = decoder_for(profile)
     encoded = RecordEncoder(profile).encode(emission)
-    (reading,) = decoder.feed(encoded, 1.0)
-    assert decoder.corrupt == 0
+    readings = decoder.feed(encoded, 1.0)
+    assert decoder.corrupt == 0 and len(readings) == 1
     tolerance = 1e-4 if profile.format == "hid" else 1e-6
-    q = np.array(reading.orientation)
+    q = np.array(readings.orientations[0])
     assert min(np.abs(q - turn).max(), np.abs(q + turn).max()) < tolerance
     if profile.has("px"):
-        np.testing.assert_allclose(reading.position, emission.position, atol=1e-6)
+        np.testing.assert_allclose(readings.positions[0], emission.position, atol=1e-6)
     if profile.has("t"):
-        assert reading.device_time == pytest.approx(emission.device_time, abs=1e-6)
+        assert readings.device_times[0] == pytest.approx(emission.device_time, abs=1e-6)
     if profile.has("wx"):
-        np.testing.assert_allclose(reading.angular_rate, emission.angular_rate, atol=math.radians(0.0625))
+        np.testing.assert_allclose(readings.rates[0], emission.angular_rate, atol=math.radians(0.0625))
 
 
 @given(st.sampled_from(["ZYX", "XYZ", "zyx", "xyz", "ZXZ", "yxy"]), st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3))

@@ -31,8 +31,9 @@ def _pieces(data: bytes, cuts: list[int]) -> list[bytes]:
 def test_any_bytes_decode_to_readings_or_counted_damage(name: str, data: bytes, cuts: list[int]) -> None:
     decoder = decoder_for(load_profile(name))
     for piece in _pieces(data, cuts):
-        for reading in decoder.feed(piece, 1.0):
-            assert len(reading.position) == 3 and len(reading.orientation) == 4
+        readings = decoder.feed(piece, 1.0)
+        assert all(len(position) == 3 for position in readings.positions)
+        assert all(len(orientation) == 4 for orientation in readings.orientations)
 
 
 unit_quaternion = st.tuples(*[st.floats(-1.0, 1.0)] * 4).filter(lambda q: sum(v * v for v in q) > 0.01).map(
@@ -51,11 +52,11 @@ def _assert_decodes_to_what_was_sent(name: str, sent: Emission) -> None:
     profile = load_profile(name)
     readings = decoder_for(profile).feed(RecordEncoder(profile).encode(sent), 1.0)
     assert len(readings) == 1
-    reading = readings[0]
+    (position,), (orientation,) = readings.positions, readings.orientations
     if profile.has(*POSITION):
-        assert reading.position == pytest.approx(sent.position, abs=POSITION_TOLERANCE_M)
-    same_sign = 1.0 if sum(a * b for a, b in zip(reading.orientation, sent.orientation)) >= 0 else -1.0
-    assert [same_sign * v for v in reading.orientation] == pytest.approx(sent.orientation, abs=ORIENTATION_TOLERANCE)
+        assert position == pytest.approx(sent.position, abs=POSITION_TOLERANCE_M)
+    same_sign = 1.0 if sum(a * b for a, b in zip(orientation, sent.orientation)) >= 0 else -1.0
+    assert [same_sign * v for v in orientation] == pytest.approx(sent.orientation, abs=ORIENTATION_TOLERANCE)
 
 
 @pytest.mark.parametrize("name", PROFILES)
