@@ -261,16 +261,21 @@ def test_a_damaged_record_between_intact_ones_of_one_chunk_is_not_counted_droppe
     assert (counters["corrupt"], counters["dropped"]) == (1, 0), "record 2 arrived damaged: counted corrupt, not dropped"
 
 
-def test_a_binary_record_cut_at_every_byte_offset_decodes_once_stamped_by_its_last_byte() -> None:
-    profile = load_profile("binary-pose")
+@pytest.mark.parametrize("profile_name", ["binary-pose", "csv", "polhemus-ascii"])
+def test_a_record_cut_at_every_byte_offset_decodes_once_stamped_by_its_last_byte(profile_name: str) -> None:
+    """Three records in two feeds, cut at every byte (in a sync, a check, a two-byte terminator)."""
+    profile = load_profile(profile_name)
     encoder = RecordEncoder(profile)
-    wire = b"".join(encoder.encode(e) for e in emissions(3))
-    size = len(wire) // 3
+    records = [encoder.encode(e) for e in emissions(3)]
+    wire, ends = b"".join(records), np.cumsum([len(r) for r in records]).tolist()
+    whole = decoder_for(profile).feed(wire, 1.0)
+    assert len(whole) == 3
     for cut in range(1, len(wire)):
         decoder = decoder_for(profile)
         first, second = decoder.feed(wire[:cut], 1.0), decoder.feed(wire[cut:], 2.0)
-        assert first.seqs + second.seqs == [0, 1, 2], f"cut at byte {cut}"
-        assert first.arrivals + second.arrivals == [1.0 if (k + 1) * size <= cut else 2.0 for k in range(3)]
+        assert first.positions + second.positions == whole.positions, f"cut at byte {cut}"
+        assert first.orientations + second.orientations == whole.orientations
+        assert first.arrivals + second.arrivals == [1.0 if end <= cut else 2.0 for end in ends]
         assert decoder.corrupt == 0
 
 
