@@ -91,7 +91,7 @@ class ReadingMaker:
         self._quaternion = _group(profile, QUATERNION, 1.0)
         self._euler_angles = _group(profile, EULER, RADIANS_PER[profile.angle_unit])
         self._rate = _group(profile, RATE, RADIANS_PER[profile.angle_unit])
-        names = profile.names
+        names = _value_names(profile)
         seq_field = profile.field(SEQUENCE)
         self._seq = itemgetter(names.index(SEQUENCE)) if seq_field else None
         self._seq_as_text = seq_field is not None and seq_field.integer_bits is None
@@ -136,12 +136,17 @@ _ORIGIN = (0.0, 0.0, 0.0)
 _Group = tuple[Callable[[Sequence[float]], tuple], tuple[float, ...] | None]
 
 
+def _value_names(profile: Profile) -> list[str]:
+    """The names of the fields that give a value, in order: a record's values skip its padding."""
+    return [f.name for f in profile.fields if not f.code.endswith("x")]
+
+
 def _group(profile: Profile, names: tuple[str, ...], unit: float) -> _Group | None:
     """How to pick the fields `names` out of a record's values, and their factors (None: all 1, on
     float fields); None where the profile has no such fields."""
     if not profile.has(*names):
         return None
-    indices = [profile.names.index(name) for name in names]
+    indices = [_value_names(profile).index(name) for name in names]
     factors = tuple(profile.scale.get(name, 1.0) * unit for name in names)
     floats = all(profile.field(name).integer_bits is None for name in names)  # type: ignore[union-attr]
     return itemgetter(*indices), (None if floats and all(f == 1.0 for f in factors) else factors)

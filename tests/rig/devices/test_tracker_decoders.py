@@ -192,6 +192,19 @@ def test_integer_fields_with_unit_scale_decode_to_floats() -> None:
     assert readings.orientations == [(1.0, 0.0, 0.0, 0.0)] and readings.device_times is None
 
 
+@pytest.mark.parametrize("checksum", ["none", "crc32"])
+def test_padding_before_the_fields_takes_no_value(checksum: str) -> None:
+    profile = parse_profile(
+        f'format = "binary"\nsync = "a5"\nchecksum = "{checksum}"\n'
+        'fields = ["_:pad2", "t:u32", "x:pad1", "qw:f32", "qx:f32", "qy:f32", "qz:f32"]\n',
+        "test", "padded",
+    )
+    sent = Emission(0, 12.0, (0.0, 0.0, 0.0), (0.6, 0.8, 0.0, 0.0))
+    readings = decoder_for(profile).feed(RecordEncoder(profile).encode(sent), 1.0)
+    assert readings.device_times == [12.0]
+    assert readings.orientations == [pytest.approx((0.6, 0.8, 0.0, 0.0), abs=1e-7)]
+
+
 def test_the_latency_histogram_gives_median_and_95th_percentile() -> None:
     histogram = LatencyHistogram()
     for latency in np.linspace(0.0, 0.01, 1001):
