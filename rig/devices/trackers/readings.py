@@ -3,13 +3,14 @@ values away from a predictor.
 
 `Readings` are the records a decoder found in one feed before their clock is mapped, column by
 column: the host's arrival times, the device's own times and record counters where it sends them,
-positions in metres, orientations as they came (maybe not of unit norm), and angular rates where
-the profile has them. `ReadingMaker` picks and scales the columns with `map` and `itemgetter`
-rather than a Python loop per field or per record (at 1000 records a second the decoding is most
-of the consumer's cost, and it runs cold, a batch every few ms); `keep_possible` removes the
-impossible ones, in one loop over the batch that normalises the quaternions as it checks them, and
-says what is wrong with each reading only where that loop finds something. Euler angles become a quaternion with plain float arithmetic (a call
-into scipy per sample would cost more than the whole reading budget)."""
+positions in metres, orientations as they came (maybe not of unit norm), and angular rates where the
+profile has them. `ReadingMaker` picks and scales the columns with `map` and `itemgetter` rather
+than a Python loop per field or per record (at 1000 records a second the decoding is most of the
+consumer's cost, and it runs cold, a batch every few ms); `keep_possible` removes the impossible
+ones, in one loop over the batch that normalises the quaternions as it checks them, and says what is
+wrong with each reading only where that loop finds something. Euler angles become a quaternion with
+plain float arithmetic (a call into scipy per sample would cost more than the whole reading budget).
+"""
 
 from __future__ import annotations
 

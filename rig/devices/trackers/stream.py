@@ -13,11 +13,12 @@ without a descriptor, HID, a test's clock) the stream's thread is the reader, in
 never blocks, or `wait(timeout)`, takes every queued chunk and decodes them together into columns
 (`Readings`), checked and counted a batch at a time, then maps the device times of all it took onto
 the rig clock in one call. It runs cold, every 20 ms or so, where each distinct function it calls
-costs several microseconds to bring back into the caches, more than a record's work: so each step
-is one loop over the batch (or one call that does the batch in C), not a chain of small batch
-operations, and no Python call or object per record beyond the record itself. A record is
-available to a predictor from its arrival time, when the reader queued the chunk that completed it. A lost link is logged, leaves a gap, and is reopened until the
-stream is closed; everything that happened is in `report()`. One thread consumes a stream.
+costs several microseconds to bring back into the caches, more than a record's work: so each step is
+one loop over the batch (or one call that does the batch in C), not a chain of small batch
+operations, and no Python call or object per record beyond the record itself. A record is available
+to a predictor from its arrival time, when the reader queued the chunk that completed it. A lost
+link is logged, leaves a gap, and is reopened until the stream is closed; everything that happened
+is in `report()`. One thread consumes a stream.
 """
 
 from __future__ import annotations
