@@ -9,13 +9,13 @@ key out (TOML has no null).
 from __future__ import annotations
 
 import dataclasses
-import tomllib
 import types
 import typing
 from pathlib import Path
 from typing import Any, TypeVar
 
 from rig.errors import ConfigError
+from rig.service.sweep import read_toml
 
 Spec = TypeVar("Spec")
 
@@ -23,13 +23,7 @@ Spec = TypeVar("Spec")
 def read_spec(kind: type[Spec], path: Path) -> Spec:
     """The `kind` dataclass a TOML file sets (its defaults where the file is silent); ConfigError on
     a file that cannot be read, an unknown key, or a value of the wrong type."""
-    try:
-        table = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as error:
-        raise ConfigError(f"cannot read the spec {path}: {error.strerror}") from None
-    except tomllib.TOMLDecodeError as error:
-        raise ConfigError(f"{path} is not valid TOML: {error}") from None
-    return _dataclass(kind, table, "", str(path))
+    return _dataclass(kind, read_toml(path, "spec"), "", str(path))
 
 
 def _dataclass(kind: type[Spec], table: dict[str, Any], prefix: str, where: str) -> Spec:

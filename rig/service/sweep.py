@@ -219,14 +219,19 @@ def write_sweep(sweep: Sweep, path: Path, comment: str = "") -> None:
         raise ConfigError(f"cannot write the sweep {path}: {error.strerror}") from None
 
 
-def read_sweep(path: Path) -> Sweep:
-    """A sweep from its TOML file; ConfigError naming what is wrong."""
+def read_toml(path: Path, what: str) -> dict[str, Any]:
+    """The tables of a TOML file (`what` it is, for the message); ConfigError if it cannot be read."""
     try:
-        spec = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        return tomllib.loads(Path(path).read_text(encoding="utf-8"))
     except OSError as error:
-        raise ConfigError(f"cannot read the sweep {path}: {error.strerror}") from None
+        raise ConfigError(f"cannot read the {what} {path}: {error.strerror}") from None
     except tomllib.TOMLDecodeError as error:
         raise ConfigError(f"{path} is not valid TOML: {error}") from None
+
+
+def read_sweep(path: Path) -> Sweep:
+    """A sweep from its TOML file; ConfigError naming what is wrong."""
+    spec = read_toml(path, "sweep")
     unknown = set(spec) - {"base", "grid", "points", "analysis"}
     if unknown:
         raise ConfigError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}; a sweep has [base], [grid], [[points]] and [analysis]")
