@@ -223,29 +223,53 @@ def targets(rows: list[dict[str, Any]]) -> dict[str, bool]:
     }  # fmt: skip
 
 
+def cpu_ticks() -> tuple[int, int] | None:
+    """The machine's CPU time so far, in clock ticks: (stolen by the hypervisor, all), from
+    /proc/stat; None where there is none."""
+    try:
+        with open("/proc/stat") as stat:
+            fields = [int(value) for value in stat.readline().split()[1:]]
+    except (OSError, ValueError):
+        return None
+    # user nice system idle iowait irq softirq steal [guest guest_nice, already counted in user, nice]
+    return (fields[7], sum(fields[:8])) if len(fields) >= 8 else None
+
+
+def stolen_pct(before: tuple[int, int] | None, after: tuple[int, int] | None) -> float | None:
+    """The share of the machine's CPU time a virtual machine's host took between two `cpu_ticks`."""
+    if before is None or after is None or after[1] <= before[1]:
+        return None
+    return 100.0 * (after[0] - before[0]) / (after[1] - before[1])
+
+
 def run_bench(rate_hz: float, duration_s: float, folder: Path, log: Callable[[str], None]) -> dict[str, Any]:
-    """Every case in turn; each row also holds the machine's 1-minute load average when it started
-    and the wake floor measured just before it (the noise its figures carry)."""
+    """Every case in turn; each row also holds the noise its figures carry: the machine's 1-minute
+    load average when it started, the wake floor measured just before it, and the share of the CPU
+    the host of a virtual machine took during it (a stolen stretch delays records by milliseconds,
+    which shows in the latency's 95th percentile first)."""
     rows = []
     for index, case in enumerate(cases(fault_at_s=duration_s / 2.0)):
         load = os.getloadavg()[0]
         floor = wake_floor(rate_hz, WAKE_FLOOR_S, folder / f"floor{index}")
-        rows.append({**run_case(case, rate_hz, duration_s, folder / f"case{index}", log), "load_average_1min": load, "wake_floor_us": floor})
+        before = cpu_ticks()
+        row = run_case(case, rate_hz, duration_s, folder / f"case{index}", log)
+        rows.append({**row, "load_average_1min": load, "wake_floor_us": floor, "stolen_cpu_pct": stolen_pct(before, cpu_ticks())})
     return {"rows": rows, "targets_met": targets(rows)}
 
 
 def table(rows: list[dict[str, Any]]) -> str:
     head = (
         "| source | transport | profile | faults | sent | recorded | missing | fabricated | corrupt (damaged) "
-        "| us/sample: reading (reader thread), process | wake floor us | latency ms median, p95 |"
+        "| us/sample: reading (reader thread), process | wake floor us | CPU stolen % | latency ms median, p95 |"
     )
     lines = [head, "|" + " --- |" * (head.count("|") - 1)]
     for r in rows:
         latency = f"{r['latency_ms_median']:.3f}, {r['latency_ms_p95']:.3f}" if r["latency_ms_median"] is not None else "n/a"
+        stolen = f"{r['stolen_cpu_pct']:.1f}" if r.get("stolen_cpu_pct") is not None else "n/a"
         lines.append(
             f"| {r['source']} | {r['transport']} | {r['profile']} | {r['faults']} | {r['sent']} | {r['recorded']} | {r['missing']} | "
             f"{r['fabricated']} | {r['corrupt']} ({r['damaged_sent']}) | {r['reading_us_per_sample']:.1f} ({r['reader_us_per_sample']:.1f}), "
-            f"{r['us_per_sample']:.1f} | {r['wake_floor_us']:.1f} | {latency} |"
+            f"{r['us_per_sample']:.1f} | {r['wake_floor_us']:.1f} | {stolen} | {latency} |"
         )
     return "\n".join(lines)
 

@@ -241,7 +241,9 @@ def _run_trackers(args: argparse.Namespace) -> int:
     for target, met in report["targets_met"].items():
         print(f"{target}: {'met' if met else 'not met'}")
     loads = [row["load_average_1min"] for row in report["rows"]]
-    print(f"machine noise: {os.cpu_count()} CPUs, 1-minute load average {min(loads):.2f} to {max(loads):.2f} over the cases")
+    stolen = [row["stolen_cpu_pct"] for row in report["rows"] if row["stolen_cpu_pct"] is not None]
+    print(f"machine noise: {os.cpu_count()} CPUs, 1-minute load average {min(loads):.2f} to {max(loads):.2f} over the cases"
+          + (f", CPU stolen by the virtual machine's host {min(stolen):.1f} to {max(stolen):.1f} %" if stolen else ""))  # fmt: skip
     writes.check()
     return 0
 

@@ -28,9 +28,20 @@ def test_the_table_and_the_plot_show_every_row(tmp_path: Path) -> None:
         "source": "serial", "transport": "pty", "profile": "csv", "faults": "corrupt=0.01,disconnect=5:0.5", "sent": 10,
         "recorded": 9, "missing": 0, "fabricated": 0, "corrupt": 1, "damaged_sent": 1, "reading_us_per_sample": 40.0,
         "reader_us_per_sample": 20.0, "us_per_sample": 70.0, "wake_floor_us": 18.0, "latency_ms_median": 0.1,
-        "latency_ms_p95": 0.4,
+        "latency_ms_p95": 0.4, "stolen_cpu_pct": 2.5,
     }  # fmt: skip
-    lines = trackers.table([row, {**row, "source": "lsl"}]).splitlines()
-    assert len(lines) == 4 and "40.0 (20.0), 70.0 | 18.0" in lines[2]
+    lines = trackers.table([row, {**row, "source": "lsl", "stolen_cpu_pct": None}]).splitlines()
+    assert len(lines) == 4 and "40.0 (20.0), 70.0 | 18.0 | 2.5 | 0.100, 0.400 |" in lines[2]
+    assert "| 18.0 | n/a | 0.100" in lines[3]
     trackers.plot([row], tmp_path / "trackers.png")
     assert (tmp_path / "trackers.png").stat().st_size > 0
+
+
+def test_the_cpu_a_host_took_is_its_share_of_the_ticks_between_two_readings() -> None:
+    assert trackers.stolen_pct((10, 1000), (40, 2000)) == 3.0
+    assert trackers.stolen_pct(None, (40, 2000)) is None
+    assert trackers.stolen_pct((10, 1000), (10, 1000)) is None, "no time passed"
+    ticks = trackers.cpu_ticks()
+    if ticks is not None:
+        stolen, total = ticks
+        assert 0 <= stolen <= total
