@@ -3,8 +3,8 @@
 Four kinds of run: the grid (cost, latency and image error of the direct and the warp renderer
 against scene size and resolution, `rig.bench.renderers`; a spec file, the options over it),
 `--seed-table` (the seeds' Table 2 beside this machine's, `rig.bench.seed_table`), `--variants`
-(image error against latency saved per warp variant, `rig.bench.warp_variants`) and `--photon-
-residual` (how near zero prediction brings the latency, `rig.bench.photon_residual`).
+(image error against latency saved per warp variant, `rig.bench.warp_variants`) and
+`--photon-residual` (how near zero prediction brings the latency, `rig.bench.photon_residual`).
 """
 
 from __future__ import annotations
