@@ -33,6 +33,7 @@ def analyse(
     reference_departures: Callable[[Track], Mapping[str, float]] | None = None,
     refresh_hz: float | None = None,
     exposure_ms: float | None = None,
+    readout_ms: float | None = None,
 ) -> LatencyResult:
     """Measure the latency between the LED and the rendered sphere in a video.
 
@@ -53,12 +54,15 @@ def analyse(
     lag that fixes the whole number of periods. ``refresh_hz`` (the display's refresh rate) and
     ``exposure_ms`` (the camera's exposure) are what the user knows of them; without them the video
     is searched for both, to work out how the camera's sampling of the display biases the latency
-    (``analysis.sampling``).
+    (``analysis.sampling``). ``readout_ms`` is the time the camera's rolling shutter takes from the
+    frame's top row to its bottom one (0 for a global shutter): each blob's samples are then dated
+    by their rows; without it the interval allows for any readout up to the frame interval
+    (``analysis.shutter``).
     """
     # The options are checked before the video is read: a typo should not cost a tracking pass.
     estimators = estimators_for(method)
     latency_range_s(latency_range_ms)
-    check_sampling_options(refresh_hz, exposure_ms)
+    check_sampling_options(refresh_hz, exposure_ms, readout_ms)
     preparing = _prepare_in_background(estimators)
     try:
         tracks = track(
@@ -77,6 +81,7 @@ def analyse(
         reference_departures=reference_departures,
         refresh_hz=refresh_hz,
         exposure_ms=exposure_ms,
+        readout_ms=readout_ms,
     )
 
 

@@ -63,18 +63,18 @@ def elongation_along(spread: np.ndarray, axis: tuple[np.ndarray, np.ndarray] | n
 def timing_residuals(
     signals: SwingSignals, latency_s: float, sphere_track: Track | None = None
 ) -> TimingResiduals | None:
-    """The sphere's residuals and speeds against the LED delayed by ``latency_s`` (see the module
-    docstring), with its elongation where ``sphere_track`` (its track over the signals' frames) has its
+    """The sphere's residuals and speeds at its own times against the LED delayed by ``latency_s``
+    (see the module docstring), with its elongation where ``sphere_track`` (its track over the signals' frames) has its
     moments; None when too few frames overlap."""
     grid, led, _ = signals.uniform()
     frame_interval = signals.frame_interval
     if grid.size < 8:
         return None
-    level, slope, inside = _catmull_rom(grid, led, signals.t - latency_s)
+    level, slope, inside = _catmull_rom(grid, led, signals.sphere_t - latency_s)
     used = inside & signals.sphere_valid
     if np.count_nonzero(used) < 32:
         return None
-    t, reference, rate = signals.t[used], level[used], slope[used]
+    t, reference, rate = signals.sphere_t[used], level[used], slope[used]
     sphere = signals.sphere[used]
     scale = max(float(np.std(reference)), 1e-12)
     u = (reference - reference.mean()) / scale
@@ -83,7 +83,7 @@ def timing_residuals(
     coefficients, *_ = np.linalg.lstsq(basis, sphere, rcond=None)
     residual = sphere - basis @ coefficients
     speed = (coefficients[1] + 2 * coefficients[2] * u + 3 * coefficients[3] * u**2) * rate / scale
-    index = np.rint((t - signals.t[0]) / frame_interval).astype(np.int64)
+    index = np.rint((signals.t[used] - signals.t[0]) / frame_interval).astype(np.int64)
     elongation = None
     if sphere_track is not None and sphere_track.spread is not None:
         valid = sphere_track.valid

@@ -38,6 +38,7 @@ def _run(args: argparse.Namespace) -> int:
         board=args.board,
         display_hz=args.display_hz,
         exposure_ms=args.exposure_ms,
+        readout_ms=args.readout_ms,
     )
     if is_batch(args, videos):
         check_batch_options(args)
@@ -94,6 +95,12 @@ def add_analysis_options(parser: argparse.ArgumentParser) -> None:
         "--exposure-ms",
         type=options.positive_float,
         help="the camera's exposure in ms, if known (default: estimated from the LED's motion blur)",
+    )
+    parser.add_argument(
+        "--readout-ms",
+        type=options.non_negative_float,
+        help="the camera's rolling-shutter readout in ms, top row to bottom row (0 for a global shutter), if known: "
+        "each blob is then timed by its rows (default: any readout up to the frame interval is allowed for)",
     )
 
 

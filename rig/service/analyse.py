@@ -25,7 +25,8 @@ DEFAULT_LATENCY_RANGE_MS = (DEFAULT_LATENCY_RANGE_S[0] * 1e3, DEFAULT_LATENCY_RA
 class AnalysisRequest:
     """What to analyse and how (see `analysis.analyse`); `board` is a board recording folder;
     `display_hz` and `exposure_ms` are the display's refresh rate and the camera's exposure, where
-    the lab knows them (else the video is searched for both)."""
+    the lab knows them (else the video is searched for both); `readout_ms` the camera's rolling-shutter
+    readout, 0 for a global shutter (else bounded by the frame rate)."""
 
     video: Path
     fps: float | None = None
@@ -39,6 +40,7 @@ class AnalysisRequest:
     board: Path | None = None
     display_hz: float | None = None
     exposure_ms: float | None = None
+    readout_ms: float | None = None
 
 
 @dataclass(frozen=True)
@@ -69,5 +71,6 @@ def analyse(request: AnalysisRequest, progress: Callable[[int, int], object] | N
         reference_departures=board.departures if board is not None else None,
         refresh_hz=request.display_hz,
         exposure_ms=request.exposure_ms,
+        readout_ms=request.readout_ms,
     )
     return Measurement(result, board)
