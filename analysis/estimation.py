@@ -98,7 +98,14 @@ def estimate(
     half_width_s = (measured.ci95_ms[1] - measured.ci95_ms[0]) / 2e3 if measured.ci95_ms is not None else 0.0
     checks = check_fit(swing, windowed_latency(swing.windows, measured.latency_ms / 1e3), residuals, half_width_s)
     sampling = (
-        measure_sampling(residuals, led_track, swing.period_s, refresh_hz, None if exposure_ms is None else exposure_ms / 1e3)
+        measure_sampling(
+            residuals,
+            led_track,
+            swing.period_s,
+            refresh_hz,
+            None if exposure_ms is None else exposure_ms / 1e3,
+            (shutter.row_time_s, shutter.row_time_range_s),
+        )
         if residuals is not None
         else None
     )

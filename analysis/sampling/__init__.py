@@ -19,9 +19,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.sampling.exposure import Exposure, exposure_from_blur, given_exposure
-from analysis.sampling.inference import RATE_TOLERANCE, RefreshHypothesis, refresh_hypotheses
+from analysis.sampling.inference import RefreshHypothesis, refresh_hypotheses
 from analysis.sampling.model import commensurate
+from analysis.sampling.rates import RATE_TOLERANCE
 from analysis.sampling.residuals import TimingResiduals
+from analysis.sampling.rows import SphereRows
 from analysis.tracking import Track
 
 # Residuals may be correlated over this fraction of a swing period.
@@ -200,16 +202,21 @@ def measure_sampling(
     period_s: float,
     refresh_hz: float | None = None,
     exposure_s: float | None = None,
+    row_time_s: tuple[float, tuple[float, float]] = (0.0, (0.0, 0.0)),
 ) -> SamplingBias:
     """What the camera's sampling of the display may do to the latency, from the sphere's timing
     residuals against the LED (``analysis.sampling.residuals``) and the LED's track (its blur);
     ``refresh_hz`` and ``exposure_s`` are the display's refresh and the camera's exposure where the
-    user knows them. The correction is left at 0 unless the video identifies the bias: every rate it
+    user knows them; ``row_time_s`` the time per row the sphere's samples were dated by and the range
+    the camera's true time per row lies in (``analysis.shutter``). The correction is left at 0 unless the video identifies the bias: every rate it
     allows agrees, and the bias's 95 % range is narrow against its size."""
     frame_interval = residuals.frame_interval
     exposure = given_exposure(exposure_s, frame_interval) if exposure_s is not None else exposure_from_blur(led, frame_interval)
     bandwidth = max(1, round(CORRELATION_PERIODS * period_s / frame_interval))
-    hypotheses = refresh_hypotheses(residuals, 1.0 / frame_interval, refresh_hz, (exposure.low_s, exposure.high_s), bandwidth)
+    rows = None
+    if residuals.rows is not None:
+        rows = SphereRows(residuals.rows - float(np.mean(residuals.rows)), residuals.row_sd, *row_time_s)
+    hypotheses = refresh_hypotheses(residuals, 1.0 / frame_interval, refresh_hz, (exposure.low_s, exposure.high_s), bandwidth, rows)
     best = hypotheses[0]
     ranges = [h.range_s(*BIAS_RANGE) for h in hypotheses]
     low, high = min(r[0] for r in ranges), max(r[1] for r in ranges)

@@ -23,9 +23,11 @@ from analysis.tracking import Track
 
 @dataclass(frozen=True)
 class TimingResiduals:
-    """Per used frame: its time (s), the sphere's residual r (px) and speed v (px/s) against the LED
-    reference, the frame's index on the camera's frame grid (for spectra), and the sphere's variance
-    along its motion less across it (px^2; NaN where not measured, None without its moments)."""
+    """Per used frame: the sphere's time (s, from the first frame's), its residual r (px) and speed
+    v (px/s) against the LED reference, the frame's index on the camera's frame grid (for spectra),
+    and the sphere's variance along its motion less across it (px^2; NaN where not measured, None
+    without its moments) and its centroid row (px; None without its track); row_sd is the standard
+    deviation of its light over its rows (px; 0 unknown), the median over frames."""
 
     t: np.ndarray
     r: np.ndarray
@@ -33,6 +35,8 @@ class TimingResiduals:
     index: np.ndarray
     frame_interval: float
     elongation: np.ndarray | None = None
+    rows: np.ndarray | None = None
+    row_sd: float = 0.0
 
 
 def _catmull_rom(grid_t: np.ndarray, values: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -84,11 +88,14 @@ def timing_residuals(
     residual = sphere - basis @ coefficients
     speed = (coefficients[1] + 2 * coefficients[2] * u + 3 * coefficients[3] * u**2) * rate / scale
     index = np.rint((signals.t[used] - signals.t[0]) / frame_interval).astype(np.int64)
-    elongation = None
-    if sphere_track is not None and sphere_track.spread is not None:
-        valid = sphere_track.valid
-        elongation = elongation_along(sphere_track.spread, main_axis(sphere_track.x[valid], sphere_track.y[valid]))[used]
-    return TimingResiduals(t - signals.t[0], residual, speed, index, frame_interval, elongation)
+    elongation, rows, row_sd = None, None, 0.0
+    if sphere_track is not None:
+        rows = sphere_track.y[used]
+        if sphere_track.spread is not None:
+            valid = sphere_track.valid
+            elongation = elongation_along(sphere_track.spread, main_axis(sphere_track.x[valid], sphere_track.y[valid]))[used]
+            row_sd = float(np.sqrt(max(float(np.median(sphere_track.spread[valid, 1])), 0.0)))
+    return TimingResiduals(t - signals.t[0], residual, speed, index, frame_interval, elongation, rows, row_sd)
 
 
 def inflation(series: np.ndarray, bandwidth: int) -> float:
