@@ -3,7 +3,7 @@
 ``analyse(video)`` tracks the pendulum's LED and the rendered sphere, and measures by how much the
 sphere lags the LED. It is two parts, which can be called alone: ``track(video) -> Tracks`` (read,
 calibrate, track, time and check) and ``estimate(tracks, method) -> LatencyResult`` (the free
-swing, the whole number of periods, the estimators). ``write_tracks_csv`` saves tracks; the
+swing, the whole number of periods, the estimators). ``Tracks.write_csv`` saves tracks; the
 estimators are listed by ``methods()``, and ``register_estimator`` adds one (see
 ``analysis.estimators``). JAX is imported only when a fit (sinefit, bayes) is asked for, and no
 import changes a JAX setting.
@@ -14,7 +14,6 @@ from analysis.estimation import estimate
 from analysis.estimators.contract import EstimationContext, Estimator
 from analysis.estimators.registry import methods, register_estimator, unregister_estimator
 from analysis.pipeline import analyse
-from analysis.report import write_tracks_csv
 from analysis.result import LatencyResult, MethodResult
 from analysis.tracks import Tracks, track
 
@@ -31,5 +30,4 @@ __all__ = [
     "register_estimator",
     "track",
     "unregister_estimator",
-    "write_tracks_csv",
 ]

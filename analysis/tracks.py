@@ -37,7 +37,7 @@ from analysis.calibration import (
 from analysis.errors import AnalysisError
 from analysis.identity import Identity, decide
 from analysis.phase import estimate_frequency
-from analysis.report import TrackStream, write_tracks_csv
+from analysis.tracks_csv import TrackStream, write_tracks_csv
 from analysis.signals import swing_signals
 from analysis.timing import FrameTimes, check_count, frame_times, repeated_frames
 from analysis.tracking import BlobTracker, Detection, Roi, Track
@@ -79,6 +79,10 @@ class Tracks:
     warnings: tuple[str, ...]
     diagnostics: dict[str, Any]
     seconds: float
+
+    def write_csv(self, path: str | Path) -> None:
+        """Write both tracks to a CSV file, one row per frame (``analysis.tracks_csv``)."""
+        write_tracks_csv(path, self.stamps, self.led, self.sphere)
 
 
 class _Tracked:
@@ -263,7 +267,7 @@ def track(
     AnalysisError asks for the ROIs when it does not decide). ``progress(done, total)`` is called
     as frames are tracked (for clips of PROGRESS_MIN_SECONDS or more). ``tracks_csv`` receives
     every frame's row as it is measured (the left blob first as the LED while that is undecided),
-    then the final table once the frame times are decided (``analysis.report``); it is
+    then the final table once the frame times are decided (``analysis.tracks_csv``); it is
     written before the tracks are checked, so tracks that fail a check stay on disk to look at.
     """
     if led_side is not None and led_side not in SIDES:
@@ -309,7 +313,7 @@ def track(
         led, sphere, stamps, times, led_roi, sphere_roi, calibration.roi_source, rule, tuple(warnings), diagnostics, seconds
     )
     if tracks_csv is not None:
-        write_tracks_csv(tracks_csv, tracks)
+        tracks.write_csv(tracks_csv)
     check_track(led, "LED", warnings)
     check_track(sphere, "sphere", warnings)
     return dataclasses.replace(tracks, warnings=tuple(warnings))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from analysis import AnalysisError, analyse
-from analysis.report import TRACKS_CSV_HEADER
+from analysis.tracks_csv import TRACKS_CSV_HEADER
 
 COLUMN = {name: index for index, name in enumerate(TRACKS_CSV_HEADER)}
 
