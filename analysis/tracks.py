@@ -38,10 +38,10 @@ from analysis.calibration import (
 from analysis.errors import AnalysisError
 from analysis.identity import Identity, decide
 from analysis.phase import estimate_frequency
-from analysis.tracks_csv import TrackStream, write_tracks_csv
 from analysis.signals import swing_signals
 from analysis.timing import FrameTimes, check_count, frame_times, recorder_repeats
 from analysis.tracking import BlobTracker, Detection, Roi, Track
+from analysis.tracks_csv import TrackStream, write_tracks_csv
 from analysis.video.file import VideoFile
 from analysis.video.frames import Crop, Frame, FrameSource, Repeats
 from analysis.video.sources import open_frames
