@@ -47,8 +47,8 @@ class Setting:
     range: the numbers allowed (for a list, each item's). choices: the names allowed, or a function
     that lists them when asked (a registry that grows). rule: a check of the whole value, giving a
     sentence saying what is wrong or None ("LOW must be below HIGH").
-    none: the word that sets None on the command line and in a spec ("measured"); a setting whose
-    default is None is None by being left out, and its help says what None does.
+    none: the word that sets None on the command line and in a spec ("measured").
+    unset: what None does, where the default is None ("found in the video"), for --help and the docs.
     flag: the command-line option, if there is one.
     """
 
@@ -58,6 +58,7 @@ class Setting:
     choices: tuple[str, ...] | Callable[[], tuple[str, ...]] | None = None
     rule: Callable[[Any], str | None] | None = None
     none: str = ""
+    unset: str = ""
     flag: Flag | None = None
 
     def allowed(self) -> tuple[str, ...] | None:
@@ -84,7 +85,7 @@ def _is_number(value: Any) -> bool:
 
 def setting(default: Any, unit: str, help: str, range: Range | None = None, *, flag: str | Flag | None = None,
             **declared: Any) -> Any:  # fmt: skip
-    """A dataclass field with its `Setting` (`declared`: choices, rule, none); `flag` the option's
+    """A dataclass field with its `Setting` (`declared`: choices, rule, none, unset); `flag` the option's
     name, or a `Flag` where the option differs from the setting."""
     flag = Flag(flag) if isinstance(flag, str) else flag
     return dataclasses.field(default=default, metadata={_KEY: Setting(unit, help, range, flag=flag, **declared)})

@@ -4,7 +4,8 @@ checked against the fields, so that a typo or a wrong type is one line naming th
 Numbers, strings and booleans are themselves; a tuple field is an array (a tuple of tuples, an
 array of arrays); a nested dataclass is a table; a dict field is a table taken as it is; a field
 that may be None is None by leaving its key out (TOML has no null), or by its setting's `none` word
-where the default is not None ("measured"). The values are then checked by the dataclass itself
+where the default is not None ("measured"); None itself, from Python, where the field may hold
+it. The values are then checked by the dataclass itself
 (`declared.check` in its `__post_init__`).
 """
 
@@ -41,9 +42,9 @@ def from_table(kind: type[Config], table: Mapping[str, Any], error: type[Excepti
 
 def _value(hint: Any, declared: Setting | None, value: Any, key: str, at: str, error: type[Exception]) -> Any:
     """`value` as a field declared `hint` holds it."""
-    if declared is not None and declared.none and value == declared.none:
+    hint, nullable = optional(hint)
+    if (declared is not None and declared.none and value == declared.none) or (value is None and nullable):
         return None
-    hint, _ = optional(hint)
     origin, args = typing.get_origin(hint), typing.get_args(hint)
     if dataclasses.is_dataclass(hint):
         if not isinstance(value, Mapping):
@@ -55,7 +56,7 @@ def _value(hint: Any, declared: Setting | None, value: Any, key: str, at: str, e
         return dict(value)
     if origin is tuple:
         repeated = len(args) == 2 and args[1] is Ellipsis
-        if not isinstance(value, list) or (not repeated and len(value) != len(args)):
+        if not isinstance(value, (list, tuple)) or (not repeated and len(value) != len(args)):
             raise error(f"{at}{key} must be {words(hint, declared)}, not {value!r}")
         items = [args[0]] * len(value) if repeated else args
         return tuple(_value(item, None, v, f"{key}[{i}]", at, error) for i, (item, v) in enumerate(zip(items, value)))
