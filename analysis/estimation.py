@@ -15,18 +15,17 @@ when it changed something.
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
-from analysis.cycles import DEFAULT_LATENCY_RANGE_S, resolve_cycles
-from analysis.errors import AnalysisError
+from analysis.cycles import resolve_cycles
 from analysis.estimators.contract import EstimationContext
 from analysis.estimators.registry import ALL, DEFAULT_METHOD, estimators_for
 from analysis.misfit import MisfitReport, check_fit
+from analysis.options import AnalysisOptions
 from analysis.phase import fft_phase_latency
 from analysis.result import LatencyResult, MethodResult
 from analysis.sampling import SamplingBias, measure_sampling
@@ -39,46 +38,34 @@ from analysis.tracks import Tracks
 from analysis.windows import windowed_latency
 
 
-def latency_range_s(latency_range_ms: Sequence[float]) -> tuple[float, float]:
-    """The plausible latency range in s; AnalysisError unless it is two finite numbers, low < high (ms)."""
-    low, high = (float(v) for v in latency_range_ms)
-    if not (math.isfinite(low) and math.isfinite(high) and low < high):
-        raise AnalysisError(f"latency range {list(latency_range_ms)!r} ms must be two finite numbers, low < high")
-    return low / 1e3, high / 1e3
-
-
 def estimate(
     tracks: Tracks,
-    method: str = DEFAULT_METHOD,
+    options: AnalysisOptions = AnalysisOptions(),
     *,
-    latency_range_ms: Sequence[float] = tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S),
-    seed: int = 0,
     reference_departures: Callable[[Track], Mapping[str, float]] | None = None,
-    refresh_hz: float | None = None,
-    exposure_ms: float | None = None,
-    readout_ms: float | None = None,
 ) -> LatencyResult:
     """Measure by how much the sphere lags the LED in tracks from ``analysis.tracks.track``.
 
-    ``method`` is a registered estimator's name (``analysis.estimators.registry.methods()``: fft,
-    xcorr, sinefit, bayes, and any registered since) or "all" (every one, the default method's
-    result reported). Latencies are looked for in ``latency_range_ms``. ``seed`` seeds the bayes
-    sampler. ``reference_departures(led_track)`` names times (s, on the video's clock) at which
-    other instruments saw the pendulum depart from rest, in the sense of ``analysis.onset`` (e.g. a
-    rig board's encoder, its clock aligned by the LED's blink code, which it reads from the LED
-    track); with the sphere's departure each gives a lag that fixes the whole number of periods.
-    ``refresh_hz`` (the display's refresh rate) and ``exposure_ms`` (the camera's exposure) are
-    what the user knows of them; without them the video is searched for both
-    (``analysis.sampling``). ``readout_ms`` is the camera's readout, the time its rolling shutter
-    takes from the frame's top row to its bottom one (0 for a global shutter); without it the
-    interval allows for any readout up to the frame interval (``analysis.shutter``).
+    Of the ``options`` (``analysis.options.AnalysisOptions``), ``method`` is a registered
+    estimator's name (``analysis.estimators.registry.methods()``: fft, xcorr, sinefit, bayes, and
+    any registered since) or "all" (every one, the default method's result reported); latencies are
+    looked for in ``latency_range_ms``; ``seed`` seeds the bayes sampler; ``display_hz`` (the
+    display's refresh rate) and ``exposure_ms`` (the camera's exposure) are what the user knows of
+    them, and without them the video is searched for both (``analysis.sampling``); ``readout_ms``
+    is the camera's readout, the time its rolling shutter takes from the frame's top row to its
+    bottom one (0 for a global shutter), and without it the interval allows for any readout up to
+    the frame interval (``analysis.shutter``).
+    ``reference_departures(led_track)`` names times (s, on the video's clock) at which other
+    instruments saw the pendulum depart from rest, in the sense of ``analysis.onset`` (e.g. a rig
+    board's encoder, its clock aligned by the LED's blink code, which it reads from the LED track);
+    with the sphere's departure each gives a lag that fixes the whole number of periods.
     """
+    method = options.method
     estimators = estimators_for(method)
-    range_s = latency_range_s(latency_range_ms)
-    check_sampling_options(refresh_hz, exposure_ms, readout_ms)
+    range_s = options.latency_range_s
     started = time.perf_counter()
     warnings = list(tracks.warnings)
-    shutter = rolling_shutter(tracks.led, tracks.sphere, tracks.frame_size[1], readout_ms)
+    shutter = rolling_shutter(tracks.led, tracks.sphere, tracks.frame_size[1], options.readout_ms)
     led_track, sphere_track = shutter.dated(tracks.led), shutter.dated(tracks.sphere)
     references = reference_departures(led_track) if reference_departures is not None else {}
     swing = measure_swing(led_track, sphere_track, references)
@@ -90,7 +77,7 @@ def estimate(
     cycles = resolve_cycles(wrapped, swing.period_s, swing.windows, swing.damping, range_s, swing.events_s)
     if cycles.warning:
         warnings.append(cycles.warning)
-    context = EstimationContext(swing, cycles, seed, warnings)
+    context = EstimationContext(swing, cycles, options.seed, warnings)
     results = {estimator.name: estimator.estimate(context) for estimator in estimators}
     primary_name = DEFAULT_METHOD if method == ALL else method
     measured = results[primary_name]
@@ -102,8 +89,8 @@ def estimate(
             residuals,
             led_track,
             swing.period_s,
-            refresh_hz,
-            None if exposure_ms is None else exposure_ms / 1e3,
+            options.display_hz,
+            None if options.exposure_ms is None else options.exposure_ms / 1e3,
             (shutter.row_time_s, shutter.row_time_range_s),
         )
         if residuals is not None
@@ -151,16 +138,6 @@ def estimate(
         led_track=led_track,
         sphere_track=sphere_track,
     )
-
-
-def check_sampling_options(refresh_hz: float | None, exposure_ms: float | None, readout_ms: float | None = None) -> None:
-    """AnalysisError unless the display's refresh and the camera's exposure, where given, are
-    positive finite numbers, and its readout, where given, a finite number of ms, 0 or more."""
-    for name, value, unit in (("refresh_hz", refresh_hz, "Hz"), ("exposure_ms", exposure_ms, "ms")):
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise AnalysisError(f"{name} must be a positive number of {unit}, not {value!r}")
-    if readout_ms is not None and not (math.isfinite(readout_ms) and readout_ms >= 0):
-        raise AnalysisError(f"readout_ms must be a number of ms, 0 (a global shutter) or more, not {readout_ms!r}")
 
 
 def _interval_s(result: MethodResult) -> tuple[float, float] | None:

@@ -6,7 +6,8 @@ it is decoded; from then on only the rectangle around both ROIs is decoded
 (``analysis.video.frames.Crop``). A video that can skip frames and decode rectangles cheaply
 (Motion-JPEG) is instead calibrated on a sample of its first frames and then read again from the
 start, every frame's rectangle alone. With all detections in hand the frame times are decided
-(``analysis.timing``), frames the recorder repeated are left out, and so are frames in which a
+(``analysis.timing``), frames the recorder repeated (whole frames, noted by the source as it
+reads) are left out, and so are frames in which a
 blob shows much less of its light than usual (partly hidden: its centroid is not its centre).
 Where neither the user's ROIs nor a side said which blob is the LED, the whole video's evidence
 decides (``analysis.identity``); when it does not, the analysis stops and asks for the ROIs. Then
@@ -28,7 +29,6 @@ import numpy as np
 
 from analysis.calibration import (
     CALIBRATION_MAX_BYTES,
-    SIDES,
     Calibration,
     calibrate,
     calibration_plan,
@@ -36,13 +36,14 @@ from analysis.calibration import (
 )
 from analysis.errors import AnalysisError
 from analysis.identity import Identity, decide
+from analysis.options import AnalysisOptions
 from analysis.phase import estimate_frequency
-from analysis.report import TrackStream, write_tracks_csv
 from analysis.signals import swing_signals
-from analysis.timing import FrameTimes, check_count, frame_times, repeated_frames
+from analysis.timing import FrameTimes, check_count, frame_times, recorder_repeats
 from analysis.tracking import BlobTracker, Detection, Roi, Track
+from analysis.tracks_csv import TrackStream, write_tracks_csv
 from analysis.video.file import VideoFile
-from analysis.video.frames import Crop, Frame, FrameSource
+from analysis.video.frames import Crop, Frame, FrameSource, Repeats
 from analysis.video.sources import open_frames
 
 # A track must have a blob in at least this fraction of frames; any frame without one is reported.
@@ -81,6 +82,10 @@ class Tracks:
     seconds: float
     frame_size: tuple[int, int]
 
+    def write_csv(self, path: str | Path) -> None:
+        """Write both tracks to a CSV file, one row per frame (``analysis.tracks_csv``)."""
+        write_tracks_csv(path, self.stamps, self.led, self.sphere)
+
 
 class _Tracked:
     """Per-frame detections of both blobs, as lists, while the video is read."""
@@ -115,10 +120,6 @@ class _Tracked:
             mass=mass,
             spread=np.where(valid[:, None], spread, np.nan),
         )
-
-    def positions(self, which: int) -> tuple[np.ndarray, np.ndarray]:
-        rows = self.rows[which]
-        return np.array([d.x for d in rows]), np.array([d.y for d in rows])
 
 
 def _track_frames(
@@ -157,13 +158,14 @@ def _read(
     progress: Callable[[int, int], object] | None,
     tracks_csv: str | Path | None,
     warnings: list[str],
+    repeats: Repeats,
 ) -> tuple[Calibration, _Tracked]:
     """Calibrate on the first frames, then track every frame, each row going to ``tracks_csv`` as
-    it is measured (see the module docstring)."""
+    it is measured (see the module docstring); the source notes whole repeated frames in ``repeats``."""
     crop = Crop()
     wanted, every = calibration_plan(video.fps, video.decodes_in_part)
     with contextlib.ExitStack() as stack:
-        stream = stack.enter_context(contextlib.closing(video.frames(crop, every)))
+        stream = stack.enter_context(contextlib.closing(video.frames(crop, every, repeats)))
         rows = stack.enter_context(TrackStream(tracks_csv)) if tracks_csv is not None else None
         first = next(stream)
         window = calibration_window(first, stream, wanted, CALIBRATION_MAX_BYTES // first[1].nbytes, given)
@@ -172,7 +174,7 @@ def _read(
         if every > 1:
             stream.close()
             window = []
-            stream = stack.enter_context(contextlib.closing(video.frames(crop)))
+            stream = stack.enter_context(contextlib.closing(video.frames(crop, repeats=repeats)))
         crop.to(band_rows, band_cols)
         origin = (band_cols.start, band_rows.start)
         tracked = _track_frames(
@@ -246,36 +248,33 @@ def _rois(
 
 def track(
     source: str | Path | np.ndarray,
+    options: AnalysisOptions = AnalysisOptions(),
     *,
-    fps: float | None = None,
-    led_roi: Sequence[float] | None = None,
-    sphere_roi: Sequence[float] | None = None,
-    led_side: str | None = None,
     progress: Callable[[int, int], object] | None = None,
     tracks_csv: str | Path | None = None,
 ) -> Tracks:
     """Track the LED and the rendered sphere in every frame of a video.
 
     ``source`` is a video file, a folder of numbered images, or an array of frames, (N, H, W) grey
-    or (N, H, W, 3) BGR; ``fps`` overrides the file's frame rate and is required for arrays and
-    image folders. ROIs are [x, y, width, height] in pixels: give both or neither; without them the
-    two largest moving bright regions are used, the LED being the one on ``led_side`` ("left" or
-    "right") if given, else the one the physical evidence names (``analysis.identity``; an
-    AnalysisError asks for the ROIs when it does not decide). ``progress(done, total)`` is called
+    or (N, H, W, 3) BGR. Of the ``options``, ``fps`` overrides the file's frame rate and is required
+    for arrays and image folders; the ROIs are [x, y, width, height] in pixels: give both or
+    neither; without them the two largest moving bright regions are used, the LED being the one on
+    ``led_side`` ("left" or "right") if given, else the one the physical evidence names
+    (``analysis.identity``; an AnalysisError asks for the ROIs when it does not decide). ``progress(done, total)`` is called
     as frames are tracked (for clips of PROGRESS_MIN_SECONDS or more). ``tracks_csv`` receives
     every frame's row as it is measured (the left blob first as the LED while that is undecided),
-    then the final table once the frame times are decided (``analysis.report``); it is
+    then the final table once the frame times are decided (``analysis.tracks_csv``); it is
     written before the tracks are checked, so tracks that fail a check stay on disk to look at.
     """
-    if led_side is not None and led_side not in SIDES:
-        raise AnalysisError(f"led_side must be left or right, not {led_side!r}")
+    fps = options.fps
     video = open_frames(source, fps)
-    given = _rois(video, led_roi, sphere_roi)
+    given = _rois(video, options.led_roi, options.sphere_roi)
     if video.fps is not None and video.frame_count < PROGRESS_MIN_SECONDS * video.fps:
         progress = None
     warnings: list[str] = []
     started = time.perf_counter()
-    calibration, tracked = _read(video, given, led_side, progress, tracks_csv, warnings)
+    noted = Repeats()
+    calibration, tracked = _read(video, given, options.led_side, progress, tracks_csv, warnings, noted)
     seconds = time.perf_counter() - started
     stamps = np.array(tracked.stamps, dtype=np.float64)
     times = frame_times(stamps, video.fps if fps is not None else None, video.container_fps, video.stamp_origin)
@@ -284,10 +283,10 @@ def track(
         count_warning = check_count(stamps.size, video.frame_count, video.name)
         if count_warning:
             warnings.append(count_warning)
-    repeats = repeated_frames(tracked.positions(0), tracked.positions(1))
+    repeats = recorder_repeats(noted.mask(stamps.size), times)
     if np.any(repeats):
         warnings.append(
-            f"{int(np.count_nonzero(repeats))} frame(s) repeat the one before exactly (inserted by the recorder); "
+            f"{int(np.count_nonzero(repeats))} frame(s) repeat the one before exactly, whole (inserted by the recorder); "
             "they were left out"
         )
     led = tracked.track_of(0, times.t, repeats)
@@ -321,7 +320,7 @@ def track(
         video.frame_size,
     )
     if tracks_csv is not None:
-        write_tracks_csv(tracks_csv, tracks)
+        tracks.write_csv(tracks_csv)
     check_track(led, "LED", warnings)
     check_track(sphere, "sphere", warnings)
     return dataclasses.replace(tracks, warnings=tuple(warnings))

@@ -22,11 +22,12 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from analysis import AnalysisOptions
 from rig.commands import choices, options, outputs
 from rig.commands.record import CAMERA_SPECS, add_camera_options
 from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
-from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, VideoOptions, measure
+from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, measure
 from rig.live.record import check_first_seconds, record_camera
 from rig.live.run import EXTERNAL, LiveConfig
 from rig.lsl import StreamNames
@@ -120,7 +121,7 @@ def _run(args: argparse.Namespace) -> int:
         print("4. Filming: keep the pendulum swinging and the camera still.", file=sys.stderr)
     report = measure(
         config, args.camera.removeprefix("camera:"), args.out, board=args.board,
-        options=VideoOptions(args.led_roi, args.sphere_roi, args.led_side),
+        options=AnalysisOptions(led_roi=args.led_roi, sphere_roi=args.sphere_roi, led_side=args.led_side),
         accept_camera_settings=args.accept_camera_settings, overwrite=args.overwrite, progress=ProgressBar("measuring"),
     )  # fmt: skip
     return _print(report, args.json)

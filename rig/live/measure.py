@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
+from analysis import AnalysisOptions
 from analysis.board.photodiode_latency import estimate_from_recording
 from rig.devices.camera.frames import FRAMES_FILE
 from rig.devices.camera.opencv_camera import OpenCvCamera, opencv_camera
@@ -31,15 +32,6 @@ from rig.service.analyse import AnalysisRequest, analyse
 
 MEASURE_FILE = "measure.json"
 PLOT_FILE = "measure.png"
-
-
-@dataclass(frozen=True)
-class VideoOptions:
-    """How to read the run's video: its regions of interest (None: found), which side the LED is on."""
-
-    led_roi: tuple[int, int, int, int] | None = None
-    sphere_roi: tuple[int, int, int, int] | None = None
-    led_side: str | None = None
 
 
 @dataclass
@@ -86,11 +78,11 @@ def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[s
     return {**filmed, "whole_run_latency_ms": log_latency(out_dir, shown, scanout).latency_ms}
 
 
-def analyse_run(out_dir: Path, fps: float | None, options: VideoOptions, board: Path | None, run: dict[str, Any],
+def analyse_run(out_dir: Path, fps: float | None, options: AnalysisOptions, board: Path | None, run: dict[str, Any],
                 progress: Callable[[int, int], object] | None = None) -> MeasureReport:  # fmt: skip
-    """The three answers for a filmed live run in `out_dir`; written to measure.json and measure.png."""
-    request = AnalysisRequest(out_dir / "video.avi", fps=fps, led_roi=options.led_roi, sphere_roi=options.sphere_roi,
-                              led_side=options.led_side, tracks_csv=out_dir / "tracks.csv")  # fmt: skip
+    """The three answers for a filmed live run in `out_dir` (its video analysed as `options` say, at
+    the frame rate the camera measured); written to measure.json and measure.png."""
+    request = AnalysisRequest(out_dir / "video.avi", replace(options, fps=fps), tracks_csv=out_dir / "tracks.csv")
     video = analyse(request, progress).to_dict()
     log = logged_latency(out_dir, run["renderer"] == EXTERNAL, run)
     board_result = None
@@ -143,7 +135,7 @@ def measure(
     out_dir: Path,
     *,
     view: View | None = None,
-    options: VideoOptions = VideoOptions(),
+    options: AnalysisOptions = AnalysisOptions(),
     board: Path | None = None,
     accept_camera_settings: bool = False,
     overwrite: bool = False,

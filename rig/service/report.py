@@ -121,7 +121,7 @@ def run_report(path: Path) -> tuple[Report, Measurement]:
     report.sections.append(Section("Diagnostics", [(("diagnostic", "value", "verdict"), rows)]))
     if measurement.board is not None:
         report.sections.append(Section("Board", [(("field", "value"), _flatten(measurement.board.to_dict()))]))
-    configuration = [("video", str(video)), ("method", request.method), ("latency range (ms)", request.latency_range_ms)]
+    configuration = [("video", str(video)), ("method", request.options.method), ("latency range (ms)", request.options.latency_range_ms)]
     if truth is not None:
         configuration += [(f"simulation.{k}", v) for k, v in _flatten(truth["config"])]
     report.sections.append(Section("Configuration and devices", [(("setting", "value"), configuration)]))

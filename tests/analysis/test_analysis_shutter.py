@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from analysis import AnalysisError, Tracks, estimate
+from analysis import AnalysisError, AnalysisOptions, Tracks, estimate
 from analysis.timing import FrameTimes
 from analysis.tracking import Roi, Track
 
@@ -26,9 +26,10 @@ PERIOD_S = 0.8
 SECONDS = 6.0
 
 
-def display(fps: float = FPS) -> dict[str, float]:
-    """The settings the sampling needs told, as a lab that knows them says (see the module docstring)."""
-    return {"refresh_hz": 60.0, "exposure_ms": 1e3 / fps}
+def told(fps: float = FPS, **options) -> AnalysisOptions:
+    """The settings the sampling needs told, as a lab that knows them says (see the module docstring),
+    and ``options``."""
+    return AnalysisOptions(display_hz=60.0, exposure_ms=1e3 / fps, **options)
 
 
 def swing_x(t: np.ndarray) -> np.ndarray:
@@ -72,7 +73,7 @@ SHORT_S = (SPHERE_ROW - LED_ROW) / HEIGHT * READOUT_S  # what the frame times re
 @pytest.mark.parametrize(("fps", "readout_s"), [(FPS, READOUT_S), (30.0, 25e-3)])
 def test_with_the_readout_given_every_estimator_times_each_blob_by_its_rows(fps: float, readout_s: float) -> None:
     tracks = tracks_of(constant(LED_ROW), constant(SPHERE_ROW), readout_s, fps)
-    result = estimate(tracks, "all", readout_ms=readout_s * 1e3, **display(fps))
+    result = estimate(tracks, told(fps, method="all", readout_ms=readout_s * 1e3))
     for name, method in result.methods.items():
         # The correlation's peak between samples is good to about 0.15 ms at 30 fps, shutter or not.
         assert method.latency_ms == pytest.approx(LATENCY_S * 1e3, abs=0.2 if name == "xcorr" else 0.01), name
@@ -86,14 +87,14 @@ def test_with_the_readout_given_every_estimator_times_each_blob_by_its_rows(fps:
 
 def test_without_the_readout_the_interval_reaches_later_by_what_the_rows_allow() -> None:
     tracks = tracks_of(constant(LED_ROW), constant(SPHERE_ROW), READOUT_S)
-    told = estimate(tracks, readout_ms=0.0, **display())  # the frame times taken as the truth's
-    result = estimate(tracks, **display())
+    framed = estimate(tracks, told(readout_ms=0.0))  # the frame times taken as the truth's
+    result = estimate(tracks, told())
     truth_ms = LATENCY_S * 1e3
     assert result.latency_ms == pytest.approx(truth_ms - SHORT_S * 1e3, abs=0.02)
-    assert told.ci95_ms[1] < truth_ms  # not widened, the interval misses the truth
+    assert framed.ci95_ms[1] < truth_ms  # not widened, the interval misses the truth
     bound_ms = (SPHERE_ROW - LED_ROW) / HEIGHT * 1e3 / FPS  # the rows' difference over a whole frame interval
-    assert result.ci95_ms[0] == pytest.approx(told.ci95_ms[0], abs=1e-9)
-    assert result.ci95_ms[1] == pytest.approx(told.ci95_ms[1] + bound_ms, abs=1e-3)
+    assert result.ci95_ms[0] == pytest.approx(framed.ci95_ms[0], abs=1e-9)
+    assert result.ci95_ms[1] == pytest.approx(framed.ci95_ms[1] + bound_ms, abs=1e-3)
     assert result.ci95_ms[0] <= truth_ms <= result.ci95_ms[1]
     (warning,) = result.warnings
     assert warning.startswith("the sphere sits 168 rows below the LED")
@@ -108,17 +109,17 @@ def test_without_the_readout_the_interval_reaches_later_by_what_the_rows_allow()
 
 def test_a_sphere_above_the_led_widens_the_interval_towards_shorter_latencies() -> None:
     tracks = tracks_of(constant(SPHERE_ROW), constant(LED_ROW), READOUT_S)
-    told = estimate(tracks, readout_ms=0.0, **display())
-    result = estimate(tracks, **display())
+    framed = estimate(tracks, told(readout_ms=0.0))
+    result = estimate(tracks, told())
     assert result.latency_ms == pytest.approx(LATENCY_S * 1e3 + SHORT_S * 1e3, abs=0.02)
-    assert result.ci95_ms[1] == pytest.approx(told.ci95_ms[1], abs=1e-9)
-    assert result.ci95_ms[0] < LATENCY_S * 1e3 < told.ci95_ms[0]
+    assert result.ci95_ms[1] == pytest.approx(framed.ci95_ms[1], abs=1e-9)
+    assert result.ci95_ms[0] < LATENCY_S * 1e3 < framed.ci95_ms[0]
     assert "rows above the LED" in result.warnings[0] and "shorter than measured" in result.warnings[0]
 
 
 def test_blobs_on_the_same_rows_need_no_readout() -> None:
     tracks = tracks_of(constant(200.0), constant(200.3), READOUT_S)
-    result = estimate(tracks, **display())
+    result = estimate(tracks, told())
     assert result.warnings == []
     assert result.latency_ms == pytest.approx(LATENCY_S * 1e3, abs=0.02)
     assert result.to_dict()["rolling_shutter"]["bias_bound_ms"] == pytest.approx(0.3 / HEIGHT * 1e3 / FPS, rel=0.01)
@@ -130,7 +131,7 @@ def test_rows_that_change_with_the_swing_are_dated_frame_by_frame() -> None:
         return SPHERE_ROW + 0.4 * swing_x(t - LATENCY_S)
 
     tracks = tracks_of(constant(LED_ROW), sphere_rows, READOUT_S)
-    result = estimate(tracks, "all", readout_ms=READOUT_S * 1e3, **display())
+    result = estimate(tracks, told(method="all", readout_ms=READOUT_S * 1e3))
     for name, method in result.methods.items():
         assert method.latency_ms == pytest.approx(LATENCY_S * 1e3, abs=0.02), name
     np.testing.assert_allclose(result.sphere_track.t - tracks.sphere.t, tracks.sphere.y / HEIGHT * READOUT_S)
@@ -144,18 +145,17 @@ def test_the_board_reference_reads_the_led_at_its_own_times() -> None:
         seen.append(led.t)
         return {}
 
-    estimate(tracks, readout_ms=READOUT_S * 1e3, reference_departures=departures, **display())
+    estimate(tracks, told(readout_ms=READOUT_S * 1e3), reference_departures=departures)
     np.testing.assert_allclose(seen[0], tracks.led.t + LED_ROW / HEIGHT * READOUT_S)
 
 
 @pytest.mark.parametrize("readout_ms", [-1.0, math.nan, math.inf])
 def test_a_readout_that_is_no_time_is_refused(readout_ms: float) -> None:
-    tracks = tracks_of(constant(LED_ROW), constant(SPHERE_ROW), READOUT_S)
-    with pytest.raises(AnalysisError, match="readout_ms must be a number of ms"):
-        estimate(tracks, readout_ms=readout_ms)
+    with pytest.raises(AnalysisError, match="readout_ms must be zero or a positive number of ms"):
+        AnalysisOptions(readout_ms=readout_ms)
 
 
 def test_a_readout_longer_than_a_frame_is_refused() -> None:
     tracks = tracks_of(constant(LED_ROW), constant(SPHERE_ROW), READOUT_S)
     with pytest.raises(AnalysisError, match="longer than the frame interval"):
-        estimate(tracks, readout_ms=5.0)
+        estimate(tracks, AnalysisOptions(readout_ms=5.0))

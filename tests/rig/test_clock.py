@@ -37,9 +37,17 @@ def test_virtual_time_never_goes_backwards(targets: list[float]) -> None:
         assert clock.now() == latest
 
 
-def test_both_clocks_are_clocks() -> None:
-    assert isinstance(VirtualClock(), Clock)
-    assert isinstance(MonotonicClock(FakeSystem(0).read_ns, FakeSystem(0).sleep), Clock)
+@pytest.mark.parametrize("kind", ["virtual", "monotonic"])
+def test_each_clock_keeps_the_clock_contract(kind: str) -> None:
+    # Waiting until a time leaves the clock at or after it, and time never runs backwards.
+    system = FakeSystem(start_ns=5_000_000_000)
+    clock: Clock = VirtualClock() if kind == "virtual" else MonotonicClock(system.read_ns, system.sleep)
+    readings = [clock.now()]
+    for target in (0.25, 0.1, 1.75, 1.75):
+        clock.wait_until(target)
+        readings.append(clock.now())
+        assert clock.now() >= target
+    assert readings == sorted(readings) and readings[-1] == pytest.approx(1.75)
 
 
 def test_monotonic_time_counts_from_when_the_clock_was_made() -> None:

@@ -12,6 +12,7 @@ import pytest
 from analysis.errors import AnalysisError
 from rig.board import BoardRecorder, EncoderEdge, PhotodiodePassage
 from rig.board.protocol import protocol
+from rig.commands import board as board_commands
 from rig.commands.board import PORT_VARIABLE, add_parser
 from rig.errors import RigError
 
@@ -38,7 +39,7 @@ def write_recording(out: Path, recording) -> None:
 def test_every_board_command_has_a_handler(command: str) -> None:
     argv = {"record": ["--out=x", "--duration=1"], "latency": ["somewhere"]}.get(command, [])
     args = parse("board", command, *argv)
-    assert callable(args.func)
+    assert args.func is getattr(board_commands, f"run_{command}")
 
 
 def test_a_command_without_a_port_says_how_to_give_one(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -17,13 +17,12 @@ import math
 import os
 from pathlib import Path
 from types import TracebackType
-from typing import TYPE_CHECKING, TextIO
+from typing import TextIO
+
+import numpy as np
 
 from analysis.errors import AnalysisError
-from analysis.tracking import Detection
-
-if TYPE_CHECKING:
-    from analysis.tracks import Tracks
+from analysis.tracking import Detection, Track
 
 TRACKS_CSV_HEADER = (
     "frame", "stamp_s", "t",
@@ -83,15 +82,15 @@ class TrackStream:
         self.close()
 
 
-def write_tracks_csv(path: str | Path, tracks: Tracks) -> None:
-    """Write both tracks, one row per frame, with their final times.
+def write_tracks_csv(path: str | Path, stamps: np.ndarray, led: Track, sphere: Track) -> None:
+    """Write both tracks, one row per frame, with the times the source stamped (``stamps``) and the
+    final frame times (the LED track's).
 
     The file is written beside its destination and then moved over it, so a reader never sees a
     half-written table.
     """
     path = Path(path)
     partial = path.with_name(path.name + ".partial")
-    led, sphere = tracks.led, tracks.sphere
     with _open(partial) as stream:
         writer = csv.writer(stream)
         writer.writerow(TRACKS_CSV_HEADER)
@@ -99,7 +98,7 @@ def write_tracks_csv(path: str | Path, tracks: Tracks) -> None:
             writer.writerow(
                 _row(
                     i,
-                    float(tracks.stamps[i]),
+                    float(stamps[i]),
                     float(led.t[i]),
                     (led.x[i], led.y[i], bool(led.valid[i]), float(led.peak[i])),
                     (sphere.x[i], sphere.y[i], bool(sphere.valid[i]), float(sphere.peak[i])),
