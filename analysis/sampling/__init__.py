@@ -2,9 +2,11 @@
 
 A camera filming a sample-and-hold display sees the sphere at whatever phase of each refresh its
 exposures fall, and reads the latency off by the mean of that phase's bias
-(``analysis.sampling.model``). ``measure_sampling`` works out which refresh rates, phases and
-exposures the video allows (``analysis.sampling.inference``, with the exposure from the LED's
-blur, ``analysis.sampling.exposure``, or as given), and ``SamplingBias.apply`` turns a latency
+(``analysis.sampling.model``), averaged over the sphere's rows, which the display's scan-out and
+the camera's readout reach one after another (``analysis.sampling.rows``). ``measure_sampling``
+works out which refresh rates, phases, exposures and row slopes the video allows
+(``analysis.sampling.inference``, with the exposure from the LED's blur,
+``analysis.sampling.exposure``, or as given), and ``SamplingBias.apply`` turns a latency
 and its interval into the corrected latency and an interval that holds every bias still possible.
 Where the video identifies the bias it is corrected; where it does not (the camera phase-locked to
 the display, or a rate the video does not show), the interval is widened by it and a warning says

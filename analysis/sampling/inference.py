@@ -2,10 +2,10 @@
 consistent with, and the latency bias each implies.
 
 For a refresh rate f, a row slope m (how the sphere's rows switch and are exposed one after
-another, ``analysis.sampling.rows``), an exposure e and a phase phi, every frame's bias and
-elongation follow (``analysis.sampling.folding``). Each misfit, chi^2(f, m, e, phi), scaled by
-its residuals' own variance and correlation, is a log likelihood, and the two add; the weighted
-mean bias of each hypothesis is what the latency is off by if it holds.
+another, ``analysis.sampling.rows``), an exposure e and a phase phi, every frame's bias follows
+(``analysis.sampling.folding``). The sphere's timing misfit, chi^2(f, m, e, phi), scaled by its
+residuals' own variance and correlation, is a log likelihood; the weighted mean bias of each
+hypothesis is what the latency is off by if it holds.
 
 The candidate rates are the given one or the common ones and those seen in the residuals'
 spectrum, each tuned to the clip (``analysis.sampling.rates``); those whose likelihood comes
@@ -19,6 +19,7 @@ common rates too fast for the camera to see the steps of stay possible, however 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,15 +31,15 @@ from analysis.sampling.rows import SphereRows
 
 CONSISTENT_LOG_LIKELIHOOD = 6.0
 TRUSTED_EXPLAINED = 0.9
-# A hypothesis whose bias quantiles span more than this fraction of what its exposures allow at any
-# phase does not place the phase.
+# A hypothesis whose bias range spans more than this fraction of what its exposures allow at any
+# phase and slope does not place the phase.
 UNPLACED = 0.5
+# The bias's range holds every hypothesis whose log likelihood comes this close to the best: the 99 %
+# profile-likelihood range of one quantity (chi-square of one degree of freedom, 6.63 / 2).
+LIKELY_LOG_LIKELIHOOD = 3.3
 # Each model is taken to be off by up to this fraction of what it explains, per frame: a display's
 # pixels take time to settle, a sphere's light is not a disc's.
 MODEL_ERROR = 0.1
-# The elongation is trusted to this fraction of the largest a double image gives (two equal images a
-# refresh's travel apart, at the swing's typical speed).
-SHAPE_RESOLUTION = 0.2
 
 
 @dataclass(frozen=True)
@@ -58,13 +59,19 @@ class RefreshHypothesis:
         return float(self.weights @ self.biases_s)
 
     def range_s(self, low: float, high: float) -> tuple[float, float]:
-        """The bias's range: its ``low`` and ``high`` quantiles where the video places the phase, or
-        every bias the exposures allow at any phase where it hardly does (the quantiles span more
-        than UNPLACED of that): the likelihood's fine detail, what pins a phase among equals, is
-        then the part of the model least to be trusted."""
+        """The bias's range: its ``low`` and ``high`` quantiles and every bias whose likelihood comes
+        within LIKELY_LOG_LIKELIHOOD of the best, where the video places the phase; or every bias
+        the exposures allow at any phase and slope where it hardly does (that range spans more than
+        UNPLACED of this): the likelihood's fine detail, what pins a phase among equals, is then the
+        part of the model least to be trusted. The likelihood's range keeps the answer from resting
+        on the prior over the row slope, which no lab states: where the video does not tell the
+        slope, a prior spread evenly over slopes up to a display as short as the sphere's travel
+        would crowd the posterior into small biases."""
         quantiles = self.quantiles_s(low, high)
+        likely = self.biases_s[self.weights >= math.exp(-LIKELY_LOG_LIKELIHOOD) * self.weights.max()]
+        spread = (min(quantiles[0], float(likely.min())), max(quantiles[1], float(likely.max())))
         least, most = self.bounds_s
-        return (least, most) if quantiles[1] - quantiles[0] > UNPLACED * (most - least) else quantiles
+        return (least, most) if spread[1] - spread[0] > UNPLACED * (most - least) else spread
 
     def quantiles_s(self, low: float, high: float) -> tuple[float, float]:
         order = np.argsort(self.biases_s)
@@ -87,35 +94,25 @@ def refresh_hypotheses(
     residuals may be correlated; ``rows`` the sphere's rows (None: a point that stays on one row)."""
     exposures = exposure_grid(*exposure_s)
     fits = [fit(residuals, rate, exposures, rows) for rate in candidate_rates(residuals, fps, refresh_hz, exposures)]
-    with_shape = all(fitted.shape is not None for fitted in fits)
-    timing_scale = min(float(fitted.timing.min()) for fitted in fits) / residuals.r.size
-    shape_scale = min(float(fitted.shape.min()) for fitted in fits) / fits[0].folding.shape[5] if with_shape else 1.0
-
-    def misfit(fitted: Fit, timing: float, shape: float) -> np.ndarray:
-        return fitted.timing / timing + (fitted.shape / shape if with_shape else 0.0)
-
-    best = min(fits, key=lambda fitted: float(misfit(fitted, timing_scale, shape_scale).min()))
-    at = np.unravel_index(int(np.argmin(misfit(best, timing_scale, shape_scale))), best.timing.shape)
-    left = _leftovers(residuals, best, rows, (int(at[0]), int(at[1]), int(at[2])), float(exposures[at[1]]))
-    timing_scale = max(timing_scale * inflation(left[0], bandwidth), (MODEL_ERROR * left[2]) ** 2, 1e-300)
-    if with_shape:
-        # Only a clear double image counts.
-        straddle = SHAPE_RESOLUTION * 0.25 * float(np.sqrt(np.mean(residuals.v**4))) / best.rate**2
-        shape_scale = max(shape_scale * inflation(left[1], bandwidth), (MODEL_ERROR * left[3]) ** 2, straddle**2, 1e-300)
+    scale = min(float(fitted.timing.min()) for fitted in fits) / residuals.r.size
+    best = min(fits, key=lambda fitted: float(fitted.timing.min()))
+    at = np.unravel_index(int(np.argmin(best.timing)), best.timing.shape)
+    left, explained = _leftovers(residuals, best, rows, (int(at[0]), int(at[1]), int(at[2])), float(exposures[at[1]]))
+    scale = max(scale * inflation(left, bandwidth), (MODEL_ERROR * explained) ** 2, 1e-300)
     hypotheses = []
-    most = max(float(-0.5 * misfit(fitted, timing_scale, shape_scale).min()) for fitted in fits)
+    most = max(float(-0.5 * fitted.timing.min() / scale) for fitted in fits)
     unseen = refresh_hz is None and 1.0 - float(best.timing.min()) / float(residuals.r @ residuals.r) < TRUSTED_EXPLAINED
     fine = exposure_grid(*exposure_s, FINE_EXPOSURE_STEPS)
     for fitted in fits:
-        top = float(-0.5 * misfit(fitted, timing_scale, shape_scale).min())
+        top = float(-0.5 * fitted.timing.min() / scale)
         too_fast = unseen and fitted.rate in COMMON_REFRESH_HZ and fitted.rate >= fps * (1 - RATE_TOLERANCE)
         if top < most - CONSISTENT_LOG_LIKELIHOOD and not too_fast:
             continue
         # The likelihood may be far narrower in the exposure and the slope than the coarse grid's steps.
-        coarse = np.exp(-0.5 * misfit(fitted, timing_scale, shape_scale) - top)
+        coarse = np.exp(-0.5 * fitted.timing / scale - top)
         slopes = rows.refined(fitted.rate, fitted.slopes, coarse.sum(axis=(1, 2))) if rows is not None else fitted.slopes
         refined = fit(residuals, fitted.rate, fine, rows, slopes)
-        log_likelihood = -0.5 * misfit(refined, timing_scale, shape_scale)
+        log_likelihood = -0.5 * refined.timing / scale
         weights = np.exp(log_likelihood - log_likelihood.max()).ravel()
         bounds = (min(float(fitted.mean.min()), float(refined.mean.min())), max(float(fitted.mean.max()), float(refined.mean.max())))
         hypotheses.append(RefreshHypothesis(fitted.rate, top, refined.mean.ravel(), weights / weights.sum(), bounds))
@@ -124,18 +121,11 @@ def refresh_hypotheses(
 
 def _leftovers(
     residuals: TimingResiduals, fitted: Fit, rows: SphereRows | None, at: tuple[int, int, int], exposure_s: float
-) -> tuple[np.ndarray, np.ndarray, float, float]:
+) -> tuple[np.ndarray, float]:
     """Per frame, what the hypothesis ``at`` (slope, exposure and phase indices) leaves of the timing
-    residuals and of the measured elongations, and the RMS of what it explains of each."""
-    frame_bias, frame_spread = frame_biases(residuals, fitted, rows, at, exposure_s)
+    residuals, and the RMS of what it explains."""
+    frame_bias = frame_biases(residuals, fitted, rows, at, exposure_s)
     weights = residuals.v**2
     mean = float(weights @ frame_bias) / max(float(weights.sum()), 1e-300)
     explained = residuals.v * (frame_bias - mean)
-    timing = residuals.r + explained
-    timing_rms = float(np.sqrt(np.mean(explained**2)))
-    if residuals.elongation is None or frame_spread is None:
-        return timing, np.zeros(1), timing_rms, 0.0
-    measured = np.isfinite(residuals.elongation)
-    expected = (weights * frame_spread)[measured]
-    shape = residuals.elongation[measured] - expected
-    return timing, shape - shape.mean(), timing_rms, float(np.sqrt(np.mean((expected - expected.mean()) ** 2)))
+    return residuals.r + explained, float(np.sqrt(np.mean(explained**2)))

@@ -8,8 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from analysis.sampling.folding import Kernels, model, point_kernels
-from analysis.sampling.model import exposure_bias, exposure_spread
+from analysis.sampling.model import exposure_bias
 from analysis.sampling.rows import SphereRows, disc_kernel, smeared
 
 BINS = 512
@@ -40,17 +39,6 @@ def test_smeared_tables_are_the_bias_averaged_row_by_row(e: float, radius: float
     np.testing.assert_allclose(g, by_rows(exposure_bias, CENTRES, e, radius), atol=2e-3)
     assert g.mean() == pytest.approx(exposure_bias(CENTRES, e).mean(), abs=1e-9)
     assert np.ptp(g) <= np.ptp(exposure_bias(CENTRES, e)) + 1e-9
-
-
-def test_a_sphere_of_rows_reads_as_its_rows_images_spread_in_time() -> None:
-    # Its elongation: each row's refreshes (V, averaged) and the spread of the rows' own biases.
-    e, radius, rate = 0.3, 0.1, 60.0
-    point = point_kernels(BINS)
-    table = model(rate, np.array([e / rate]), BINS, True, Kernels(disc_kernel(radius, BINS), point.timing, point.shape))
-    spread = by_rows(exposure_spread, CENTRES, e, radius) + by_rows(lambda s, e: exposure_bias(s, e) ** 2, CENTRES, e, radius)
-    expected = spread - by_rows(exposure_bias, CENTRES, e, radius) ** 2
-    np.testing.assert_allclose(table.spread[0] * rate**2, expected, atol=3e-3)
-    np.testing.assert_allclose(table.bias[0] * rate, by_rows(exposure_bias, CENTRES, e, radius), atol=2e-3)
 
 
 def test_the_slopes_reach_from_the_readout_to_a_display_as_short_as_the_spheres_travel() -> None:
