@@ -171,8 +171,8 @@ def _components(means: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.
     means, weights = means[kept], weights[kept]
     if means.size <= MIXTURE_COMPONENTS:
         return means, weights / weights.sum()
-    edges = np.linspace(means.min(), means.max(), MIXTURE_COMPONENTS + 1)
-    index = np.clip(np.searchsorted(edges, means, side="right") - 1, 0, MIXTURE_COMPONENTS - 1)
+    least, most = float(means.min()), float(means.max())
+    index = np.clip(((means - least) / max(most - least, 1e-300) * MIXTURE_COMPONENTS).astype(np.int64), 0, MIXTURE_COMPONENTS - 1)
     total = np.bincount(index, weights, MIXTURE_COMPONENTS)
     centre = np.bincount(index, weights * means, MIXTURE_COMPONENTS)
     used = total > 0

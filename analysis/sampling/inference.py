@@ -19,6 +19,7 @@ common rates too fast for the camera to see the steps of stay possible, however 
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -27,7 +28,7 @@ import numpy as np
 from analysis.sampling.folding import Fit, fit, frame_biases
 from analysis.sampling.rates import COMMON_REFRESH_HZ, FINE_EXPOSURE_STEPS, RATE_TOLERANCE, candidate_rates, exposure_grid
 from analysis.sampling.residuals import TimingResiduals, inflation
-from analysis.sampling.rows import SphereRows
+from analysis.sampling.rows import REFINED_GRID, SphereRows
 
 CONSISTENT_LOG_LIKELIHOOD = 6.0
 TRUSTED_EXPLAINED = 0.9
@@ -37,6 +38,10 @@ UNPLACED = 0.5
 # The bias's range holds every hypothesis whose log likelihood comes this close to the best: the 99 %
 # profile-likelihood range of one quantity (chi-square of one degree of freedom, 6.63 / 2).
 LIKELY_LOG_LIKELIHOOD = 3.3
+# The bias's quantiles are read off a histogram of this many bins over its range.
+QUANTILE_BINS = 1 << 16
+# Hypotheses this much less likely than the best (a log likelihood 27.6 lower) are dropped.
+NEGLIGIBLE_WEIGHT = 1e-12
 # Each model is taken to be off by up to this fraction of what it explains, per frame: a display's
 # pixels take time to settle, a sphere's light is not a disc's.
 MODEL_ERROR = 0.1
@@ -74,10 +79,20 @@ class RefreshHypothesis:
         return (least, most) if spread[1] - spread[0] > UNPLACED * (most - least) else spread
 
     def quantiles_s(self, low: float, high: float) -> tuple[float, float]:
-        order = np.argsort(self.biases_s)
-        cumulative = np.cumsum(self.weights[order])
-        values = self.biases_s[order]
-        return float(values[np.searchsorted(cumulative, low)]), float(values[min(np.searchsorted(cumulative, high), values.size - 1)])
+        """The bias's ``low`` and ``high`` quantiles, each to the outer edge of its bin of a
+        QUANTILE_BINS histogram over the biases (a hypothesis may hold a million of them)."""
+        edges, cumulative = self._histogram
+        first = min(int(np.searchsorted(cumulative, low)), cumulative.size - 1)
+        last = min(int(np.searchsorted(cumulative, high)), cumulative.size - 1)
+        return float(edges[first]), float(edges[last + 1])
+
+    @functools.cached_property
+    def _histogram(self) -> tuple[np.ndarray, np.ndarray]:
+        """The edges of QUANTILE_BINS bins over the biases, and the cumulative weight up to each bin's end."""
+        least, most = float(self.biases_s.min()), float(self.biases_s.max())
+        edges = np.linspace(least, max(most, least + 1e-15), QUANTILE_BINS + 1)
+        index = np.clip(((self.biases_s - least) / (edges[-1] - least) * QUANTILE_BINS).astype(np.int64), 0, QUANTILE_BINS - 1)
+        return edges, np.cumsum(np.bincount(index, self.weights, QUANTILE_BINS))
 
 
 def refresh_hypotheses(
@@ -106,16 +121,23 @@ def refresh_hypotheses(
     for fitted in fits:
         top = float(-0.5 * fitted.timing.min() / scale)
         too_fast = unseen and fitted.rate in COMMON_REFRESH_HZ and fitted.rate >= fps * (1 - RATE_TOLERANCE)
-        if top < most - CONSISTENT_LOG_LIKELIHOOD and not too_fast:
+        consistent = top >= most - CONSISTENT_LOG_LIKELIHOOD
+        if not (consistent or too_fast):
             continue
-        # The likelihood may be far narrower in the exposure and the slope than the coarse grid's steps.
-        coarse = np.exp(-0.5 * fitted.timing / scale - top)
-        slopes = rows.refined(fitted.rate, fitted.slopes, coarse.sum(axis=(1, 2))) if rows is not None else fitted.slopes
-        refined = fit(residuals, fitted.rate, fine, rows, slopes)
+        # The likelihood may be far narrower in the exposure and the slope than the coarse grid's
+        # steps; a rate kept only because the camera cannot see it has nothing to narrow.
+        refined = fitted
+        if consistent:
+            coarse = np.exp(-0.5 * fitted.timing / scale - top)
+            slopes = fitted.slopes
+            if rows is not None:
+                slopes = rows.refined(fitted.rate, fitted.slopes, coarse.sum(axis=(1, 2)), max(4, REFINED_GRID // fine.size))
+            refined = fit(residuals, fitted.rate, fine, rows, slopes)
         log_likelihood = -0.5 * refined.timing / scale
         weights = np.exp(log_likelihood - log_likelihood.max()).ravel()
+        kept = weights >= NEGLIGIBLE_WEIGHT
         bounds = (min(float(fitted.mean.min()), float(refined.mean.min())), max(float(fitted.mean.max()), float(refined.mean.max())))
-        hypotheses.append(RefreshHypothesis(fitted.rate, top, refined.mean.ravel(), weights / weights.sum(), bounds))
+        hypotheses.append(RefreshHypothesis(fitted.rate, top, refined.mean.ravel()[kept], weights[kept] / weights[kept].sum(), bounds))
     return sorted(hypotheses, key=lambda h: -h.log_likelihood)
 
 

@@ -38,11 +38,13 @@ import numpy as np
 # The coarse slope grid's steps move the kernel's radius, and the centroid's phase over the sphere's
 # rows travel, by at most this fraction of a refresh, with at most COARSE_SLOPES steps; the fine
 # grid's, around the slopes the coarse one left possible, by FINE_STEP_REFRESHES, with at most
-# FINE_SLOPES steps.
+# FINE_SLOPES steps (fewer where many exposures are tried with them, see REFINED_GRID).
 COARSE_STEP_REFRESHES = 1.0 / 64
 COARSE_SLOPES = 32
 FINE_STEP_REFRESHES = 1.0 / 512
 FINE_SLOPES = 48
+# At most this many (slope, exposure) pairs are refined: 48 slopes for a given exposure, 12 for 48.
+REFINED_GRID = 576
 # Coarse slopes whose posterior weight is below this fraction of the largest are not refined.
 NEGLIGIBLE_WEIGHT = 1e-6
 
@@ -75,15 +77,15 @@ class SphereRows:
         high = 1.0 / (refresh_hz * max(self.extent_px, 1e-9)) - self.row_time_range_s[0]
         return self._grid(refresh_hz, low, high, COARSE_STEP_REFRESHES, COARSE_SLOPES)
 
-    def refined(self, refresh_hz: float, coarse: np.ndarray, weights: np.ndarray) -> np.ndarray:
-        """A fine grid of slopes over those of the ``coarse`` grid whose posterior ``weights`` are not
-        negligible, a coarse step beyond them either side."""
+    def refined(self, refresh_hz: float, coarse: np.ndarray, weights: np.ndarray, most: int = FINE_SLOPES) -> np.ndarray:
+        """A fine grid of at most ``most`` steps over the slopes of the ``coarse`` grid whose
+        posterior ``weights`` are not negligible, a coarse step beyond them either side."""
         if coarse.size < 2:
             return coarse
         kept = np.flatnonzero(weights >= NEGLIGIBLE_WEIGHT * weights.max())
         step = coarse[1] - coarse[0]
         low, high = max(coarse[kept[0]] - step, coarse[0]), min(coarse[kept[-1]] + step, coarse[-1])
-        return self._grid(refresh_hz, low, high, FINE_STEP_REFRESHES, FINE_SLOPES)
+        return self._grid(refresh_hz, low, high, FINE_STEP_REFRESHES, min(most, FINE_SLOPES))
 
     def _grid(self, refresh_hz: float, low: float, high: float, step_refreshes: float, most: int) -> np.ndarray:
         reach = max(self.radius_px, float(np.ptp(self.offsets)) / 2 if self.offsets.size else 0.0)
