@@ -25,16 +25,17 @@ VERTICAL_X = 0.05
 @dataclass(frozen=True)
 class SwingSignals:
     """Both signals per frame (px), NaN where a blob was not found or not used: the LED's at times
-    t (s), the sphere's at sphere_t (t where not given: both blobs exposed at once)."""
+    t (s), the sphere's at sphere_times (None: at t, both blobs exposed at once)."""
 
     t: np.ndarray
     led: np.ndarray
     sphere: np.ndarray
-    sphere_t: np.ndarray = None  # type: ignore[assignment]  # t unless given, see __post_init__
+    sphere_times: np.ndarray | None = None
 
-    def __post_init__(self) -> None:
-        if self.sphere_t is None:
-            object.__setattr__(self, "sphere_t", self.t)
+    @property
+    def sphere_t(self) -> np.ndarray:
+        """The sphere's sample times (s)."""
+        return self.t if self.sphere_times is None else self.sphere_times
 
     @property
     def led_valid(self) -> np.ndarray:
@@ -55,10 +56,10 @@ class SwingSignals:
         step = self.frame_interval
         count = int(np.floor((self.t[-1] - self.t[0]) / step + 1e-9)) + 1
         grid = self.t[0] + step * np.arange(count)
-        return grid, interpolated(grid, self.t, self.led), interpolated(grid, self.sphere_t, self.sphere)
+        return grid, _interpolated(grid, self.t, self.led), _interpolated(grid, self.sphere_t, self.sphere)
 
 
-def interpolated(grid: np.ndarray, t: np.ndarray, values: np.ndarray) -> np.ndarray:
+def _interpolated(grid: np.ndarray, t: np.ndarray, values: np.ndarray) -> np.ndarray:
     """``values`` (NaN where missing) at times ``t``, increasing, interpolated at ``grid`` by the cubic
     through the two valid samples either side (linearly with fewer than four valid samples, and
     held beyond the ends). A cubic, not a line, because a signal dated off the grid (a rolling
