@@ -10,10 +10,10 @@ about).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 
-from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum
 
@@ -24,6 +24,13 @@ SPHERE_RADIUS_PX = 7.0
 ROI_MARGIN_PX = 14.0
 
 Rect = tuple[int, int, int, int]
+
+
+class CameraImage(Protocol):
+    """What the layout needs of the camera (a `rig.sim.camera.CameraConfig`): its image's size in pixels."""
+
+    width: int
+    height: int
 
 
 @dataclass(frozen=True)
@@ -79,7 +86,7 @@ def _bounding_rect(points: np.ndarray, margin: float, width: int, height: int) -
     return (x0, y0, x1 - x0, y1 - y0)
 
 
-def make_layout(pendulum: Pendulum, camera: CameraConfig, display: DisplayConfig) -> BenchLayout:
+def make_layout(pendulum: Pendulum, camera: CameraImage, display: DisplayConfig) -> BenchLayout:
     """Lay out the bench so the pendulum's full swing fills both halves of the camera image."""
     length = pendulum.length_m
     amplitude = np.radians(pendulum.config.amplitude_deg)
