@@ -55,6 +55,8 @@ class Display(Protocol):
     width: int
     height: int
     refresh_hz: float
+    """The refresh rate: nominal until connected, then what the display measured where it measures
+    it (a window); read it after `connect`."""
 
     def connect(self, clock: Clock) -> None: ...
 

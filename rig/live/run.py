@@ -188,7 +188,7 @@ def run_live(
             swaps = files.enter_context(CsvRecord(out_dir / SWAPS_FILE, SWAP_COLUMNS, overwrite=overwrite))
             display = WindowDisplay(config.window, scanout_fraction=config.scanout_fraction, frame_clock=frame_clock,
                                     swap_log=lambda swap: swaps.write(swap.row()))  # fmt: skip
-        publisher = LslPublisher(config.streams, display.refresh_hz, published)
+        publisher = LslPublisher(config.streams, display, published)
         tracker = make_device("tracker", config.tracker, DeviceContext())
         swing = SwingWatch(tracker) if config.until_still else None
         setup = RenderSetup(width=display.width, height=display.height, world_to_clip=view.world_to_clip,

@@ -28,7 +28,7 @@ from rig.clock import Clock
 from rig.devices.protocols import NO_IMAGE, Camera, Display, Instrument, TrackerSource
 from rig.errors import RigError
 from rig.records import CsvRecord
-from rig.render.protocol import AppFrameRequest, Renderer, RenderSetup
+from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, DisplayFrameResult, Renderer, RenderSetup
 from rig.session.record import RunRecord
 from rig.session.timing import CostModel, PhotonTarget, TimingPolicy
 
@@ -125,7 +125,7 @@ class Session:
         """The display row the sphere was last drawn at: where the next image's photons are expected."""
         self.log = SessionLog()
         self._app_frames = 0
-        self._last_cost = parts.app_cost.expected_s(1.0 / parts.display.refresh_hz)
+        self._last_cost = math.nan
 
     def run(self) -> SessionLog:
         """Connect everything, run to `t_end`, release everything (on any exit); what was shown."""
@@ -140,6 +140,7 @@ class Session:
             if self.from_connect:
                 shift = parts.clock.now() - self.t_begin
                 self.t_begin, self.t_end = self.t_begin + shift, self.t_end + shift
+            self._last_cost = parts.app_cost.expected_s(1.0 / parts.display.refresh_hz)  # the refresh as connected
             self._loop()
         return self.log
 
@@ -155,6 +156,12 @@ class Session:
             float(position[0]), self.row_estimate, self.feed.newest_sensor_time, float(cost_s), cost_source
         )
         return self.display.present(image, t_ready, image_id)
+
+    def compose(self, k: int, ready: int) -> DisplayFrameResult:
+        """The renderer's composed image for refresh k from application frame `ready`."""
+        self.feed.deliver()
+        request = DisplayFrameRequest(k, self.display.vblank_time(k), self.photon_target(k), self.feed.predict, ready)
+        return self.renderer.render_display_frame(request)
 
     def photon_target(self, k: int) -> float:
         """The instant refresh k's pose is predicted for, at the row the sphere was last drawn at."""
@@ -203,7 +210,7 @@ class Session:
             [index, start, cost, self.parts.app_cost.source, finish, t_photon, self.feed.newest_sensor_time, *position.tolist()]
         )
         self._app_frames += 1
-        return self.parts.timing.app_frame_done(self, index, result, finish, cost)
+        return self.parts.timing.app_frame_done(self, index, result, finish, cost, self.parts.app_cost.source)
 
     def _log_refresh(self, k: int) -> None:
         """Log refresh k; it missed if it repeats the previous refresh's image."""
