@@ -20,14 +20,14 @@ from typing import Any, Callable
 import numpy as np
 
 from analysis.board.photodiode_latency import estimate_from_recording
-from rig.devices.camera.frames import FRAMES_FILE
-from rig.devices.camera.opencv_camera import OpenCvCamera, opencv_camera
+from rig.devices.camera.opencv_camera import opencv_camera
 from rig.errors import RigError
 from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
 from rig.live.run import EXTERNAL, LiveConfig, run_live
 from rig.live.view import View
 from rig.render.protocol import RenderSetup
 from rig.service.analyse import AnalysisRequest, analyse
+from rig.session.record import FRAMES_FILE
 
 MEASURE_FILE = "measure.json"
 PLOT_FILE = "measure.png"
@@ -150,9 +150,9 @@ def measure(
     progress: Callable[[float, float], None] | None = None,
 ) -> MeasureReport:
     """Run `config` live while `camera_spec` films it, then analyse (see the module docstring)."""
-    camera: OpenCvCamera = opencv_camera(camera_spec, out_dir, accept_refused=accept_camera_settings, overwrite=overwrite)
+    camera = opencv_camera(camera_spec, accept_refused=accept_camera_settings)
     result = run_live(config, out_dir, view=view, camera=camera, overwrite=overwrite, progress=progress)
-    fps = camera.writer.measured_fps() if camera.writer else None
-    if camera.writer is None or camera.writer.frames < 2:
+    film = result.summary["film"]
+    if film is None or film["frames"] < 2:
         raise RigError(f"the camera {camera_spec} recorded no video; check it films while the run goes")
-    return analyse_run(out_dir, fps, options, board, result.summary)
+    return analyse_run(out_dir, film["measured_fps"], options, board, result.summary)

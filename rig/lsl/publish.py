@@ -1,8 +1,8 @@
 """The rig's LSL outlets (`rig.lsl.streams`): the predicted pose per display frame and the raw
 tracker stream, and the wrappers that feed them from a session without the session knowing.
 
-`PublishingTracker` wraps a tracker source: every sample the session takes is pushed on
-`RigTracker`. `PublishingRenderer` wraps a renderer: every pose it draws a display frame with (an
+`LslPublisher.samples` taps a tracker source (`rig.devices.tap`): every sample the session takes
+is pushed on `RigTracker`. `PublishingRenderer` wraps a renderer: every pose it draws a display frame with (an
 application frame of a renderer that shows one image per frame, each composed frame of one that
 composes at every refresh) is pushed on `RigPose` with the photon time it was predicted for, the
 newest sample behind it and, as its stamp, when the renderer was handed it. Pushing never blocks.
@@ -92,30 +92,6 @@ class LslPublisher:
 
     def close(self) -> None:
         self._pose = self._tracker = None
-
-
-class PublishingTracker:
-    """A tracker source whose samples are also pushed on the rig's tracker outlet."""
-
-    def __init__(self, tracker: Any, publisher: LslPublisher) -> None:
-        self.tracker = tracker
-        self.publisher = publisher
-
-    def connect(self, clock: Clock) -> None:
-        self.tracker.connect(clock)
-
-    def poll(self) -> list[PoseSample]:
-        samples = self.tracker.poll()
-        self.publisher.samples(samples)
-        return samples
-
-    def wait(self, timeout_s: float) -> list[PoseSample]:
-        samples = self.tracker.wait(timeout_s)
-        self.publisher.samples(samples)
-        return samples
-
-    def close(self) -> None:
-        self.tracker.close()
 
 
 class PublishingRenderer:

@@ -18,12 +18,12 @@ Gaussian draws would dominate the simulation's cost, and the analyser cannot tel
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rig.clock import Clock
-from rig.devices.protocols import CameraFrame
+from rig.devices.protocols import CameraFrame, Fault
 from rig.errors import ConfigError
 from rig.sim.impairments import FilmImpairments, FrameImpairer
 
@@ -198,6 +198,13 @@ class SimCamera:
                 self._filmed += 1
             self._next += 1
         return frames
+
+    def fault(self) -> Fault | None:
+        """None: the simulated camera films to the end."""
+        return None
+
+    def report(self) -> dict[str, Any]:
+        return {"camera": "sim", "fps": self.fps, "frames": self._filmed}
 
     def close(self) -> None:
         self._sensor = None
