@@ -8,7 +8,8 @@
   photon time, the newest sample behind it, the sensor-to-photon delay, the x drawn, whether the
   refresh missed (the display repeats the previous refresh's image: the renderer had no new one
   ready), and what the work that made the image cost on the clock and where that figure came from;
-* the camera's film, where the run has a camera (`FilmRecord`): `video.avi` and `camera_frames.csv`.
+* the camera's film, where the run has a camera (`FilmRecord`): `video.avi` and `camera_frames.csv`;
+* `board/`, where the rig board records beside the run (`rig.board.instrument`, `rig.sim.board`).
 
 `FilmRecord` is also what `rig record` films into. It appends each frame to `video.avi`
 (Motion-JPEG, what the analyser reads) and a row to `camera_frames.csv` (`FRAME_COLUMNS`): the
@@ -43,6 +44,7 @@ APP_FRAMES_FILE = "app_frames.csv"
 DISPLAY_FRAMES_FILE = "display_frames.csv"
 VIDEO_FILE = "video.avi"
 FRAMES_FILE = "camera_frames.csv"
+BOARD_FOLDER = "board"
 RUN_FILES = (VIDEO_FILE, FRAMES_FILE, TRACKER_FILE, APP_FRAMES_FILE, DISPLAY_FRAMES_FILE)
 APP_FRAME_COLUMNS = (
     "index", "t_start", "cost_s", "cost_source", "t_finish", "t_photon_target", "t_sensor_newest", "x", "y", "z",
