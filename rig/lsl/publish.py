@@ -2,10 +2,11 @@
 tracker stream, and the wrappers that feed them from a session without the session knowing.
 
 `LslPublisher.samples` taps a tracker source (`rig.devices.tap`): every sample the session takes
-is pushed on `RigTracker`. `PublishingRenderer` wraps a renderer: every pose it draws a display frame with (an
-application frame of a renderer that shows one image per frame, each composed frame of one that
-composes at every refresh) is pushed on `RigPose` with the photon time it was predicted for, the
-newest sample behind it and, as its stamp, when the renderer was handed it. Pushing never blocks.
+is pushed on `RigTracker`. `PublishingRenderer` wraps a renderer: every pose it draws a display
+frame with (an application frame of a renderer that shows one image per frame, each composed frame
+of one that composes at every refresh) is pushed on `RigPose` with the photon time it was predicted
+for, the newest sample behind it and, as its stamp, when the renderer was handed it. Pushing never
+blocks.
 """
 
 from __future__ import annotations

@@ -98,7 +98,9 @@ def _row_fraction(grey: np.ndarray) -> float:
     return float((rows.mean() + 0.5) / grey.shape[0]) if rows.size else 0.5
 
 
-def _film(setup: TwinSetup, origin_ns: int, rect: tuple[int, int, int, int], motion_start: Any, stop: Any, ring: FrameRing) -> None:
+def _film(
+    setup: TwinSetup, origin_ns: int, rect: tuple[int, int, int, int], motion_start: Any, stop: Any, ring: FrameRing
+) -> None:
     """The twin's process: film into `ring` until `stop` is set, then write REPORT_FILE."""
     from rig.live.selftest.xscreen import XScreen
 
