@@ -96,7 +96,7 @@ def self_test(
             renderer.terminate()
             renderer.wait(timeout=10)
         emulator.close()
-    fps = camera.measured_fps
+    fps = result.summary["film"]["measured_fps"]
     options = AnalysisOptions(led_roi=layout.led_roi, sphere_roi=layout.sphere_roi)
     report = analyse_run(out_dir, fps, options, None, result.summary)
     report.run["self_test"] = _agreement(report)
