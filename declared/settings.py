@@ -25,7 +25,8 @@ class Flag:
     a setting in seconds given in ms). per: the option is the setting x this sibling setting (an
     exposure in seconds given as a fraction of the frame interval: exposure x fps). range, default:
     the option's, where they are not the setting's own converted (None: they are; needed with
-    `per`). group: the title of the --help section it is listed in ("" for the command's main one).
+    `per`). help: the option's, where it is not the setting's. group: the title of the --help
+    section it is listed in ("" for the command's main one).
     """
 
     name: str
@@ -35,6 +36,7 @@ class Flag:
     range: Range | None = None
     default: Any = None
     metavar: str | None = None
+    help: str = ""
     group: str = ""
 
 
@@ -89,6 +91,14 @@ def setting(default: Any, unit: str, help: str, range: Range | None = None, *, f
     name, or a `Flag` where the option differs from the setting."""
     flag = Flag(flag) if isinstance(flag, str) else flag
     return dataclasses.field(default=default, metadata={_KEY: Setting(unit, help, range, flag=flag, **declared)})
+
+
+def like(kind: type, name: str, **changes: Any) -> Any:
+    """A field declared as the field `name` of the dataclass `kind` is, with its default: the same
+    setting held in a second place (`changes` to its `Setting`, such as a flag of its own)."""
+    field = next(field for field in dataclasses.fields(kind) if field.name == name)
+    declared = dataclasses.replace(setting_of(field), **changes)
+    return dataclasses.field(default=field.default, metadata={_KEY: declared})
 
 
 def setting_of(field: dataclasses.Field) -> Setting | None:

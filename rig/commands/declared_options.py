@@ -15,26 +15,24 @@ from declared.settings import whole_numbers
 Config = TypeVar("Config")
 
 
-def add_declared_options(parser: argparse.ArgumentParser, kind: type, groups: dict[str, str] | None = None) -> None:
+def add_declared_options(parser: argparse.ArgumentParser, kind: type, groups: dict[str, str] | None = None) -> dict[str, Any]:
     """An option for each setting of `kind` with a flag (nested configs' included), in declaration
     order; a flag's group is a section titled as `groups` says (a group not named there is left out:
-    its options are not this command's)."""
+    its options are not this command's). The sections by title, for options of the command's own."""
     groups = {"": "", **(groups or {})}
-    sections: dict[str, Any] = {}
+    sections = {title: parser.add_argument_group(title) if title else parser for title in groups.values()}
     for entry in walk(kind):
         flag = entry.setting.flag
-        if flag is None or flag.group not in groups:
-            continue
-        title = groups[flag.group]
-        if title not in sections:
-            sections[title] = parser.add_argument_group(title) if title else parser
-        sections[title].add_argument(flag.name, dest=_dest(entry), **_argument(entry))
+        if flag is not None and flag.group in groups:
+            sections[groups[flag.group]].add_argument(flag.name, dest=_dest(entry), **_argument(entry))
+    return sections
 
 
-def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception]) -> Config:
-    """The `kind` the options given make (every setting without an option at its default), each
-    value in its setting's unit; `error` is what `kind` raises for a value it does not allow."""
-    table: dict[str, Any] = {}
+def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception], **given: Any) -> Config:
+    """The `kind` the options given make (every setting without an option at its default, and the
+    fields in `given` as given), each value in its setting's unit; `error` is what `kind` raises
+    for a value it does not allow."""
+    table: dict[str, Any] = dict(given)
     per: list[tuple[Entry, Any]] = []
     for entry in walk(kind):
         flag = entry.setting.flag
@@ -76,7 +74,8 @@ def _argument(entry: Entry) -> dict[str, Any]:
     unit = flag.unit if flag.unit is not None else setting.unit
     shown = setting.unset if default is None else ",".join(f"{v:g}" for v in default) if isinstance(default, tuple) else str(default)
     about = "; ".join(part for part in (unit, f"default: {shown}" if shown and entry.hint is not bool else "") if part)
-    keywords: dict[str, Any] = {"help": f"{setting.help} ({about})".replace("%", "%%") if about else setting.help}
+    text = flag.help or setting.help
+    keywords: dict[str, Any] = {"help": (f"{text} ({about})" if about else text).replace("%", "%%")}
     if entry.hint is bool:
         return keywords | {"action": "store_true"}
     keywords |= {"default": default, "metavar": flag.metavar}

@@ -22,10 +22,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from declared import NON_NEGATIVE, POSITIVE, Flag, Range, check, setting
 from rig.clock import Clock
 from rig.devices.protocols import CameraFrame
 from rig.errors import ConfigError
-from rig.sim.impairments import FilmImpairments, FrameImpairer
+from rig.sim.impairments import FILM, FilmImpairments, FrameImpairer
 
 if TYPE_CHECKING:
     from rig.sim.scene import FilmedScene
@@ -38,30 +39,34 @@ _NOISE_PAD = 64
 
 @dataclass(frozen=True)
 class CameraConfig:
-    fps: float = 240.0
-    exposure_s: float | None = None
-    width: int = 640
-    height: int = 480
-    noise_dn: float = 2.0
-    dark_dn: float = 8.0
-    led_peak_dn: float = 900.0
-    display_black_dn: float = 6.0
-    display_white_dn: float = 190.0
-    subsamples: int = 8
+    fps: float = setting(240.0, "frames per second", "camera frame rate", Range(1.0, 10000.0, True, True), flag="--camera-fps")
+    exposure_s: float | None = setting(
+        None, "seconds", "camera exposure, at most one frame interval", POSITIVE, unset="the whole frame interval",
+        flag=Flag(
+            "--exposure", unit="frame intervals", per="fps", range=Range(0.0, 1.0, includes_high=True), default=1.0, metavar="F",
+            help="camera exposure, as a fraction of the frame interval",
+        ),
+    )  # fmt: skip
+    width: int = setting(640, "pixels", "sensor width", Range(64.0, includes_low=True))
+    height: int = setting(480, "pixels", "sensor height", Range(48.0, includes_low=True))
+    noise_dn: float = setting(2.0, "DN", "sensor read noise, in digital numbers", NON_NEGATIVE, flag=Flag("--noise-dn", group=FILM))
+    dark_dn: float = setting(8.0, "DN", "the sensor's dark level", NON_NEGATIVE)
+    led_peak_dn: float = setting(900.0, "DN", "the LED's peak before the sensor saturates", POSITIVE)
+    display_black_dn: float = setting(6.0, "DN", "how bright the display's black films", NON_NEGATIVE)
+    display_white_dn: float = setting(
+        190.0, "DN", "how bright the display's white films: lower for a dim sphere", POSITIVE,
+        flag=Flag("--display-white-dn", group=FILM),
+    )  # fmt: skip
+    subsamples: int = setting(8, "", "instants of each exposure averaged (motion blur)", Range(1.0, includes_low=True))
     impairments: FilmImpairments = field(default_factory=FilmImpairments)
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.fps) and 1.0 <= self.fps <= 10000.0):
-            raise ConfigError(f"camera frame rate must be 1-10000 fps, got {self.fps}")
-        if self.exposure_s is not None and not 0.0 < self.exposure_s <= 1.0 / self.fps:
+        check(self, ConfigError, "camera.")
+        if self.exposure_s is not None and not self.exposure_s <= 1.0 / self.fps:
             raise ConfigError(
                 f"camera exposure must be positive and at most one frame interval ({1e3 / self.fps:.3f} ms), "
                 f"got {self.exposure_s * 1e3:.3f} ms"
             )
-        if self.width < 64 or self.height < 48:
-            raise ConfigError(f"camera resolution must be at least 64x48, got {self.width}x{self.height}")
-        if self.noise_dn < 0 or self.subsamples < 1:
-            raise ConfigError("camera noise must be >= 0 and subsamples >= 1")
 
     @property
     def exposure(self) -> float:
