@@ -10,7 +10,8 @@ import another's declarations, so the primitive lives here, importing nothing of
   setting in a second dataclass, and `walk(kind)` lists a config's settings, nested configs
   included, for the command line and the docs tables;
 * `from_table(kind, table, ErrorType)` (`declared.tables`) reads a spec's table into the dataclass,
-  every key and type checked.
+  every key and type checked;
+* `declared.docs.markdown_table(kind)` is the docs' table of a config's settings.
 """
 
 from declared.ranges import ANY, FRACTION, NON_NEGATIVE, OPEN_UNIT, POSITIVE, Range

@@ -45,7 +45,7 @@ class Setting:
     """What a setting means to a user.
 
     unit: as a message reads it ("seconds", "Hz"); "" for a pure number or a name.
-    help: one line for --help and the docs tables; where the default is None it says what None does.
+    help: one line for --help and the docs tables.
     range: the numbers allowed (for a list, each item's). choices: the names allowed, or a function
     that lists them when asked (a registry that grows). rule: a check of the whole value, giving a
     sentence saying what is wrong or None ("LOW must be below HIGH").
@@ -84,6 +84,7 @@ class Setting:
 
 def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
+
 
 def setting(default: Any, unit: str, help: str, range: Range | None = None, *, flag: str | Flag | None = None,
             **declared: Any) -> Any:  # fmt: skip

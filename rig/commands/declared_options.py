@@ -68,7 +68,7 @@ def _get(table: dict[str, Any], path: str) -> Any:
 
 
 def _argument(entry: Entry) -> dict[str, Any]:
-    """argparse's keywords for the entry's option."""
+    """argparse's keywords for the entry's option: its help ends with its unit and default."""
     setting, flag = entry.setting, entry.setting.flag
     default = flag.default if flag.default is not None else _converted(entry.default, flag.factor)
     unit = flag.unit if flag.unit is not None else setting.unit
@@ -79,9 +79,8 @@ def _argument(entry: Entry) -> dict[str, Any]:
     if entry.hint is bool:
         return keywords | {"action": "store_true"}
     keywords |= {"default": default, "metavar": flag.metavar}
-    if setting.allowed() is not None:
-        return keywords | {"choices": setting.allowed(), "metavar": flag.metavar}
-    return keywords | {"type": _parser(entry)}
+    choices = setting.allowed()
+    return keywords | ({"choices": choices} if choices is not None else {"type": _parser(entry)})
 
 
 def _converted(value: Any, factor: float) -> Any:
@@ -89,25 +88,28 @@ def _converted(value: Any, factor: float) -> Any:
 
 
 def _parser(entry: Entry) -> Callable[[str], Any]:
-    """Text to the option's value, checked against the setting's range in the option's unit."""
+    """Text to the option's value (a list is comma-separated), checked against the setting's range
+    in the option's unit."""
     setting, flag = entry.setting, entry.setting.flag
-    hint = typing.get_args(entry.hint) if typing.get_origin(entry.hint) is tuple else (entry.hint,)
-    whole = whole_numbers(entry.hint)
+    kinds = typing.get_args(entry.hint) if typing.get_origin(entry.hint) is tuple else (entry.hint,)
+    listed = len(kinds) > 1
     allowed = flag.range or (setting.range.scaled(flag.factor) if setting.range is not None else None)
     unit = flag.unit if flag.unit is not None else setting.unit
+    expected = _expected(kinds, flag.metavar, setting.none)
 
     def parse(text: str) -> Any:
         if setting.none and text == setting.none:
             return None
-        parts = text.split(",") if len(hint) > 1 else [text]
+        parts = text.split(",") if listed else [text]
+        items = [kinds[0]] * len(parts) if kinds[-1] is Ellipsis else kinds
         try:
-            if len(parts) != len(hint):
+            if len(parts) != len(items):
                 raise ValueError
-            values = tuple(kind(part) for kind, part in zip(hint, parts))
+            values = tuple(kind(part) for kind, part in zip(items, parts))
         except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {_expected(hint, flag.metavar, setting.none)}, got {text!r}") from None
-        value = values if len(hint) > 1 else values[0]
-        problem = setting.problem(value, whole, allowed, unit)
+            raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}") from None
+        value = values if listed else values[0]
+        problem = setting.problem(value, whole_numbers(entry.hint), allowed, unit)
         if problem is not None:
             raise argparse.ArgumentTypeError(f"{problem}, got {text}")
         return value
@@ -115,7 +117,8 @@ def _parser(entry: Entry) -> Callable[[str], Any]:
     return parse
 
 
-def _expected(hint: tuple[Any, ...], metavar: str | None, none: str) -> str:
-    kind = "whole number" if hint[0] is int else "number" if hint[0] is float else "value"
-    what = f"a {kind}" if len(hint) == 1 else f"{metavar or 'values'}, {len(hint)} {kind}s"
+def _expected(kinds: tuple[Any, ...], metavar: str | None, none: str) -> str:
+    noun = "whole number" if kinds[0] is int else "number" if kinds[0] is float else "value"
+    count = "" if kinds[-1] is Ellipsis else f"{len(kinds)} "
+    what = f"a {noun}" if len(kinds) == 1 else f"{metavar or 'values'}, {count}{noun}s"
     return f"{what} or '{none}'" if none else what
