@@ -23,8 +23,8 @@ that takes longer than a refresh misses refreshes), or the server's modelled whe
 a sweep (`rig.service.sweep`) of explicit points, written beside the runs as films.toml, so that
 `rig sweep films.toml --out DIR` films exactly those again.
 
-The grid is data: `specs/renderers.toml` (the default) and `specs/renderers-quick.toml` (`--quick`),
-read by `read_grid`. `rig.bench.seed_table` and `rig.bench.warp_variants` build on these parts.
+The grid is `BenchGrid`, each setting declared once with its default; a spec (`--spec`, and
+`specs/renderers-quick.toml` for `--quick`) sets any of them, read by `read_grid`. `rig.bench.seed_table` and `rig.bench.warp_variants` build on these parts.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from declared import NON_NEGATIVE, POSITIVE, Range, check, like, setting
 from predictors import Pose
 from rig.bench.renderer_latency import LatencyRun, film_latencies
 from rig.bench.spec_reader import read_spec
@@ -53,9 +54,7 @@ from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
-SPECS = Path(__file__).parent / "specs"
-SPEC = SPECS / "renderers.toml"
-QUICK_SPEC = SPECS / "renderers-quick.toml"
+QUICK_SPEC = Path(__file__).parent / "specs" / "renderers-quick.toml"
 
 ROW_FIELDS = (
     "renderer", "spec", "reconstruction", "views", "triangles", "width", "height", "rate_ratio",
@@ -73,39 +72,50 @@ LATENCY_FIELDS = (
 
 @dataclass(frozen=True)
 class BenchGrid:
-    """What `rig bench renderers` measures, and how much of it."""
+    """What `rig bench renderers` measures, and how much of it: each setting declared on its field
+    (the defaults are the bench's grid); a spec file (`--spec FILE.toml`, `specs/renderers-quick.toml`)
+    sets any of them, every key and value checked (`read_grid`)."""
 
-    triangles: tuple[int, ...] = (10_000, 100_000, 1_000_000, 5_000_000)
-    resolutions: tuple[tuple[int, int], ...] = ((320, 240), (640, 480), (1280, 720))
-    """the first is the latency runs' display too"""
-    ratios: tuple[int, ...] = (1, 5, 10)
-    warp: str = "warp"
-    """the warp renderer's spec, options included"""
-    phases: int = 4
-    """client poses per (N, resolution) for the image error, spread over a swing"""
-    warp_rounds: int = 16
-    direct_frames: int = 4
-    direct_budget_s: float = 6.0
-    """stop timing direct frames (after the first) once this much time is spent"""
-    latency_triangles: tuple[int, ...] | None = None
-    """the load sizes whose latency is filmed (None: all)"""
+    triangles: tuple[int, ...] = setting(
+        (10_000, 100_000, 1_000_000, 5_000_000), "triangles",
+        "load sizes (a soup of small random triangles), each timed at every resolution", NON_NEGATIVE,
+    )  # fmt: skip
+    resolutions: tuple[tuple[int, int], ...] = setting(
+        ((320, 240), (640, 480), (1280, 720)), "pixels", "display sizes, [width, height]; the first is the latency films' display too"
+    )
+    ratios: tuple[int, ...] = setting(
+        (1, 5, 10), "", "client:display rate ratios 1:r whose image error is measured (display frames per client frame)",
+        Range(1.0, includes_low=True),
+    )  # fmt: skip
+    warp: str = setting("warp", "", "the warp renderer and its options, a renderer spec such as warp:recon=grid,views=2")
+    phases: int = setting(4, "", "client poses per load and resolution for the image error, spread over a swing", Range(1.0, includes_low=True))
+    warp_rounds: int = setting(
+        16, "", "rounds of warp timing; each round times one display frame of every load in turn", Range(1.0, includes_low=True)
+    )
+    direct_frames: int = setting(4, "", "direct frames timed at most (the first is always timed)", Range(1.0, includes_low=True))
+    direct_budget_s: float = setting(6.0, "seconds", "no more direct frames are timed after this long", POSITIVE)
+    latency_triangles: tuple[int, ...] | None = setting(
+        None, "triangles", "the load sizes whose latency is filmed", NON_NEGATIVE, unset="all of them"
+    )
     latency_camera: CameraConfig = CameraConfig()
-    """the latency runs' camera; its frame rate follows the pendulum period"""
-    latency_duration_s: float = 6.0
-    max_period_s: float = 8.0
-    refresh_hz: float = 60.0
-    server_ms: float | None = None
-    """the warp server's modelled cost in the latency runs (ms), None: measured"""
-    predictor: str = "hold"
-    """the latency runs' predictor, both renderers alike (as the seeds' Table 2)"""
-    direct_predictor: str | None = None
-    """the direct renderer's predictor in the latency runs, where it differs"""
+    """the latency films' camera; its frame rate follows the pendulum's period"""
+    latency_duration_s: float = setting(6.0, "seconds", "the latency films' shortest length", POSITIVE)
+    max_period_s: float = setting(
+        8.0, "seconds", "the longest pendulum period filmed: a latency that would need a longer one is beyond range", POSITIVE
+    )
+    refresh_hz: float = like(DisplayConfig, "refresh_hz", flag=None)
+    server_ms: float | None = setting(
+        None, "ms", "the warp server's modelled cost in the latency films", POSITIVE, unset="measured here, as every other cost"
+    )
+    predictor: str = setting("hold", "", "the latency films' predictor, both renderers alike (as the seeds' Table 2)")
+    direct_predictor: str | None = setting(
+        None, "", "the direct renderer's predictor in the latency films, where it differs", unset="the same"
+    )
 
     def __post_init__(self) -> None:
+        check(self, ConfigError)
         if not (self.triangles and self.resolutions and self.ratios):
             raise ConfigError("a renderer bench grid needs at least one load size, resolution and rate ratio")
-        if min(self.ratios) < 1 or min(self.triangles) < 0:
-            raise ConfigError("rate ratios are display frames per client frame, at least 1; load sizes are at least 0")
         if min(min(size) for size in self.resolutions) < 16:
             raise ConfigError(f"a display is at least 16x16 pixels, got {self.resolutions}")
 
@@ -121,9 +131,10 @@ class BenchGrid:
         )  # fmt: skip
 
 
-def read_grid(path: Path) -> BenchGrid:
-    """A grid from its TOML spec (`rig.bench.spec_reader`: every key and type checked)."""
-    return read_spec(BenchGrid, path)
+def read_grid(path: Path | None) -> BenchGrid:
+    """The grid a TOML spec sets (`rig.bench.spec_reader`: every key and value checked), the
+    defaults where it is silent; with no spec, the defaults."""
+    return read_spec(BenchGrid, path) if path is not None else BenchGrid()
 
 
 Log = Callable[[str], None]

@@ -140,7 +140,7 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
         "instead, labelled). --seed-table sets this machine's latencies beside the seeds' Table 2; --variants plots "
         "image error against latency saved for each warp variant; --photon-residual films each predictor aimed at "
         "the photons and at scan-out. The grid is a spec file "
-        f"({renderers.SPEC.name}, in {renderers.SPECS}; --spec runs an edited copy), the grid's options override it; "
+        "(BenchGrid's settings, each with its default: --spec FILE.toml sets any of them), the grid's options override it; "
         "its latency films are written beside the runs as films.toml, which `rig sweep` films again. The default grid "
         "takes several minutes, --seed-table up to an hour; --quick runs a tiny one of each.",
     )
@@ -152,8 +152,8 @@ def add_renderers(benchmarks: argparse._SubParsersAction) -> None:
     parser.add_argument("--csv", type=outputs.csv_file, metavar="OUT.csv", help="write the rows as CSV")
     parser.add_argument("--plot", type=outputs.plot_file, metavar="OUT.png", help="plot the run (latency against N, error against latency saved, ...)")
     grid = parser.add_mutually_exclusive_group()
-    grid.add_argument("--spec", type=Path, default=renderers.SPEC, metavar="SPEC.toml",
-                      help="the grid, as a TOML file of rig.bench.renderers.BenchGrid's fields (default: the bench's own)")  # fmt: skip
+    grid.add_argument("--spec", type=Path, metavar="SPEC.toml",
+                      help="the grid, as a TOML file of rig.bench.renderers.BenchGrid's settings (default: BenchGrid's defaults)")  # fmt: skip
     grid.add_argument("--quick", action="store_true", help=f"a tiny run (a smoke test, seconds not minutes; {renderers.QUICK_SPEC.name})")
     parser.add_argument("--triangles", type=_int_list, metavar="N,N,...", help="load sizes (default 10000,100000,1000000,5000000; --variants 10000,200000)")
     parser.add_argument("--resolutions", type=_resolution_list, metavar="WxH,...", help="display sizes; the first is the latency runs' (default 320x240,640x480,1280x720)")

@@ -6,7 +6,7 @@ import argparse
 import json
 
 from rig.commands import outputs
-from rig.commands.simulation_options import add_lab_options, add_simulation_options, config_from_args, with_lab_options
+from rig.commands.simulation_options import add_simulation_options, simulation_config
 from rig.progress import ProgressBar
 from rig.service import simulate
 from rig.service.run_plot import plot_run
@@ -14,7 +14,7 @@ from rig.sim.board import BOARD_FOLDER
 
 
 def _run(args: argparse.Namespace) -> int:
-    result = simulate(with_lab_options(config_from_args(args), args), args.out, ProgressBar("simulating"), args.overwrite)
+    result = simulate(simulation_config(args), args.out, ProgressBar("simulating"), args.overwrite)
     writes = outputs.LateWrites()
     if args.plot is not None:
         writes.write(args.plot, lambda: plot_run(result.out_dir, result.truth.latency_ms, args.plot))
@@ -54,6 +54,5 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="plot the run's truth: the sphere as tracked, predicted and displayed, and each refresh's delay from "
         "the newest sample to its photons beside the true latency",
     )
-    add_simulation_options(parser)
-    add_lab_options(parser)
+    add_simulation_options(parser, lab=True)
     parser.set_defaults(func=_run)

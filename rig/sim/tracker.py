@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from declared import FRACTION, NON_NEGATIVE, POSITIVE, Flag, check, setting
 from predictors import PoseSample
 from rig.clock import Clock
 from rig.devices.protocols import Fault
@@ -36,28 +37,23 @@ from rig.sim.pendulum import Pendulum
 
 @dataclass(frozen=True)
 class TrackerConfig:
-    """Rate, noise and transport of a simulated tracker. Times in seconds, noise as std-devs."""
+    """Rate, noise and transport of a simulated tracker, each declared on its field (`declared.setting`)."""
 
-    rate_hz: float = 120.0
-    position_noise_m: float = 0.0002
-    orientation_noise_deg: float = 0.05
-    transport_delay_s: float = 0.004
-    jitter_s: float = 0.0005
-    dropout: float = 0.0
-    phase_s: float = 0.0
+    rate_hz: float = setting(120.0, "Hz", "tracker sample rate", POSITIVE, flag="--tracker-hz")
+    position_noise_m: float = setting(0.0002, "metres", "position noise, standard deviation per axis", NON_NEGATIVE)
+    orientation_noise_deg: float = setting(
+        0.05, "degrees", "orientation noise, standard deviation of each rotation-vector component", NON_NEGATIVE
+    )
+    transport_delay_s: float = setting(
+        0.004, "seconds", "fixed tracker-to-host delay", NON_NEGATIVE, flag=Flag("--transport-delay-ms", unit="ms", factor=1e3)
+    )
+    jitter_s: float = setting(0.0005, "seconds", "mean transport jitter, exponentially distributed", NON_NEGATIVE)
+    dropout: float = setting(0.0, "", "probability that a sample is lost", FRACTION)
+    phase_s: float = setting(0.0, "seconds", "first sensor time after the start, less than one sample interval", NON_NEGATIVE)
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.rate_hz) and self.rate_hz > 0.0):
-            raise ConfigError(
-                f"tracker.rate_hz must be a positive finite rate in Hz, got {self.rate_hz!r}"
-            )
-        for name in ("position_noise_m", "orientation_noise_deg", "transport_delay_s", "jitter_s"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ConfigError(f"tracker.{name} must be a finite number >= 0, got {value!r}")
-        if not (0.0 <= self.dropout < 1.0):
-            raise ConfigError(f"tracker.dropout must be a probability in [0, 1), got {self.dropout!r}")
-        if not (0.0 <= self.phase_s < 1.0 / self.rate_hz):
+        check(self, ConfigError, "tracker.")
+        if not self.phase_s < 1.0 / self.rate_hz:
             raise ConfigError(
                 f"tracker.phase_s must be in [0, 1 / rate_hz) = [0, {1.0 / self.rate_hz!r}) s, "
                 f"got {self.phase_s!r}"
