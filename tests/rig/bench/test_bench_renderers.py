@@ -12,17 +12,22 @@ from pathlib import Path
 
 import pytest
 
-from rig.bench import seed_table
+from rig.bench import renderers, seed_table
 from rig.bench.renderer_latency import FILMS_SPEC, film_latency
-from rig.bench.renderers import LATENCY_FIELDS, QUICK_SPEC, ROW_FIELDS, SPEC, BenchGrid, read_grid, scene_setup
+from rig.bench.renderer_setup import scene_setup
+from rig.bench.renderers import LATENCY_FIELDS, QUICK_SPEC, ROW_FIELDS, SPEC, BenchGrid
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
+from rig.bench.spec_reader import read_spec
 from rig.cli import EXIT_USER_ERROR, main
 from rig.commands import bench
-from rig.commands.bench_renderers import _grid
 from rig.service.sweep import read_sweep
 from rig.sim.camera import CameraConfig
 
-QUICK_GRID = read_grid(QUICK_SPEC)
+QUICK_GRID = read_spec(BenchGrid, QUICK_SPEC)
+
+
+def _grid(args: argparse.Namespace) -> BenchGrid:
+    return bench.spec(renderers.BENCH, args)
 
 
 def bench_parser() -> argparse.ArgumentParser:
@@ -114,8 +119,8 @@ def test_the_films_spec_sweeps_exactly_the_simulations_the_bench_filmed(quick_ru
 
 
 def test_the_specs_hold_the_grids_the_bench_had():
-    assert read_grid(SPEC) == BenchGrid()
-    assert read_grid(QUICK_SPEC) == BenchGrid(
+    assert read_spec(BenchGrid, SPEC) == BenchGrid()
+    assert QUICK_GRID == BenchGrid(
         triangles=(1_000, 8_000), resolutions=((160, 120),), ratios=(1, 3), phases=1, warp_rounds=3, direct_frames=3,
         direct_budget_s=1.0, latency_triangles=(1_000,), latency_camera=CameraConfig(width=320, height=240, subsamples=4),
         latency_duration_s=2.5, max_period_s=4.0,
