@@ -42,7 +42,6 @@ from rig.sim.camera import CameraConfig
 
 SEED_SOURCE = "Smit, van Liere, Beck, Froehlich 2010, Table 2"
 SEED_REFRESH_MS = 1e3 / 60.0
-SEED_COLUMNS = ("faces", "reference_ms", "reference_sd_ms", "reference_frame_ms", "warp_ms", "warp_sd_ms", "warp_frame_ms")
 SEED_TABLE_2 = (
     (64e6, None, None, 577.0, 58.9, 2.6, 14.1),
     (32e6, 780.0, 14.2, 289.0, 61.1, 2.5, 14.3),
