@@ -11,17 +11,22 @@ from pathlib import Path
 
 import pytest
 
-from rig.bench import seed_table
+from rig.bench import renderers, seed_table
 from rig.bench.renderer_latency import FILMS_SPEC, film_latency
-from rig.bench.renderers import LATENCY_FIELDS, QUICK_SPEC, ROW_FIELDS, BenchGrid, read_grid, scene_setup
+from rig.bench.renderer_setup import scene_setup
+from rig.bench.renderers import LATENCY_FIELDS, QUICK_SPEC, ROW_FIELDS, BenchGrid, read_grid
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
+from rig.bench.spec_reader import read_spec
 from rig.cli import EXIT_USER_ERROR, main
 from rig.commands import bench
-from rig.commands.bench_renderers import _grid
 from rig.service.sweep import read_sweep
 from rig.sim.camera import CameraConfig
 
-QUICK_GRID = read_grid(QUICK_SPEC)
+QUICK_GRID = read_spec(BenchGrid, QUICK_SPEC)
+
+
+def _grid(args: argparse.Namespace) -> BenchGrid:
+    return bench.spec(renderers.BENCH, args)
 
 
 def bench_parser() -> argparse.ArgumentParser:
