@@ -18,8 +18,8 @@ from typing import Any, Sequence
 
 from rig.devices.trackers.lsl_tracker import CHANNELS, pylsl
 from rig.emulate.encode import Emission, RecordEncoder
-from rig.emulate.faults import ByteFaults
 from rig.errors import RigError
+from rig.sim.tracker_faults import ByteFaults
 
 # After a reader opens the port it may flush what is waiting (pyserial does): start a little later.
 READER_GRACE_S = 0.1
