@@ -59,9 +59,13 @@ def _run(args: argparse.Namespace) -> int:
     sink = make_sink(config)
     config = replace(config, address=sink.address)
     spec = f"serial:{sink.address}?profile={config.profile}" if transport != "lsl" else sink.address
-    print(f"emulated tracker ready: record it with --tracker {spec}", flush=True)
     try:
-        counts = run_emulator(config, sink, lambda message: print(f"emulator: {message}", file=sys.stderr, flush=True))
+        counts = run_emulator(
+            config,
+            sink,
+            lambda message: print(f"emulator: {message}", file=sys.stderr, flush=True),
+            on_ready=lambda: print(f"emulated tracker ready: record it with --tracker {spec}", flush=True),
+        )
     finally:
         sink.close()
     summary = {"tracker": spec, "faults": config.faults.label, "sent": counts.sent, "intact": counts.intact,

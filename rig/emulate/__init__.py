@@ -108,13 +108,19 @@ def make_sink(config: EmulatorConfig) -> Sink:
 
 
 def run_emulator(
-    config: EmulatorConfig, sink: Sink, on_event: Callable[[str], None], on_start: Callable[[float], None] = lambda t: None
+    config: EmulatorConfig,
+    sink: Sink,
+    on_event: Callable[[str], None],
+    on_start: Callable[[float], None] = lambda t: None,
+    on_ready: Callable[[], None] = lambda: None,
 ) -> SentCounts:
     """Streams `config` through `sink` (from make_sink), logging every record's fate to config.log;
+    `on_ready` is called once the samples are worked out, before it waits for a reader, and
     `on_start` is told the monotonic time (s) of the stream's time 0 once a reader is there. An LSL
     record is stamped with its sensor time on the LSL clock (the monotonic clock), a serial one with
     the device's own clock."""
     samples, rates = emulated_samples(config)
+    on_ready()
     if config.transport == "lsl":
         device_clock: Callable[[float], float] = lambda t: t
     else:

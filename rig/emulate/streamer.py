@@ -120,6 +120,9 @@ def stream(
         delay = start + due[k] - time.monotonic()
         if delay > 0:
             time.sleep(delay)
+        if not sink.connected():  # a pty's writes would block once its buffer is full
+            on_event("the reader went away; stopping")
+            break
         emissions = [emission(j) for j in range(k, group)]
         damaged, t_write = sink.send(emissions, rate)
         record(emissions, ["damaged" if d else "intact" for d in damaged], t_write)
