@@ -18,6 +18,7 @@ from typing import Any, Sequence
 
 from rig.devices.trackers.lsl_tracker import CHANNELS, pylsl
 from rig.emulate.encode import Emission, RecordEncoder
+from rig.emulate.streamer import ReaderGone
 from rig.errors import RigError
 from rig.sim.tracker_faults import ByteFaults
 
@@ -62,7 +63,10 @@ class PtySink:
         return True
 
     def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
-        """Writes the records at once; (damaged per record, the monotonic time of the write)."""
+        """Writes the records at once; (damaged per record, the monotonic time of the write). ReaderGone
+        once nobody reads: the write would block for good when the terminal's buffer is full."""
+        if not self._reader_present():
+            raise ReaderGone
         chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
         written = time.monotonic()
         os.write(self._master, b"".join(chunks))

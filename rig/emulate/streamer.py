@@ -33,6 +33,10 @@ READER_RETURN_S = 2.0
 DRAIN_S = 0.05
 
 
+class ReaderGone(Exception):
+    """Raised by a sink that cannot send once its reader has gone (a pty's writes would block)."""
+
+
 class Sink(Protocol):
     address: str
 
@@ -120,11 +124,12 @@ def stream(
         delay = start + due[k] - time.monotonic()
         if delay > 0:
             time.sleep(delay)
-        if not sink.connected():  # a pty's writes would block once its buffer is full
+        emissions = [emission(j) for j in range(k, group)]
+        try:
+            damaged, t_write = sink.send(emissions, rate)
+        except ReaderGone:
             on_event("the reader went away; stopping")
             break
-        emissions = [emission(j) for j in range(k, group)]
-        damaged, t_write = sink.send(emissions, rate)
         record(emissions, ["damaged" if d else "intact" for d in damaged], t_write)
         k = group
     time.sleep(DRAIN_S)
