@@ -72,9 +72,6 @@ class PtySink:
         os.write(self._master, b"".join(chunks))
         return list(damaged), written
 
-    def connected(self) -> bool:
-        return self._reader_present()
-
     def disconnect(self) -> None:
         os.close(self._master)
         self._master = -1
@@ -132,9 +129,6 @@ class TcpSink:
             self._client = None
         return list(damaged), written
 
-    def connected(self) -> bool:
-        return self._client is not None
-
     def disconnect(self) -> None:
         for sock in (self._client, self._listener):
             if sock is not None:
@@ -181,9 +175,6 @@ class LslSink:
         for emission in emissions:
             self._outlet.push_sample([*emission.position, *emission.orientation], emission.device_time)
         return [False] * len(emissions), written
-
-    def connected(self) -> bool:
-        return self._outlet is not None and self._outlet.have_consumers()
 
     def disconnect(self) -> None:
         self._outlet = None

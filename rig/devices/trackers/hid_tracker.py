@@ -21,8 +21,6 @@ from rig.errors import ConfigError, RigError
 
 DEFAULT_PROFILE = "hid-quat16"
 READ_TIMEOUT_MS = 50
-# Longest report read: full-speed USB interrupt reports are at most 64 bytes, high-speed 1024.
-MAX_REPORT_BYTES = 1024
 
 
 class HidDevice(Protocol):
