@@ -106,7 +106,7 @@ def stream(
             sink.disconnect()
             on_event(f"disconnected at {time.monotonic() - start:.3f} s for {disconnect[1]:g} s")
             time.sleep(max(0.0, start + sum(disconnect) - time.monotonic()))
-            if not sink.reconnect(start + due[-1] + READER_RETURN_S):
+            if not sink.reconnect(start + max(due) + READER_RETURN_S):
                 on_event("the reader did not come back; stopping")
                 break
             away_until, disconnect = time.monotonic() - start, None
