@@ -29,8 +29,11 @@ SENT_COLUMNS = ("seq", "device_time", "t_write", "fate")
 READER_TIMEOUT_S = 60.0
 # How long after its last record the emulator waits for a reader to come back from a disconnect.
 READER_RETURN_S = 2.0
-# Before a disconnect, and at the end, the emulator lets the reader take what is in flight.
+# At the end the emulator lets the reader take what is in flight; before a disconnect, longer (up
+# to half the time the port is away), as a closed pty loses what its reader has not read yet and a
+# reader on a loaded machine may wait that long for the CPU.
 DRAIN_S = 0.05
+DISCONNECT_DRAIN_S = 0.25
 
 
 class ReaderGone(Exception):
@@ -102,7 +105,7 @@ def stream(
     k, count = 0, len(seqs)
     while k < count:
         if disconnect is not None and due[k] >= disconnect[0]:
-            time.sleep(DRAIN_S)
+            time.sleep(min(DISCONNECT_DRAIN_S, disconnect[1] / 2))
             sink.disconnect()
             on_event(f"disconnected at {time.monotonic() - start:.3f} s for {disconnect[1]:g} s")
             time.sleep(max(0.0, start + sum(disconnect) - time.monotonic()))
