@@ -36,8 +36,8 @@ from rig.live.run import LiveConfig, run_live
 from rig.live.selftest.emulator import EmulatedPendulum
 from rig.live.selftest.frame_clock import FixedRateFrameClock
 from rig.live.view import View
-from rig.records import CsvRecord
-from rig.sim.bench import make_layout
+from rig.writers import CsvRecord
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig

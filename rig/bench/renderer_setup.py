@@ -16,7 +16,7 @@ from rig.errors import ConfigError
 from rig.render import gl, make_renderer
 from rig.render.protocol import RenderSetup
 from rig.render.warp import WarpRenderer
-from rig.sim.bench import make_layout
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig

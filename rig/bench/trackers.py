@@ -6,7 +6,7 @@ latency from the emulator's write to the sample's queueing for a predictor.
 
 Each case starts `rig emulate-tracker` in a process of its own (a pseudo-terminal, a TCP socket or
 an LSL outlet, with the emulator's log of every record's fate) and records it in this process with
-`rig.service.record.record_tracker`, as `rig record-tracker` does. Then:
+`rig.service.tracker_recording.record_tracker`, as `rig record-tracker` does. Then:
 
 * sent, recorded: records the emulator wrote (intact or damaged) and rows in tracker.csv;
 * missing: intact records sent that are not in tracker.csv; fabricated: rows that match no intact
@@ -55,7 +55,7 @@ from rig.devices.trackers.decoders import BinaryDecoder
 from rig.devices.trackers.profile import load_profile
 from rig.devices.trackers.stream import TrackerRecord
 from rig.errors import RigError
-from rig.service.record import record_tracker
+from rig.service.tracker_recording import record_tracker
 
 TARGET_US_PER_SAMPLE = 50.0
 TARGET_LATENCY_MEDIAN_MS = 1.0

@@ -22,7 +22,7 @@ from rig.emulate.encode import RecordEncoder
 from rig.emulate.sinks import LslSink, PtySink, TcpSink
 from rig.emulate.streamer import SENT_COLUMNS, SentCounts, Sink, stream
 from rig.errors import ConfigError
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import Motion, TrackerConfig, TrackerSamples, measure
 from rig.sim.tracker_faults import ByteFaults, FaultPlan

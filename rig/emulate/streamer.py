@@ -18,7 +18,7 @@ from typing import Callable, Protocol, Sequence
 import numpy as np
 
 from rig.emulate.encode import Emission
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 from rig.sim.tracker import TrackerSamples
 
 SENT_COLUMNS = ("seq", "device_time", "t_write", "fate")

@@ -1,6 +1,6 @@
 """Simulate the rig: a session on a virtual clock with the simulated devices, and the run's truth.
 
-A run writes into its output folder as it goes (`rig.session.record`): `tracker.csv`,
+A run writes into its output folder as it goes (`rig.session.run_record`): `tracker.csv`,
 `app_frames.csv`, `display_frames.csv`, `video.avi` and `camera_frames.csv` (or the camera's
 `video.mp4` or `video.mov` with `frame_times.csv` too, `rig.film_file`), with a simulated board its
 recording in `board/` (`rig.sim.board`), and at the end `truth.json` (`rig.sim.truth`). A folder

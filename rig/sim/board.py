@@ -15,7 +15,7 @@ split further at the swing's turning points (found by bisection), so the angle i
 each: every crossing in one is found, none is missed, and each is solved for by Newton's method
 kept inside its interval, to far better than a microsecond.
 
-Written into the board folder as the run goes, through rig.board.recording's writer in the format
+Written into the board folder as the run goes, through rig.board.recorder's writer in the format
 of analysis.board.recording:
 led.csv (the switch-on at the start of the run, every change during the blink with its bit, the
 switch back on after it), encoder.csv (every edge, `edges` = 1 as a board reporting every edge
@@ -39,10 +39,10 @@ from analysis.board.recording import METADATA, TABLES
 from declared import ANY, Range, check, setting
 from rig.board.events import BoardIdentity, EncoderEdge, LedChange
 from rig.board.protocol import protocol
-from rig.board.recording import BoardRecorder
+from rig.board.recorder import BoardRecorder
 from rig.clock import Clock
 from rig.errors import ConfigError
-from rig.session.record import BOARD_FOLDER
+from rig.session.run_record import BOARD_FOLDER
 from rig.sim.pendulum import Pendulum
 
 __all__ = ["BOARD_FOLDER", "SimulatedBoard", "SimulatedBoardConfig", "encoder_count", "remove_recording"]

@@ -9,7 +9,7 @@ from typing import Any
 from declared import NON_NEGATIVE, POSITIVE, Flag, Range, check, like, setting
 from rig.errors import ConfigError
 from rig.session.timing import DEFAULT_SERVER_MS, PhotonTarget
-from rig.sim.bench import DEFAULT_LAYOUT, LAYOUT_HELP, placement
+from rig.sim.layout import DEFAULT_LAYOUT, LAYOUT_HELP, placement
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -42,7 +42,7 @@ class SimulationConfig:
     composed display frame cost on the virtual clock, in ms (modelled), or None (MEASURED) for what
     they take on this machine. photon_target, persistence: `rig.session.PhotonTarget`'s. scene_load:
     the renderer checks it when it opens. layout: where the LED and the display sit in the camera's
-    frame (`rig.sim.bench.placement`). The pendulum's release and the board's blink must fall within
+    frame (`rig.sim.layout.placement`). The pendulum's release and the board's blink must fall within
     the film.
     """
 

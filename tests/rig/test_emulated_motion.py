@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from predictors import PoseSample, quaternion, sample_row
 from predictors.trace import SAMPLE_COLUMNS
 from rig.emulate import EmulatorConfig, emulated_motion, emulated_samples, quiet_tracker
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 from rig.sim.tracker import TrackerConfig
 
 

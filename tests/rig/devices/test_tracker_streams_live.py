@@ -12,7 +12,7 @@ import pytest
 from predictors import read_samples, read_trace
 from rig.devices.trackers.clock_mapping import WINDOW_S
 from rig.emulate import EmulatorConfig, quiet_tracker
-from rig.service.record import DEVICE_FILE, TRACKER_FILE, record_tracker
+from rig.service.tracker_recording import DEVICE_FILE, TRACKER_FILE, record_tracker
 from rig.sim.tracker_faults import parse_faults
 
 pytestmark = pytest.mark.slow

@@ -23,11 +23,11 @@ from rig.errors import RigError
 from rig.live.run import LiveConfig, run_live
 from rig.live.selftest.frame_clock import FixedRateFrameClock
 from rig.live.view import View
-from rig.sim.bench import make_layout
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
-from rig.records import VideoRecord
+from rig.writers import VideoRecord
 
 pytestmark = pytest.mark.slow
 

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from analysis.board.blink_code import lfsr_bits
 from analysis.board.recording import load_table
 from rig.board.protocol import protocol
-from rig.board.recording import FILES
+from rig.board.recorder import FILES
 from rig.clock import VirtualClock
 from rig.errors import ConfigError, RigError
 from rig.sim.board import SimulatedBoard, SimulatedBoardConfig, encoder_count

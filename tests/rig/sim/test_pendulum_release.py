@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rig.errors import ConfigError
-from rig.sim.bench import make_layout
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
