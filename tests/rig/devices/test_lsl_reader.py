@@ -20,8 +20,6 @@ from rig.devices.trackers import stream as stream_module
 from rig.devices.trackers._readers import LslReader
 from rig.devices.trackers.lsl_tracker import CHANNELS, OPEN_TIMEOUT_S, RESOLVE_TIMEOUT_S, lsl_tracker, pylsl
 
-pytestmark = pytest.mark.slow
-
 # Long enough never to run out on a loaded machine; a reader that works returns far sooner.
 PATIENCE_S = 10.0
 _names = count()

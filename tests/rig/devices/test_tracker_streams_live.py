@@ -15,8 +15,6 @@ from rig.emulate import EmulatorConfig, quiet_tracker
 from rig.service.tracker_recording import DEVICE_FILE, TRACKER_FILE, record_tracker
 from rig.sim.tracker_faults import parse_faults
 
-pytestmark = pytest.mark.slow
-
 RATE_HZ = 400.0
 DURATION_S = 1.5
 # The emulator waits for its reader, sends, then lingers: the recording outlasts it by this much.

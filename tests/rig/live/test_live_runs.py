@@ -29,8 +29,6 @@ from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.writers import VideoRecord
 
-pytestmark = pytest.mark.slow
-
 RIG = [sys.executable, "-m", "rig.cli"]
 SELF_TEST_S = 12.0
 AGREEMENT_MS = 2.0
