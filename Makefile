@@ -9,7 +9,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 
-.PHONY: demo test system test-system venv clean
+.PHONY: demo test test-all system test-system venv clean
 
 system:
 	@scripts/install-system-packages.sh system-packages.txt
@@ -31,7 +31,13 @@ $(TEST_STAMP): $(STAMP)
 demo: system $(STAMP)
 	$(BIN)/rig demo --out out/demo
 
+# `make test` is what CI runs: every test but those marked slow (heavier variants of what the others
+# cover: benchmark modes, whole tuning runs, an installed wheel); `make test-all` runs those too.
 test: test-system $(TEST_STAMP)
+	$(MAKE) -C firmware all test
+	$(BIN)/python -m pytest -q -m "not slow"
+
+test-all: test-system $(TEST_STAMP)
 	$(MAKE) -C firmware all test
 	$(BIN)/python -m pytest -q
 

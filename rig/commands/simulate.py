@@ -6,7 +6,7 @@ import argparse
 import json
 
 from rig.commands import outputs
-from rig.commands.simulation_options import add_lab_options, add_simulation_options, config_from_args, with_lab_options
+from rig.commands.simulation_options import add_simulation_options, simulation_config
 from rig.progress import ProgressBar
 from rig.service import simulate
 from rig.service.run_plot import plot_run
@@ -14,7 +14,7 @@ from rig.sim.board import BOARD_FOLDER
 
 
 def _run(args: argparse.Namespace) -> int:
-    result = simulate(with_lab_options(config_from_args(args), args), args.out, ProgressBar("simulating"), args.overwrite)
+    result = simulate(simulation_config(args), args.out, ProgressBar("simulating"), args.overwrite)
     writes = outputs.LateWrites()
     if args.plot is not None:
         writes.write(args.plot, lambda: plot_run(result.out_dir, result.truth.latency_ms, args.plot))
@@ -40,7 +40,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "simulate",
         help="simulate the rig and write a video with known latency",
         description="Simulate pendulum, tracker, predictor, renderer, display and camera on a virtual clock. "
-        "Writes DIR/video.avi, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and DIR/display_frames.csv, "
+        "Writes DIR/video.avi, DIR/camera_frames.csv, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and "
+        "DIR/display_frames.csv, "
         f"and with --board the board's recording in DIR/{BOARD_FOLDER}/.",
     )
     parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="output folder")
@@ -53,6 +54,5 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="plot the run's truth: the sphere as tracked, predicted and displayed, and each refresh's delay from "
         "the newest sample to its photons beside the true latency",
     )
-    add_simulation_options(parser)
-    add_lab_options(parser)
+    add_simulation_options(parser, lab=True)
     parser.set_defaults(func=_run)

@@ -29,7 +29,7 @@ from rig.live.selftest.frame_clock import FixedRateFrameClock
 from rig.live.selftest.twin import ScreenCamera, TwinSetup
 from rig.live.view import View
 from rig.lsl import StreamNames
-from rig.sim.bench import make_layout
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -96,7 +96,7 @@ def self_test(
             renderer.terminate()
             renderer.wait(timeout=10)
         emulator.close()
-    fps = camera.measured_fps
+    fps = result.summary["film"]["measured_fps"]
     options = AnalysisOptions(led_roi=layout.led_roi, sphere_roi=layout.sphere_roi)
     report = analyse_run(out_dir, fps, options, None, result.summary)
     report.run["self_test"] = _agreement(report)
