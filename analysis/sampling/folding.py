@@ -1,12 +1,12 @@
 """The misfit of every phase, exposure and row slope of one refresh rate, by folding the frames.
 
 For a refresh rate f, a row slope m (``analysis.sampling.rows``), an exposure e (in refreshes) and a
-phase phi, every frame's bias is b_n = G(frac(f (t_n - shift_n) + phi)) / f, G the exposure's bias
+phase phi, every frame's bias is b_n = G(frac(f (t_n - shift_n) + phi)) / f, t_n its frame time, G the exposure's bias
 g smeared over the sphere's rows by f m and shift_n the time its centroid row moves its phase
 (``analysis.sampling.rows``), and the sphere's residuals should read r_n = -v_n (b_n - mean b)
 (``analysis.sampling.residuals``).
 
-Frames are folded by the phase of their dated time, frac(f t_n), into bins: every phi is then a
+Frames are folded by the phase of their frame time, frac(f t_n), into bins: every phi is then a
 circular shift, and the misfit over all phases takes a few FFTs per (m, e). A bin's frames are
 shifted from it by shift_n, distributed over the frames as the slope's kernel says, so its model is
 G smeared once more by that distribution (``analysis.sampling.rows``).
@@ -32,10 +32,11 @@ PHASE_BINS = 512
 
 
 class Folding:
-    """The residuals' sums per phase bin at a refresh rate: W = sum v^2 and X = sum v r."""
+    """The residuals' sums per phase bin at a refresh rate, the frames at ``times`` (their frame
+    times; residuals.t by default): W = sum v^2 and X = sum v r."""
 
-    def __init__(self, residuals: TimingResiduals, refresh_hz: float, bins: int) -> None:
-        phase = refresh_hz * residuals.t
+    def __init__(self, residuals: TimingResiduals, refresh_hz: float, bins: int, times: np.ndarray | None = None) -> None:
+        phase = refresh_hz * (residuals.t if times is None else times)
         self.index = ((phase - np.floor(phase)) * bins).astype(np.int64) % bins
         self.w = np.bincount(self.index, residuals.v**2, bins)
         self.x = np.bincount(self.index, residuals.v * residuals.r, bins)
@@ -112,7 +113,7 @@ def fit(
     allow; one, 0, without them), every exposure and every phase."""
     if slopes is None:
         slopes = rows.slopes(rate) if rows is not None else np.zeros(1)
-    folding = Folding(residuals, rate, PHASE_BINS)
+    folding = Folding(residuals, rate, PHASE_BINS, rows.frame_times(residuals.t) if rows is not None else None)
     misfits, means = [], []
     for slope in slopes:
         smear = kernels(residuals, rate, rows, float(slope)) if rows is not None else None

@@ -108,7 +108,8 @@ def refresh_hypotheses(
     ``exposure_s`` is the range the exposure lies in; ``bandwidth`` (frames) the span over which
     residuals may be correlated; ``rows`` the sphere's rows (None: a point that stays on one row)."""
     exposures = exposure_grid(*exposure_s)
-    fits = [fit(residuals, rate, exposures, rows) for rate in candidate_rates(residuals, fps, refresh_hz, exposures)]
+    times = rows.frame_times(residuals.t) if rows is not None else residuals.t
+    fits = [fit(residuals, rate, exposures, rows) for rate in candidate_rates(residuals, fps, refresh_hz, exposures, times)]
     scale = min(float(fitted.timing.min()) for fitted in fits) / residuals.r.size
     best = min(fits, key=lambda fitted: float(fitted.timing.min()))
     at = np.unravel_index(int(np.argmin(best.timing)), best.timing.shape)

@@ -41,12 +41,12 @@ LINE_MIN_HZ = 8.0
 SPECTRUM_PAD = 4
 
 
-def tuned_rate(residuals: TimingResiduals, nominal_hz: float, exposures_s: np.ndarray, noise: float) -> float:
+def tuned_rate(residuals: TimingResiduals, nominal_hz: float, exposures_s: np.ndarray, noise: float, times: np.ndarray) -> float:
     """The rate within RATE_TOLERANCE of nominal whose hypotheses fit the residuals' timing best
     (searched coarsely, then finely around the best), or the nominal rate when the residuals folded
     at it show no pattern at all (nothing to tune by)."""
     chance = noise * (FOLD_BINS + FOLD_SIGMAS * math.sqrt(2 * FOLD_BINS))
-    if Folding(residuals, nominal_hz, FOLD_BINS).explained() <= chance:
+    if Folding(residuals, nominal_hz, FOLD_BINS, times).explained() <= chance:
         return nominal_hz
     duration = float(residuals.t[-1] - residuals.t[0]) if residuals.t.size > 1 else 0.0
     half = RATE_TOLERANCE * nominal_hz
@@ -58,7 +58,7 @@ def tuned_rate(residuals: TimingResiduals, nominal_hz: float, exposures_s: np.nd
     table = bias_table(nominal_hz, exposures_s, TUNING_BINS)
 
     def misfit(rate: float) -> float:
-        return float(fit_one(residuals, table, Folding(residuals, rate, TUNING_BINS))[0].min())
+        return float(fit_one(residuals, table, Folding(residuals, rate, TUNING_BINS, times))[0].min())
 
     coarse = min(half, COARSE_STEPS * fine)
     rates = nominal_hz + coarse * np.arange(-math.floor(half / coarse), math.floor(half / coarse) + 1)
@@ -98,13 +98,16 @@ def exposure_grid(low_s: float, high_s: float, steps: int = EXPOSURE_STEPS) -> n
     return np.linspace(max(low_s, 0.02 * high_s), high_s, steps)
 
 
-def candidate_rates(residuals: TimingResiduals, fps: float, refresh_hz: float | None, exposures: np.ndarray) -> list[float]:
+def candidate_rates(
+    residuals: TimingResiduals, fps: float, refresh_hz: float | None, exposures: np.ndarray, times: np.ndarray
+) -> list[float]:
+    """The rates to fit, each tuned (see the module docstring); the frames at ``times`` (their frame times)."""
     noise = float(residuals.r @ residuals.r) / residuals.r.size
     coarse = exposures[:: max(1, exposures.size // 3)]
     if refresh_hz is not None:
-        return [tuned_rate(residuals, refresh_hz, coarse, noise)]
+        return [tuned_rate(residuals, refresh_hz, coarse, noise, times)]
     # A line in the spectrum places the refreshes to within a fraction of a spectral bin: only its
     # aliases need tuning; without one, the common rates may be near-locked and drifting.
     seen = spectral_rates(residuals, fps)
-    rates = {tuned_rate(residuals, rate, coarse, noise) for rate in seen or COMMON_REFRESH_HZ}
+    rates = {tuned_rate(residuals, rate, coarse, noise, times) for rate in seen or COMMON_REFRESH_HZ}
     return sorted(rates | (set(COMMON_REFRESH_HZ) if seen else set()))

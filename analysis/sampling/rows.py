@@ -11,14 +11,15 @@ m = kappa - r.
 So each frame's bias is not g at one phase (``analysis.sampling.model``) but g averaged over the
 sphere's rows, each at its own phase: g smeared by the sphere's row profile scaled by f m
 (``disc_kernel``, ``smeared``), and the centroid's phase moves as the sphere moves up and down the
-frame. Where the sphere's samples are dated by their rows (a readout given), its dated time already
-holds r per row, and the centroid's phase is frac(f (t - (m + r) dy) + phi), dy its row less its
-mean; where they are not, r is 0 in that and unknown in m. Frames are compared with the model by
-the phase of their dated time alone, so the centroid's moves are a distribution of shifts over the
-frames (``shift_kernel``), which smears the model once more: the frames in a phase bin are, on
-average, that far off it. Their slow swing with the sphere's rows is then no part of the model, as
-the slow errors of the tracks (a blob's shape against its position) are none: a model that
-followed it would follow them too.
+frame: its phase is frac(f t_k - f m dy + phi), t_k the frame's time and dy its row less its mean.
+Frames are compared with the model by the phase of their frame time alone (``frame_times``: a
+sample dated by its rows, a readout given, less what the dating added), so the centroid's moves are
+a distribution of shifts over the frames (``shift_kernel``), which smears the model once more: the
+frames in a phase bin are, on average, that far off it. Their slow swing with the sphere's rows is
+then no part of the model, as the slow errors of the tracks (a blob's shape against its position)
+are none: a model that followed it would follow them too. Folded by their dated times, the frames
+of a camera locked to the display would split between neighbouring bins by their rows, that is by
+where the swing is, and the tracks' slow errors would read as a switch falling between them.
 
 Neither kappa nor the true r is known: kappa is at least 0 (a display that scans top to bottom as
 the camera sees it) and at most a refresh over the sphere's extent (the display is at least as tall
@@ -95,9 +96,13 @@ class SphereRows:
         return np.linspace(low, high, min(steps, most) + 1)
 
     def shifts(self, slope_s: float) -> np.ndarray:
-        """Per frame, how much earlier than its dated time the centroid's row is exposed against its
-        switch, for the net slope ``slope_s`` (s)."""
-        return (slope_s + self.dating_row_s) * self.offsets
+        """Per frame, by how much (s) the net slope ``slope_s`` moves the centroid's row's phase
+        earlier than its frame time's."""
+        return slope_s * self.offsets
+
+    def frame_times(self, dated: np.ndarray) -> np.ndarray:
+        """The frames' times (up to a constant) of samples ``dated`` by their rows."""
+        return dated - self.dating_row_s * self.offsets
 
 
 def disc_kernel(radius: float, bins: int) -> np.ndarray:
