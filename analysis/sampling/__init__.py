@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.sampling.exposure import Exposure, exposure_from_blur, given_exposure
-from analysis.sampling.inference import RefreshHypothesis, refresh_hypotheses
+from analysis.sampling.inference import BIAS_RANGE, RefreshHypothesis, refresh_hypotheses
 from analysis.sampling.model import commensurate
 from analysis.sampling.rates import RATE_TOLERANCE
 from analysis.sampling.residuals import TimingResiduals
@@ -42,8 +42,6 @@ WIDENING_NOTICE_S = 0.05e-3
 MIXTURE_COMPONENTS = 64
 QUANTILE_GRID = 512
 NORMAL_95 = 1.959963984540054
-# The bias's range: all but this much of its posterior either side.
-BIAS_RANGE = (0.005, 0.995)
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,9 @@ UNPLACED = 0.5
 # The bias's range holds every hypothesis whose log likelihood comes this close to the best: the 99 %
 # profile-likelihood range of one quantity (chi-square of one degree of freedom, 6.63 / 2).
 LIKELY_LOG_LIKELIHOOD = 3.3
+# The bias's range: all but this much of its posterior either side, and every bias the likelihood
+# leaves near the best (LIKELY_LOG_LIKELIHOOD).
+BIAS_RANGE = (0.005, 0.995)
 # The bias's quantiles are read off a histogram of this many bins over its range.
 QUANTILE_BINS = 1 << 16
 # Hypotheses this much less likely than the best (a log likelihood 27.6 lower) are dropped.
@@ -126,20 +129,29 @@ def refresh_hypotheses(
         if not (consistent or too_fast):
             continue
         # The likelihood may be far narrower in the exposure and the slope than the coarse grid's
-        # steps; a rate kept only because the camera cannot see it has nothing to narrow.
-        refined = fitted
-        if consistent:
+        # steps. A rate kept only because the camera cannot see it has nothing to narrow, nor has
+        # one whose coarse grid leaves every bias open at more than the given exposure (the
+        # refined grid's cost is in its exposures).
+        hypothesis = _hypothesis(fitted, fitted, scale, top)
+        placed = hypothesis.range_s(*BIAS_RANGE) != hypothesis.bounds_s
+        if consistent and (placed or fine.size == exposures.size):
             coarse = np.exp(-0.5 * fitted.timing / scale - top)
             slopes = fitted.slopes
             if rows is not None:
                 slopes = rows.refined(fitted.rate, fitted.slopes, coarse.sum(axis=(1, 2)), max(4, REFINED_GRID // fine.size))
-            refined = fit(residuals, fitted.rate, fine, rows, slopes)
-        log_likelihood = -0.5 * refined.timing / scale
-        weights = np.exp(log_likelihood - log_likelihood.max()).ravel()
-        kept = weights >= NEGLIGIBLE_WEIGHT
-        bounds = (min(float(fitted.mean.min()), float(refined.mean.min())), max(float(fitted.mean.max()), float(refined.mean.max())))
-        hypotheses.append(RefreshHypothesis(fitted.rate, top, refined.mean.ravel()[kept], weights[kept] / weights[kept].sum(), bounds))
+            hypothesis = _hypothesis(fitted, fit(residuals, fitted.rate, fine, rows, slopes), scale, top)
+        hypotheses.append(hypothesis)
     return sorted(hypotheses, key=lambda h: -h.log_likelihood)
+
+
+def _hypothesis(coarse: Fit, refined: Fit, scale: float, top: float) -> RefreshHypothesis:
+    """The hypothesis of a rate from its fit over the ``refined`` grid (the ``coarse`` one's, or a
+    finer one around its likely slopes and exposures), the misfits scaled by ``scale``."""
+    log_likelihood = -0.5 * refined.timing / scale
+    weights = np.exp(log_likelihood - log_likelihood.max()).ravel()
+    kept = weights >= NEGLIGIBLE_WEIGHT
+    bounds = (min(float(coarse.mean.min()), float(refined.mean.min())), max(float(coarse.mean.max()), float(refined.mean.max())))
+    return RefreshHypothesis(refined.rate, top, refined.mean.ravel()[kept], weights[kept] / weights[kept].sum(), bounds)
 
 
 def _leftovers(

@@ -40,8 +40,8 @@ import numpy as np
 # rows travel, by at most this fraction of a refresh, with at most COARSE_SLOPES steps; the fine
 # grid's, around the slopes the coarse one left possible, by FINE_STEP_REFRESHES, with at most
 # FINE_SLOPES steps (fewer where many exposures are tried with them, see REFINED_GRID).
-COARSE_STEP_REFRESHES = 1.0 / 64
-COARSE_SLOPES = 32
+COARSE_STEP_REFRESHES = 1.0 / 32
+COARSE_SLOPES = 16
 FINE_STEP_REFRESHES = 1.0 / 512
 FINE_SLOPES = 48
 # At most this many (slope, exposure) pairs are refined: 48 slopes for a given exposure, 12 for 48.

@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from analysis.sampling.model import exposure_bias
-from analysis.sampling.rows import SphereRows, disc_kernel, smeared
+from analysis.sampling.rows import COARSE_STEP_REFRESHES, SphereRows, disc_kernel, smeared
 
 BINS = 512
 CENTRES = (np.arange(BINS) + 0.5) / BINS
@@ -49,8 +49,8 @@ def test_the_slopes_reach_from_the_readout_to_a_display_as_short_as_the_spheres_
     assert slopes[0] == pytest.approx(-30e-6)
     assert slopes[-1] == pytest.approx(1 / (60.0 * rows.extent_px) - 10e-6)
     assert rows.extent_px == pytest.approx(np.ptp(offsets) + 14.0)
-    # A step moves the disc's radius (7 rows) by at most 1/64 of a refresh.
-    assert 60.0 * np.diff(slopes).max() * 7.0 <= 1 / 64 + 1e-12
+    # A step moves the disc's radius (7 rows) by at most the coarse step's share of a refresh.
+    assert 60.0 * np.diff(slopes).max() * 7.0 <= COARSE_STEP_REFRESHES + 1e-12
     np.testing.assert_allclose(rows.shifts(1e-4), (1e-4 + 0.0) * offsets)
 
 
