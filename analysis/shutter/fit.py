@@ -1,0 +1,280 @@
+"""The bands a flashing light draws, fitted over all rows of all frames at once.
+
+Row y of frame k records its dark level plus its own gain times ``on_fraction(u, e, duty)``, with
+u = f' (t_k + y L) - psi (``analysis.shutter.model``): f' = f + nu is the flash frequency as the
+film's clock sees it (the given one, off by a little: a display's 59.94 Hz against the 60 Hz it
+is called), L the time between rows (s per row; 0 for a global shutter), e the exposure in
+cycles. Every frame and row is fitted together, so L is found from the bands' spatial period
+where they repeat across the rows, and from how they move from frame to frame at the frames'
+times where they do not (a slow flash, a short readout, a display whose scan-out nearly follows
+the camera's); a global shutter's frames go light and dark whole, and L comes out 0 within its
+uncertainty.
+
+The start is the strongest peak of the film's two-dimensional Fourier transform at the flash
+frequency (rows against frame times: its row frequency is f' L, its phase psi); a few peaks are
+tried. Each row's dark level and gain are solved exactly for every trial of the other five
+parameters (variable projection), so uneven lighting costs nothing. The uncertainties come from a
+jackknife over blocks of frames: the spread of the fit when each block is left out in turn.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from analysis.shutter.film import RowFilm
+from analysis.shutter.model import on_fraction, on_fraction_derivatives
+
+# The flash frequency seen may differ from the given one by this share, and by at most this share
+# of its distance to the nearest multiple of half the frame rate: frames taken 1 / fps apart see
+# f and k fps - f alike (with the rows' order reversed), so the given frequency must decide.
+NU_SHARE = 0.01
+NU_ALIAS_SHARE = 0.5
+CANDIDATE_PEAKS = 3
+JACKKNIFE_BLOCKS = 10
+# Student's t at 97.5 % for JACKKNIFE_BLOCKS - 1 degrees of freedom: the 95 % half-width factor.
+T95 = 2.262
+# A row sample is on a ramp while its on-fraction is strictly between these.
+RAMP = (0.02, 0.98)
+MIN_RAMP_ROWS = 3
+# The fit's parameters (see _Data.to_x) stay within these; duty and exposure in cycles.
+DUTY_BOUNDS = (0.01, 0.99)
+EXPOSURE_BOUNDS = (1e-4, 0.999)
+MAX_ITERATIONS = 100
+
+
+@dataclass(frozen=True)
+class Bands:
+    """The fitted parameters: line_s (L, s per row, signed), nu_hz (f' - f), phase (psi, cycles),
+    duty, exposure (e, cycles of the flash)."""
+
+    line_s: float
+    nu_hz: float
+    phase: float
+    duty: float
+    exposure: float
+
+
+@dataclass(frozen=True)
+class BandFit:
+    """The fit (``bands``), the flash frequency seen (``flash_hz``), each quantity's jackknife
+    standard error (``sd``: line_s, exposure_s, duty, flash_hz), how well the model explains the
+    rows (``misfit``: the residual's RMS over the rows' swing), the largest gap between the phases
+    the frames caught the flash at (cycles, at the middle row), how many frames caught the light switching in at least
+    MIN_RAMP_ROWS rows, and the frames' times against the bands' (``timing_rms_s``: the robust RMS
+    of the shift that best fits each such frame alone)."""
+
+    bands: Bands
+    flash_hz: float
+    sd: dict[str, float]
+    misfit: float
+    phase_gap: float
+    ramp_frames: int
+    timing_rms_s: float
+
+
+class _Data:
+    """A film's samples in the fit's units: times and rows centred, weights by pixels averaged."""
+
+    def __init__(self, film: RowFilm, frames: np.ndarray, flash_hz: float) -> None:
+        self.flash_hz = flash_hz
+        self.levels = film.levels[frames]
+        self.t = film.times[frames] - film.times.mean()
+        self.y = film.rows - film.rows.mean()
+        self.weights = np.sqrt(film.pixels / film.pixels.mean())
+        self.span_rows = float(np.ptp(film.rows)) + 1.0
+        self.span_s = float(np.ptp(film.times)) + film.frame_interval_s
+        half_fps = 0.5 / film.frame_interval_s
+        self.nu_max = min(NU_SHARE * flash_hz, NU_ALIAS_SHARE * abs(flash_hz - half_fps * round(flash_hz / half_fps)))
+        reach = self.nu_max * self.span_s
+        self.lower = np.array([-np.inf, -reach, -np.inf, DUTY_BOUNDS[0], EXPOSURE_BOUNDS[0]])
+        self.upper = np.array([np.inf, reach, np.inf, DUTY_BOUNDS[1], EXPOSURE_BOUNDS[1]])
+
+    def to_x(self, bands: Bands) -> np.ndarray:
+        """Parameters of order one: band cycles across the rows, cycles gained over the film, psi, duty, e."""
+        f = self.flash_hz + bands.nu_hz
+        return np.array([f * bands.line_s * self.span_rows, bands.nu_hz * self.span_s, bands.phase, bands.duty, bands.exposure])
+
+    def bands(self, x: np.ndarray) -> Bands:
+        nu = x[1] / self.span_s
+        return Bands(x[0] / self.span_rows / (self.flash_hz + nu), nu, x[2], x[3], x[4])
+
+    def phases(self, bands: Bands, shifts: np.ndarray | float = 0.0) -> np.ndarray:
+        """Where each sample's exposure starts, in cycles of the flash (frames, rows); ``shifts``
+        (cycles, one per frame) move frames against their times."""
+        f = self.flash_hz + bands.nu_hz
+        return f * self.t[:, None] + np.reshape(shifts, (-1, 1)) + f * bands.line_s * self.y[None, :] - bands.phase
+
+    def model(self, bands: Bands) -> np.ndarray:
+        """Each sample's on-fraction, (frames, rows)."""
+        return on_fraction(self.phases(bands), bands.exposure, bands.duty)
+
+    def rows_fit(self, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each row's dark level and gain that best explain its levels by ``g`` (least squares)."""
+        centred = g - g.mean(axis=0)
+        spread = (centred**2).mean(axis=0)
+        gain = (centred * (self.levels - self.levels.mean(axis=0))).mean(axis=0) / np.maximum(spread, 1e-12)
+        return self.levels.mean(axis=0) - gain * g.mean(axis=0), gain
+
+    def residuals(self, x: np.ndarray, jacobian: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+        """The weighted residuals, (frames, rows), and, if asked, their Jacobian in x, (5, frames,
+        rows): Kaufman's for variable projection, each derivative of the model with the part each
+        row's dark level and gain take up projected out."""
+        bands = self.bands(x)
+        u = self.phases(bands)
+        g = on_fraction(u, bands.exposure, bands.duty)
+        dark, gain = self.rows_fit(g)
+        residuals = (self.levels - dark - gain * g) * self.weights
+        if not jacobian:
+            return residuals, None
+        slopes = on_fraction_derivatives(u, bands.exposure, bands.duty, g)
+        by_u = slopes[0]
+        derivatives = np.stack([by_u * self.y / self.span_rows, by_u * self.t[:, None] / self.span_s, -by_u, slopes[2], slopes[1]])
+        derivatives *= -(gain * self.weights)
+        derivatives -= derivatives.mean(axis=1, keepdims=True)
+        centred = g - g.mean(axis=0)
+        along = (derivatives * centred).sum(axis=1, keepdims=True) / np.maximum((centred**2).sum(axis=0), 1e-12)
+        return residuals, derivatives - along * centred
+
+
+def fit_bands(film: RowFilm, flash_hz: float, line_max_s: float) -> BandFit:
+    """Fit the film's bands (see the module); ``line_max_s`` is the largest |L| to look for."""
+    data = _Data(film, np.arange(len(film.times)), flash_hz)
+    fits = [_refine(data, start) for start in _starts(data, line_max_s)]
+    best = min(fits, key=lambda pair: pair[1])[0]
+    best = _positive_gain(data, best)
+    replicates = [_refine(_Data(film, keep, flash_hz), best)[0] for keep in _leave_one_block_out(len(film.times))]
+    g = data.model(best)
+    dark, gain = data.rows_fit(g)
+    misfit = float(np.sqrt(np.mean(((data.levels - dark - gain * g) / np.maximum(np.abs(gain), 1e-12)) ** 2)))
+    on_ramp = (g > RAMP[0]) & (g < RAMP[1])
+    informative = on_ramp.sum(axis=1) >= MIN_RAMP_ROWS
+    return BandFit(
+        bands=best,
+        flash_hz=flash_hz + best.nu_hz,
+        sd=_jackknife_sd(best, replicates, flash_hz),
+        misfit=misfit,
+        phase_gap=largest_gap((flash_hz + best.nu_hz) * data.t - best.phase),
+        ramp_frames=int(informative.sum()),
+        timing_rms_s=_timing_rms(data, best, dark, gain, informative),
+    )
+
+
+def _starts(data: _Data, line_max_s: float) -> list[Bands]:
+    """Starting points from the strongest peaks of the film's Fourier transform near the flash
+    frequency: row frequency (cycles per row) against the frame times' frequency."""
+    low, high = np.percentile(data.levels, [5, 95], axis=0)
+    shares = (data.levels - low) / np.maximum(high - low, 1e-9)
+    centred = shares - shares.mean(axis=0)
+    f = data.flash_hz
+    row_max = min(1.25 * f * line_max_s, 0.5 / max(float(np.min(np.diff(data.y))), 1.0)) if len(data.y) > 1 else 0.0
+    row_freqs = _symmetric_grid(row_max, 0.2 / data.span_rows)
+    nus = _symmetric_grid(data.nu_max, 0.2 / data.span_s)
+    by_time = np.exp(-2j * np.pi * (f + nus)[:, None] * data.t[None, :]) @ centred
+    spectrum = by_time @ np.exp(-2j * np.pi * data.y[:, None] * row_freqs[None, :])
+    power = np.abs(spectrum)
+    duty = float(np.clip(shares.mean(), 0.05, 0.95))
+    starts = []
+    for _ in range(CANDIDATE_PEAKS):
+        i, j = np.unravel_index(int(np.argmax(power)), power.shape)
+        if power[i, j] <= 0:
+            break
+        peak = spectrum[i, j]
+        exposure = _exposure_from_amplitude(abs(peak) / centred.size, duty)
+        phase = (np.pi * (exposure - duty) - np.angle(peak)) / (2 * np.pi)
+        starts.append(Bands(row_freqs[j] / (f + nus[i]), float(nus[i]), float(phase), duty, exposure))
+        power[max(0, i - 5) : i + 6, max(0, j - 5) : j + 6] = 0.0
+    return starts
+
+
+def _symmetric_grid(largest: float, step: float) -> np.ndarray:
+    """Multiples of ``step`` from -``largest`` to ``largest``, zero among them."""
+    count = int(np.ceil(largest / step))
+    return np.arange(-count, count + 1) * step
+
+
+def _exposure_from_amplitude(amplitude: float, duty: float) -> float:
+    """The exposure (cycles) whose trapezoid's first harmonic has ``amplitude``: it is
+    sin(pi duty) / pi times sinc(exposure), for rows normalised to swing from 0 to 1."""
+    target = np.clip(amplitude * np.pi / np.sin(np.pi * duty), 0.0, 1.0)
+    grid = np.linspace(0.005, 0.995, 199)
+    sinc = np.sinc(grid)
+    return float(np.clip(grid[np.argmin(np.abs(sinc - target))], 0.01, 0.8 * min(duty, 1.0 - duty)))
+
+
+def _refine(data: _Data, start: Bands) -> tuple[Bands, float]:
+    """Levenberg-Marquardt from ``start`` within the parameters' bounds; the bands and the cost."""
+    x = np.clip(data.to_x(start), data.lower, data.upper)
+    residuals, jacobian = data.residuals(x, jacobian=True)
+    cost = float(np.sum(residuals**2))
+    damping = 1e-3
+    for _ in range(MAX_ITERATIONS):
+        assert jacobian is not None
+        flat = jacobian.reshape(len(x), -1)
+        normal = flat @ flat.T
+        gradient = flat @ residuals.ravel()
+        while damping < 1e10:
+            step = np.linalg.solve(normal + damping * np.diag(np.diag(normal) + 1e-12), -gradient)
+            trial = np.clip(x + step, data.lower, data.upper)
+            trial_residuals, _ = data.residuals(trial)
+            trial_cost = float(np.sum(trial_residuals**2))
+            if trial_cost < cost:
+                break
+            damping *= 4.0
+        else:
+            break
+        converged = cost - trial_cost <= 1e-10 * cost
+        x, cost, damping = trial, trial_cost, max(damping / 3.0, 1e-9)
+        if converged:
+            break
+        residuals, jacobian = data.residuals(x, jacobian=True)
+    return data.bands(x), cost
+
+
+def _positive_gain(data: _Data, bands: Bands) -> Bands:
+    """The same fit read with the light on where the rows are bright: a fit whose rows mostly
+    brighten as the modelled light goes off is the complement's (duty 1 - d, on from psi + d)."""
+    _, gain = data.rows_fit(data.model(bands))
+    if np.median(gain) >= 0:
+        return bands
+    return _refine(data, replace(bands, phase=bands.phase + bands.duty, duty=1.0 - bands.duty))[0]
+
+
+def _leave_one_block_out(count: int) -> list[np.ndarray]:
+    blocks = np.array_split(np.arange(count), JACKKNIFE_BLOCKS)
+    return [np.concatenate([block for j, block in enumerate(blocks) if j != i]) for i in range(len(blocks))]
+
+
+def _jackknife_sd(best: Bands, replicates: list[Bands], flash_hz: float) -> dict[str, float]:
+    def derived(bands: Bands) -> dict[str, float]:
+        f = flash_hz + bands.nu_hz
+        return {"line_s": bands.line_s, "exposure_s": bands.exposure / f, "duty": bands.duty, "flash_hz": f}
+
+    values = [derived(bands) for bands in replicates]
+    n = len(values)
+    return {key: float(np.sqrt((n - 1) / n * np.sum((np.array([v[key] for v in values]) - np.mean([v[key] for v in values])) ** 2))) for key in derived(best)}
+
+
+def largest_gap(phases: np.ndarray) -> float:
+    """The largest gap (cycles) between phases taken modulo one cycle."""
+    ordered = np.sort(np.mod(phases, 1.0))
+    return float(np.max(np.diff(np.concatenate([ordered, [ordered[0] + 1.0]]))))
+
+
+def _timing_rms(data: _Data, bands: Bands, dark: np.ndarray, gain: np.ndarray, informative: np.ndarray) -> float:
+    """The robust RMS (s) of the time shift that best fits each informative frame alone: searched
+    over a quarter period either way, then around each frame's best to a 64th of that step."""
+    if not informative.any():
+        return float("nan")
+
+    def best(shifts: np.ndarray) -> np.ndarray:  # shifts (trials, frames) in cycles: each frame's best
+        costs = [
+            (((data.levels - dark - gain * on_fraction(data.phases(bands, trial), bands.exposure, bands.duty)) * data.weights) ** 2).sum(axis=1)
+            for trial in shifts
+        ]
+        return shifts[np.argmin(costs, axis=0), np.arange(shifts.shape[1])]
+
+    frames = len(data.t)
+    coarse = best(np.repeat(np.linspace(-0.25, 0.25, 41)[:, None], frames, axis=1))
+    fine = best(coarse[None, :] + np.linspace(-0.0125, 0.0125, 41)[:, None])
+    return float(1.4826 * np.median(np.abs(fine[informative]))) / (data.flash_hz + bands.nu_hz)

@@ -1,0 +1,112 @@
+"""Films that cannot decide the readout or the exposure are refused in one line that says what to
+change; so are inputs out of range."""
+
+import numpy as np
+import pytest
+
+from analysis import AnalysisError
+from analysis.shutter import DisplayScan, estimate_shutter, film_of_frames
+
+
+def refusal(film, duty=0.25, frames=None, **options):
+    made, times = film.frames()
+    made = made if frames is None else frames
+    with pytest.raises(AnalysisError) as error:
+        estimate_shutter(film_of_frames(made, times), options.pop("flash_hz", film.flash_hz), duty=duty, **options)
+    message = str(error.value)
+    assert "\n" not in message
+    return message
+
+
+def test_an_exposure_longer_than_the_light_is_on_is_refused(flash_film):
+    message = refusal(flash_film(flash_hz=310, exposure_s=1e-3))  # on for 0.81 ms of each 3.2 ms
+    assert "ramps meet" in message and "flash at most" in message
+
+
+def test_an_exposure_filling_the_light_s_on_time_is_refused(flash_film):
+    message = refusal(flash_film(fps=30, readout_s=25e-3, exposure_s=4e-3, flash_hz=61.3, duration_s=3))
+    assert "ramps meet" in message
+
+
+def test_an_exposure_over_half_the_period_of_a_square_wave_is_refused(flash_film):
+    # 0.7 of a period reads like 0.3 of one; only the frame interval could tell them apart, and it allows both.
+    film = flash_film(fps=60, readout_s=14e-3, exposure_s=0.7 / 130.3, flash_hz=130.3, duty=0.5, duration_s=1)
+    message = refusal(film, duty=0.5)
+    assert "cannot tell an exposure of 2.30 ms from one of 5.37 ms" in message
+    assert "--duty" in message and "flash at most" in message
+
+
+def test_a_square_wave_too_fast_for_the_frame_interval_is_refused_until_the_longest_exposure_is_given(flash_film):
+    film = flash_film(fps=240, readout_s=3.5e-3, exposure_s=0.5e-3, flash_hz=505, duty=0.5, duration_s=1)
+    assert "cannot tell an exposure" in refusal(film, duty=0.5)
+    frames, times = film.frames()
+    result = estimate_shutter(film_of_frames(frames, times), 505, duty=0.5, max_exposure_s=1e-3)
+    assert result.exposure_s == pytest.approx(0.5e-3, rel=0.02)
+
+
+def test_an_unknown_duty_cycle_leaves_exposure_and_duty_undecided(flash_film):
+    assert "cannot tell an exposure" in refusal(flash_film(readout_s=7e-3, flash_hz=81.3), duty=None)
+
+
+def test_a_wrong_duty_cycle_is_refused(flash_film):
+    message = refusal(flash_film(readout_s=7e-3, flash_hz=81.3, duty=0.4), duty=0.25)
+    assert "on 40% of each period, not the 25% given" in message
+
+
+def test_too_few_frames_are_refused(flash_film):
+    assert "only 30 frames" in refusal(flash_film(readout_s=7e-3, flash_hz=81.3, duration_s=0.25))
+
+
+def test_saturation_everywhere_is_refused(flash_film):
+    assert "saturates all" in refusal(flash_film(readout_s=7e-3, flash_hz=81.3, on_dn=600))
+
+
+def test_a_film_without_a_flashing_light_is_refused(flash_film):
+    film = flash_film(readout_s=7e-3, flash_hz=81.3)
+    still = np.full((180, 160, 24), 40, dtype=np.uint8)
+    assert "no flashing light found" in refusal(film, frames=still)
+
+
+def test_a_flash_at_a_multiple_of_the_frame_rate_looks_still_and_is_refused(flash_film):
+    message = refusal(flash_film(readout_s=7e-3, exposure_s=0.3e-3, flash_hz=120.0))
+    assert "no flashing light found" in message and "no multiple of the frame rate" in message
+
+
+def test_bands_that_only_alternate_are_refused(flash_film):
+    message = refusal(flash_film(readout_s=7e-3, exposure_s=0.3e-3, flash_hz=180.0))
+    assert "too few phases" in message and "such as 165.8 Hz" in message
+
+
+def test_a_wrong_flash_frequency_is_refused(flash_film):
+    message = refusal(flash_film(readout_s=7e-3, flash_hz=81.3), flash_hz=95.0)
+    assert "do not follow a light flashing at 95 Hz" in message
+
+
+def test_a_display_without_its_scan_out_share_cannot_decide_a_short_readout(flash_film, panel):
+    film = flash_film(fps=240, readout_s=3.5e-3, exposure_s=4e-3, flash_hz=30.0, duty=0.5, height=200, duration_s=2,
+                      panel=panel(60.0, 30, 150))  # fmt: skip
+    message = refusal(film, duty=0.5, display=DisplayScan(60.0, "top-down"))
+    assert "display's scan-out" in message
+
+
+def test_a_display_reaching_the_frame_s_edge_is_refused(flash_film, panel):
+    film = flash_film(fps=120, readout_s=7e-3, exposure_s=2e-3, flash_hz=30.0, duty=0.5, duration_s=2, panel=panel(60.0, 0, 160))
+    assert "panel's whole height" in refusal(film, duty=0.5, display=DisplayScan(60.0, "top-down", 1.0))
+
+
+@pytest.mark.parametrize(
+    "options, words",
+    [
+        ({"flash_hz": -5.0}, "flash frequency"),
+        ({"duty": 1.2}, "duty cycle"),
+        ({"max_exposure_s": 0.0}, "longest exposure"),
+    ],
+)
+def test_inputs_out_of_range_are_refused(flash_film, options, words):
+    duty = options.pop("duty", 0.25)
+    assert words in refusal(flash_film(readout_s=7e-3, flash_hz=81.3), duty=duty, **options)
+
+
+def test_a_display_described_wrongly_is_refused():
+    with pytest.raises(AnalysisError, match="scan-out must be one of"):
+        DisplayScan(60.0, "left-right")
