@@ -117,18 +117,21 @@ def implausible_period_warning(period_s: float, times: FrameTimes) -> str | None
     )
 
 
-def repeated_frames(*tracks: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
-    """Frames in which every blob sits exactly where it was in the frame before (bool per frame).
+def recorder_repeats(whole: np.ndarray, times: FrameTimes) -> np.ndarray:
+    """Frames the recorder repeated (bool per frame): each whole frame that is the one before
+    exactly (``whole``, noted by the source), where the frame times confirm a copy.
 
-    With sensor noise no two real frames give bit-identical sub-pixel centroids, so such a frame
-    is a copy the recorder inserted; its time is wrong and it is left out.
+    With sensor noise no two captures are identical, so an identical whole frame is a copy the
+    recorder put in a slot of a constant frame rate for want of a new one; its time is wrong. Only
+    the whole frame counts: an encoder keeps still regions of a compressed film bit for bit while
+    the rest changes. Where the file stamps each frame with its own time and those times vary (as
+    phones record), a recorder that misses a capture leaves a gap, not a copy: an identical frame
+    there is a capture at its own time (a still scene, or one its encoder found unchanged), and is
+    kept.
     """
-    count = tracks[0][0].size
-    same = np.zeros(count, dtype=bool)
-    same[1:] = True
-    for x, y in tracks:
-        same[1:] &= (x[1:] == x[:-1]) & (y[1:] == y[:-1])
-    return same
+    if times.variable:
+        return np.zeros(whole.shape, dtype=bool)
+    return whole.astype(bool, copy=True)
 
 
 def check_count(decoded: int, stated: int, name: str) -> str | None:

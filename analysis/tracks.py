@@ -6,7 +6,8 @@ it is decoded; from then on only the rectangle around both ROIs is decoded
 (``analysis.video.frames.Crop``). A video that can skip frames and decode rectangles cheaply
 (Motion-JPEG) is instead calibrated on a sample of its first frames and then read again from the
 start, every frame's rectangle alone. With all detections in hand the frame times are decided
-(``analysis.timing``), frames the recorder repeated are left out, and so are frames in which a
+(``analysis.timing``), frames the recorder repeated (whole frames, noted by the source as it
+reads) are left out, and so are frames in which a
 blob shows much less of its light than usual (partly hidden: its centroid is not its centre).
 Where neither the user's ROIs nor a side said which blob is the LED, the whole video's evidence
 decides (``analysis.identity``); when it does not, the analysis stops and asks for the ROIs. Then
@@ -37,12 +38,12 @@ from analysis.calibration import (
 from analysis.errors import AnalysisError
 from analysis.identity import Identity, decide
 from analysis.phase import estimate_frequency
-from analysis.tracks_csv import TrackStream, write_tracks_csv
 from analysis.signals import swing_signals
-from analysis.timing import FrameTimes, check_count, frame_times, repeated_frames
+from analysis.timing import FrameTimes, check_count, frame_times, recorder_repeats
 from analysis.tracking import BlobTracker, Detection, Roi, Track
+from analysis.tracks_csv import TrackStream, write_tracks_csv
 from analysis.video.file import VideoFile
-from analysis.video.frames import Crop, Frame, FrameSource
+from analysis.video.frames import Crop, Frame, FrameSource, Repeats
 from analysis.video.sources import open_frames
 
 # A track must have a blob in at least this fraction of frames; any frame without one is reported.
@@ -119,10 +120,6 @@ class _Tracked:
             spread=np.where(valid[:, None], spread, np.nan),
         )
 
-    def positions(self, which: int) -> tuple[np.ndarray, np.ndarray]:
-        rows = self.rows[which]
-        return np.array([d.x for d in rows]), np.array([d.y for d in rows])
-
 
 def _track_frames(
     frames: Iterable[Frame],
@@ -160,13 +157,14 @@ def _read(
     progress: Callable[[int, int], object] | None,
     tracks_csv: str | Path | None,
     warnings: list[str],
+    repeats: Repeats,
 ) -> tuple[Calibration, _Tracked]:
     """Calibrate on the first frames, then track every frame, each row going to ``tracks_csv`` as
-    it is measured (see the module docstring)."""
+    it is measured (see the module docstring); the source notes whole repeated frames in ``repeats``."""
     crop = Crop()
     wanted, every = calibration_plan(video.fps, video.decodes_in_part)
     with contextlib.ExitStack() as stack:
-        stream = stack.enter_context(contextlib.closing(video.frames(crop, every)))
+        stream = stack.enter_context(contextlib.closing(video.frames(crop, every, repeats)))
         rows = stack.enter_context(TrackStream(tracks_csv)) if tracks_csv is not None else None
         first = next(stream)
         window = calibration_window(first, stream, wanted, CALIBRATION_MAX_BYTES // first[1].nbytes, given)
@@ -175,7 +173,7 @@ def _read(
         if every > 1:
             stream.close()
             window = []
-            stream = stack.enter_context(contextlib.closing(video.frames(crop)))
+            stream = stack.enter_context(contextlib.closing(video.frames(crop, repeats=repeats)))
         crop.to(band_rows, band_cols)
         origin = (band_cols.start, band_rows.start)
         tracked = _track_frames(
@@ -278,7 +276,8 @@ def track(
         progress = None
     warnings: list[str] = []
     started = time.perf_counter()
-    calibration, tracked = _read(video, given, led_side, progress, tracks_csv, warnings)
+    noted = Repeats()
+    calibration, tracked = _read(video, given, led_side, progress, tracks_csv, warnings, noted)
     seconds = time.perf_counter() - started
     stamps = np.array(tracked.stamps, dtype=np.float64)
     times = frame_times(stamps, video.fps if fps is not None else None, video.container_fps, video.stamp_origin)
@@ -287,10 +286,10 @@ def track(
         count_warning = check_count(stamps.size, video.frame_count, video.name)
         if count_warning:
             warnings.append(count_warning)
-    repeats = repeated_frames(tracked.positions(0), tracked.positions(1))
+    repeats = recorder_repeats(noted.mask(stamps.size), times)
     if np.any(repeats):
         warnings.append(
-            f"{int(np.count_nonzero(repeats))} frame(s) repeat the one before exactly (inserted by the recorder); "
+            f"{int(np.count_nonzero(repeats))} frame(s) repeat the one before exactly, whole (inserted by the recorder); "
             "they were left out"
         )
     led = tracked.track_of(0, times.t, repeats)

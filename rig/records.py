@@ -121,7 +121,9 @@ class VideoRecord:
         self._writer.set(cv2.VIDEOWRITER_PROP_QUALITY, self.QUALITY)
         self.frames = 0
 
-    def write(self, grey: np.ndarray) -> None:
+    def write(self, grey: np.ndarray, t_start: float | None = None) -> None:
+        """Append a frame; an AVI places frame i at i / fps, so its start time is not stored (taken
+        so that every film writer takes the same frames, `rig.film_file`)."""
         self._writer.write(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR))
         self.frames += 1
 

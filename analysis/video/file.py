@@ -1,9 +1,11 @@
-"""A video file read with OpenCV: Motion-JPEG as raw packets decoded to grey, other codecs the ordinary way.
+"""A video file: Motion-JPEG read with OpenCV as raw packets decoded to grey, other codecs with PyAV.
 
 A Motion-JPEG file's packets are read raw and decoded by ``analysis.video.decoding`` (grey straight
 from libjpeg, only the crop's rectangle once it is set, a few frames ahead on a few threads); a
-packet left out by ``every`` is read past, never decoded. Any other codec is read the ordinary way
-and cropped afterwards.
+packet left out by ``every`` is read past, never decoded. Any other codec (H.264 and HEVC from
+phones) is decoded whole by PyAV and cropped afterwards; each frame's stamp is its presentation
+time in the container (its PTS on the stream's time base), so a film with variable frame timing
+gives every frame's own time.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import numpy as np
 
 from analysis.errors import AnalysisError
 from analysis.video.decoding import REGION_DECODER_MISSING, decode_jpeg, decodes_regions, ordered_map
-from analysis.video.frames import Crop, Frame, checked_every, checked_fps, cut_frames
+from analysis.video.frames import Crop, Frame, Repeats, checked_every, checked_fps, cut_frames, noted_repeats, same_image
 
 # Frame rates outside this range are not believed when a container states them.
 PLAUSIBLE_FPS = (1.0, 10_000.0)
@@ -106,40 +108,37 @@ class VideoFile:
         """
         return self._raw_jpeg
 
-    def frames(self, crop: Crop | None = None, every: int = 1) -> Iterator[Frame]:
-        return cut_frames(self._grey_frames(crop, checked_every(every)), crop)
+    def frames(self, crop: Crop | None = None, every: int = 1, repeats: Repeats | None = None) -> Iterator[Frame]:
+        every = checked_every(every)
+        if self._raw_jpeg:
+            return cut_frames(self._jpeg_frames(crop, every, repeats if every == 1 else None), crop)
+        return cut_frames(noted_repeats(self._decoded_frames(every), repeats, every), crop)
 
-    def _grey_frames(self, crop: Crop | None, every: int) -> Generator[Frame, None, None]:
+    def _jpeg_frames(self, crop: Crop | None, every: int, repeats: Repeats | None) -> Generator[Frame, None, None]:
         capture = cv2.VideoCapture(str(self._path))
         try:
-            if self._raw_jpeg and capture.set(cv2.CAP_PROP_FORMAT, -1):
-                stamps: deque[float] = deque()
-                packets = self._packets(capture, stamps, every)
-                decoded = ordered_map(
-                    lambda packet: decode_jpeg(packet, crop),
-                    packets,
-                    lambda index: f"frame {index * every} of {self._path}",
-                )
-                for frame in decoded:
-                    yield stamps.popleft(), frame
-                return
-            for index in itertools.count():
-                if not capture.grab():
-                    return
-                if index % every:
-                    continue
-                ok, frame = capture.retrieve()
-                if not ok:
-                    return
-                stamp = capture.get(cv2.CAP_PROP_POS_MSEC) / 1e3
-                yield stamp, cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame
+            if not capture.set(cv2.CAP_PROP_FORMAT, -1):
+                raise AnalysisError(f"{self._path} no longer reads as Motion-JPEG packets; check that the file is not being written")
+            stamps: deque[float] = deque()
+            packets = self._packets(capture, stamps, every, repeats)
+            decoded = ordered_map(
+                lambda packet: decode_jpeg(packet, crop),
+                packets,
+                lambda index: f"frame {index * every} of {self._path}",
+            )
+            for frame in decoded:
+                yield stamps.popleft(), frame
         finally:
             capture.release()
 
     @staticmethod
-    def _packets(capture: cv2.VideoCapture, stamps: deque[float], every: int) -> Iterator[np.ndarray]:
+    def _packets(capture: cv2.VideoCapture, stamps: deque[float], every: int, repeats: Repeats | None) -> Iterator[np.ndarray]:
         """Every ``every``-th raw packet in order, from the first; each one's presentation time (s)
-        is appended to ``stamps``. Packets left out are read past, not copied."""
+        is appended to ``stamps``, and a packet identical to the one before noted in ``repeats``.
+        Packets left out are read past, not copied."""
+        if repeats is not None:
+            repeats.start()
+        previous = None
         for index in itertools.count():
             if index % every:
                 if not capture.grab():
@@ -149,4 +148,31 @@ class VideoFile:
             if not ok or packet is None:
                 return
             stamps.append(capture.get(cv2.CAP_PROP_POS_MSEC) / 1e3)
-            yield packet.reshape(-1).copy()
+            packet = packet.reshape(-1).copy()
+            if repeats is not None:
+                repeats.note(index, same_image(packet, previous))
+                previous = packet
+            yield packet
+
+    def _decoded_frames(self, every: int) -> Generator[Frame, None, None]:
+        """Every ``every``-th frame, decoded whole to grey by PyAV, stamped with its presentation
+        time (s; NaN for a frame without one)."""
+        import av  # here: reading Motion-JPEG, the rig's own films, need not load FFmpeg
+
+        try:
+            container = av.open(str(self._path))
+        except av.FFmpegError as error:
+            raise AnalysisError(f"{self._path} cannot be decoded: {error}; re-record it or convert it to MP4") from None
+        index = 0
+        try:
+            stream = container.streams.video[0]
+            stream.thread_type = "AUTO"
+            for index, frame in enumerate(container.decode(stream)):
+                if index % every:
+                    continue
+                stamp = float(frame.pts * frame.time_base) if frame.pts is not None and frame.time_base is not None else math.nan
+                yield stamp, frame.to_ndarray(format="gray")
+        except av.FFmpegError as error:
+            raise AnalysisError(f"{self._path} is corrupt after frame {index}: {error}; re-record it or leave it out") from None
+        finally:
+            container.close()

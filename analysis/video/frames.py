@@ -9,7 +9,9 @@ trusts is decided afterwards from all the stamps (see ``analysis.timing``).
 A consumer that needs only part of each frame (the tracker, once it knows its ROIs) says so with a
 ``Crop``: every frame yielded after the crop is set holds only that rectangle. One that needs only
 a sample of the frames asks for every n-th; a source whose ``decodes_in_part`` is true then skips
-the others without decoding them.
+the others without decoding them. One that wants to know which frames repeat the one before
+exactly, whole (a recorder's copy, which a crop cannot see), passes ``Repeats``: a source reading
+every frame notes them there.
 """
 
 from __future__ import annotations
@@ -64,9 +66,10 @@ class FrameSource(Protocol):
         than decoding the frames whole."""
         ...
 
-    def frames(self, crop: Crop | None = None, every: int = 1) -> Iterator[Frame]:
+    def frames(self, crop: Crop | None = None, every: int = 1, repeats: Repeats | None = None) -> Iterator[Frame]:
         """Stamped grey frames in order, or every ``every``-th of them from the first; once ``crop``
-        is set, only its rectangle of each."""
+        is set, only its rectangle of each. Reading every frame, the source notes in ``repeats``
+        each one whose whole image is the one before's exactly."""
         ...
 
 
@@ -94,6 +97,49 @@ class Crop:
         if frame.shape == (rows.stop - rows.start, cols.stop - cols.start):
             return frame
         return frame[rows, cols]
+
+
+class Repeats:
+    """The frames (indices from the first) whose whole image repeats the frame before exactly, as a
+    source reading every frame notes them: an encoded frame that repeats is compared by its bytes
+    where they decode to the whole image (Motion-JPEG), else by its decoded pixels."""
+
+    def __init__(self) -> None:
+        self.frames: list[int] = []
+
+    def start(self) -> None:
+        """Forget what an earlier reading noted: a source starts each reading with this."""
+        self.frames.clear()
+
+    def note(self, index: int, same: bool) -> None:
+        if same:
+            self.frames.append(index)
+
+    def mask(self, count: int) -> np.ndarray:
+        """The repeats as a bool per frame, for ``count`` frames."""
+        mask = np.zeros(count, dtype=bool)
+        mask[[i for i in self.frames if i < count]] = True
+        return mask
+
+
+def same_image(image: np.ndarray, previous: np.ndarray | None) -> bool:
+    """Whether two whole images (or encoded frames' bytes) are identical."""
+    return previous is not None and image.shape == previous.shape and bool(np.array_equal(image, previous))
+
+
+def noted_repeats(frames: Generator[Frame, None, None], repeats: Repeats | None, every: int) -> Generator[Frame, None, None]:
+    """Whole frames as they are, each compared with the one before and noted in ``repeats``
+    (reading every frame; a sample notes nothing). Closing this closes ``frames``."""
+    if repeats is None or every != 1:
+        yield from frames
+        return
+    repeats.start()
+    previous = None
+    with contextlib.closing(frames):
+        for index, (stamp, image) in enumerate(frames):
+            repeats.note(index, same_image(image, previous))
+            previous = image
+            yield stamp, image
 
 
 def cut_frames(frames: Generator[Frame, None, None], crop: Crop | None) -> Iterator[Frame]:

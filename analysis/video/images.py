@@ -10,7 +10,7 @@ import cv2
 
 from analysis.errors import AnalysisError
 from analysis.video.decoding import ordered_map
-from analysis.video.frames import Crop, Frame, checked_every, checked_fps, cut_frames
+from analysis.video.frames import Crop, Frame, Repeats, checked_every, checked_fps, cut_frames, noted_repeats
 
 IMAGE_SUFFIXES = frozenset({".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".webp"})
 
@@ -84,8 +84,9 @@ class ImageFolder:
     def decodes_in_part(self) -> bool:
         return False
 
-    def frames(self, crop: Crop | None = None, every: int = 1) -> Iterator[Frame]:
-        return cut_frames(self._grey_frames(checked_every(every)), crop)
+    def frames(self, crop: Crop | None = None, every: int = 1, repeats: Repeats | None = None) -> Iterator[Frame]:
+        every = checked_every(every)
+        return cut_frames(noted_repeats(self._grey_frames(every), repeats, every), crop)
 
     def _grey_frames(self, every: int) -> Generator[Frame, None, None]:
         paths = self._paths[::every]

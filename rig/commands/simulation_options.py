@@ -10,6 +10,8 @@ from rig.commands import options
 from rig.commands.choices import predictors_listing, renderers_listing
 from rig.service import SimulationConfig
 from rig.session import PHOTON_TARGETS
+from rig.film_file import CODECS, CONTAINERS, default_codec
+from rig.sim.bench import DEFAULT_LAYOUT, LAYOUT_HELP
 from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -46,6 +48,15 @@ def add_simulation_options(parser: argparse.ArgumentParser) -> None:
         metavar="F",
         help="camera exposure as a fraction of the frame interval, in (0, 1] (default: %(default)s, the whole interval)",
     )
+    group.add_argument(
+        "--readout-ms",
+        type=options.non_negative_float,
+        default=CameraConfig().readout_s * 1e3,
+        metavar="R",
+        help="rolling shutter: row y of H starts exposing y/H x R ms after row 0, at most a frame interval "
+        "(default: %(default)s, a global shutter)",
+    )
+    group.add_argument("--layout", default=DEFAULT_LAYOUT, metavar="LAYOUT", help=f"where the LED and the display sit in the frame: {LAYOUT_HELP} (default: %(default)s)")
     group.add_argument(
         "--display-phase",
         type=_refresh_fraction,
@@ -131,6 +142,16 @@ def _add_camera_options(parser: argparse.ArgumentParser) -> None:
         metavar="F",
         help="hide the sphere in this share of the frames, drawn by the seed (default: %(default)s)",
     )
+    group.add_argument("--container", choices=CONTAINERS, default=camera.container, help="the film's file (default: %(default)s)")
+    group.add_argument("--codec", choices=CODECS, default=None, help="the film's codec (default: mjpeg in an avi, h264 in an mp4 or mov)")
+    group.add_argument(
+        "--frame-jitter-ms",
+        type=options.non_negative_float,
+        default=camera.frame_jitter_s * 1e3,
+        metavar="J",
+        help="start each exposure up to J/2 ms before or after its nominal time, drawn by the seed, as phones do; "
+        "needs an mp4 or mov, which stamps each frame (default: %(default)s)",
+    )
     group.add_argument("--every-nth", type=options.positive_int, default=film.every_nth, metavar="N", help="film every N-th exposure only (default: %(default)s)")
     group.add_argument(
         "--first-frame",
@@ -175,6 +196,10 @@ def config_from_args(args: argparse.Namespace) -> SimulationConfig:
             fps=args.camera_fps,
             exposure_s=args.exposure / args.camera_fps,
             noise_dn=args.noise_dn,
+            readout_s=args.readout_ms / 1e3,
+            frame_jitter_s=args.frame_jitter_ms / 1e3,
+            container=args.container,
+            codec=args.codec or default_codec(args.container),
             display_white_dn=args.display_white_dn,
             impairments=FilmImpairments(
                 blur_sigma_px=args.blur_px,
@@ -195,6 +220,7 @@ def config_from_args(args: argparse.Namespace) -> SimulationConfig:
         warp_ms=args.warp_ms,
         photon_target=args.predict_to,
         persistence=args.persistence,
+        layout=args.layout,
     )
 
 

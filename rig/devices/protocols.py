@@ -84,12 +84,19 @@ class Display(Protocol):
 
 @dataclass(frozen=True, eq=False)
 class CameraFrame:
-    """One camera frame: its index, when its exposure started and how long it lasted, its image."""
+    """One camera frame: its index, when its exposure started and how long it lasted, its image,
+    and its readout: a rolling shutter exposes row y of the image's H rows from
+    t_start + (y / H) readout_s (0: a global shutter, or a camera that does not know its readout)."""
 
     index: int
     t_start: float
     exposure_s: float
     image: np.ndarray
+    readout_s: float = 0.0
+
+    def row_start(self, row: float | np.ndarray) -> float | np.ndarray:
+        """When row `row` (0 at the top) of this frame started exposing."""
+        return self.t_start + np.asarray(row, dtype=np.float64) / self.image.shape[0] * self.readout_s
 
 
 @runtime_checkable

@@ -1,9 +1,10 @@
 """Simulate the rig: a session on a virtual clock with the simulated devices, and the run's truth.
 
 A run writes into its output folder as it goes (`rig.session.record`): `tracker.csv`,
-`app_frames.csv`, `display_frames.csv` and `video.avi`, with a simulated board its recording in
-`board/` (`rig.sim.board`), and at the end `truth.json` (`rig.sim.truth`). A folder that already
-holds a run is refused unless `overwrite` is given.
+`app_frames.csv`, `display_frames.csv` and `video.avi` (or the camera's `video.mp4` or `video.mov`
+with `frame_times.csv`, `rig.film_file`), with a simulated board its recording in `board/`
+(`rig.sim.board`), and at the end `truth.json` (`rig.sim.truth`). A folder that already holds a
+run is refused unless `overwrite` is given.
 """
 
 from __future__ import annotations
@@ -12,20 +13,23 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 import predictors
 from rig.clock import VirtualClock
 from rig.devices.registry import DeviceContext, make_device
 from rig.errors import RigError
+from rig.film_file import FRAME_TIMES_FILE, STAMPED_CONTAINERS, video_file_name
 from rig.render import RenderSetup, make_renderer
 from rig.session import RUN_FILES, PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
 from rig.session.session import Progress
 from rig.sim.board import BOARD_FOLDER, remove_recording
 from rig.sim.config import SimulationConfig
-from rig.sim.truth import Truth, run_truth
+from rig.sim.truth import FilmTruth, Truth, run_truth
 from rig.sim.world import SimulatedWorld
 
 TRUTH_FILE = "truth.json"
-SIMULATION_FILES = (*RUN_FILES, TRUTH_FILE, BOARD_FOLDER)
+SIMULATION_FILES = (*RUN_FILES, *map(video_file_name, STAMPED_CONTAINERS), FRAME_TIMES_FILE, TRUTH_FILE, BOARD_FOLDER)
 
 
 @dataclass(frozen=True)
@@ -88,6 +92,20 @@ def _prepare(out_dir: Path, overwrite: bool) -> None:
         remove_recording(out_dir / BOARD_FOLDER)
 
 
+def _film_truth(config: SimulationConfig, world: SimulatedWorld, film_times: np.ndarray) -> FilmTruth:
+    """How the camera filmed: its readout, where the blobs sit on average over the film, its file."""
+    led_row, sphere_row = world.layout.mean_rows(world.pendulum.led_position(film_times))
+    camera = config.camera
+    return FilmTruth(
+        readout_ms=camera.readout_s * 1e3,
+        led_row=led_row,
+        sphere_row=sphere_row,
+        container=camera.container,
+        codec=camera.codec,
+        frame_times=FRAME_TIMES_FILE if camera.container in STAMPED_CONTAINERS else None,
+    )
+
+
 def simulate(
     config: SimulationConfig,
     out_dir: Path,
@@ -128,7 +146,8 @@ def simulate(
         target=PhotonTarget(config.photon_target, config.persistence),
     )
     _prepare(out_dir, overwrite)
-    with RunRecord(out_dir, (camera.fps, camera.width, camera.height), overwrite=overwrite) as record:
+    film = (config.camera.container, config.camera.codec)
+    with RunRecord(out_dir, (camera.fps, camera.width, camera.height), overwrite=overwrite, film=film) as record:
         log = Session(parts, world.t_begin, world.t_end, record, progress).run()
     impairments = config.camera.impairments
     truth = run_truth(
@@ -136,11 +155,12 @@ def simulate(
         world.pendulum,
         display,
         log,
-        camera_span=(0.0, float(camera.frame_times[-1] + config.camera.exposure)),
+        camera_span=(0.0, float(camera.frame_times[-1] + camera.frame_span_s)),
         frames=len(camera.film_times),
         rois=(list(impairments.film_rect(world.layout.led_roi, camera.width)), list(impairments.film_rect(world.layout.sphere_roi, camera.width))),
         costs=(app_cost.describe(log.app_costs_s), timing.display_frame_cost()),
         board=board.truth() if board is not None else None,
+        film=None if config.films_by_default() else _film_truth(config, world, camera.film_times),
     )
     truth.write(out_dir / TRUTH_FILE)
     return SimulationResult(out_dir, record.video_path, truth)

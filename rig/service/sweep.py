@@ -39,6 +39,7 @@ from typing import Any, Callable, Mapping
 
 from analysis import LatencyResult
 from rig.errors import ConfigError
+from rig.film_file import video_file_name
 from rig.executor import executor
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, analysed_row
@@ -106,8 +107,9 @@ class Sweep:
         points = []
         for index, (settings, labels) in enumerate(self.settings()):
             folder = out / f"point{index:03d}"
-            request = dataclasses.replace(template, video=folder / "video.avi")
-            points.append(SweepPoint(index, build(SimulationConfig, settings), labels, folder, request, rois))
+            config = build(SimulationConfig, settings)
+            request = dataclasses.replace(template, video=folder / video_file_name(config.camera.container))
+            points.append(SweepPoint(index, config, labels, folder, request, rois))
         return points
 
 

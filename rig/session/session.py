@@ -224,4 +224,4 @@ class Session:
         if self.parts.camera is None or self.record.video is None:
             return
         for frame in self.parts.camera.poll():
-            self.record.video.write(frame.image)
+            self.record.video.write(frame.image, frame.t_start)

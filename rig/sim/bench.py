@@ -1,10 +1,20 @@
 """Geometry of the simulated bench: where the camera sees the LED, the display and the sphere.
 
-The camera looks at the pendulum plane. The left half of its image shows the real LED swinging;
-the right half shows the display panel. The renderer's view is orthographic onto the same plane,
-so a sphere drawn at the tracked position moves across the display as the LED moves across the
-camera's left half (same direction, different scale and offset, which the analyser does not care
-about).
+The camera looks at the pendulum plane. Part of its image shows the real LED swinging, another
+part the display panel; the bench's layout (`Placement`) says where, as fractions of the frame:
+
+* ``side-by-side`` (the default): the LED's swing centred in the left half, the panel in the right
+  half, both at mid-height;
+* ``led-above`` / ``led-below``: the LED's swing left of centre and 35 % of the frame's height
+  above / below the panel's centre, as a phone filming a lab bench often sees them;
+* ``LX,LY,LW/DX,DY,DW``: the LED swing's centre (LX, LY) and width LW, then the panel's centre
+  (DX, DY) and width DW, x and widths as fractions of the frame's width, y of its height (the
+  default is ``0.25,0.5,0.4/0.75,0.5,0.42``). The panel keeps the display's aspect ratio; both must
+  lie inside the frame, apart.
+
+The renderer's view is orthographic onto the same plane, so a sphere drawn at the tracked position
+moves across the display as the LED moves across its part of the image (same direction, different
+scale and offset, which the analyser does not care about).
 """
 
 from __future__ import annotations
@@ -13,17 +23,53 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from rig.errors import ConfigError
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum
 
-LED_SWING_FILL = 0.8
 DISPLAY_SWING_FILL = 0.7
-PANEL_WIDTH_FRACTION = 0.42
 SPHERE_RADIUS_PX = 7.0
 ROI_MARGIN_PX = 14.0
+LAYOUTS = {
+    "side-by-side": "0.25,0.5,0.4/0.75,0.5,0.42",
+    "led-above": "0.27,0.3,0.4/0.73,0.65,0.42",
+    "led-below": "0.27,0.7,0.4/0.73,0.35,0.42",
+}
+DEFAULT_LAYOUT = "side-by-side"
+LAYOUT_HELP = (
+    f"{', '.join(LAYOUTS)} (the LED 35 %% of the frame's height above or below the display), or "
+    "LX,LY,LW/DX,DY,DW: the LED swing's centre and width, then the display panel's, as fractions of the "
+    "frame (x and widths of its width, y of its height)"
+)
 
 Rect = tuple[int, int, int, int]
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the bench sits in the camera's frame: the LED's swing and the display panel, each as
+    (centre x, centre y, width), fractions of the frame's width (x, width) and height (y)."""
+
+    led: tuple[float, float, float]
+    display: tuple[float, float, float]
+
+
+def placement(spec: str) -> Placement:
+    """The placement a layout names (`LAYOUTS`) or spells out as LX,LY,LW/DX,DY,DW; ConfigError if neither."""
+    text = LAYOUTS.get(spec, spec)
+    parts = text.split("/")
+    try:
+        numbers = [tuple(float(v) for v in part.split(",")) for part in parts]
+    except ValueError:
+        numbers = []
+    if len(numbers) != 2 or any(len(n) != 3 for n in numbers) or not all(0.0 < v < 1.0 for n in numbers for v in n):
+        raise ConfigError(
+            f"a bench layout is one of {', '.join(LAYOUTS)} or LX,LY,LW/DX,DY,DW with fractions of the frame in (0, 1), "
+            f"got {spec!r}"
+        )
+    (lx, ly, lw), (dx, dy, dw) = numbers
+    return Placement(led=(lx, ly, lw), display=(dx, dy, dw))
 
 
 @dataclass(frozen=True)
@@ -58,6 +104,14 @@ class BenchLayout:
             axis=1,
         )
 
+    def mean_rows(self, positions: np.ndarray) -> tuple[float, float]:
+        """The mean row (index, 0 at the top) of the LED and of the sphere drawn at world positions
+        (N, 3), as fractions of the frame's height: a rolling shutter exposes a row at that
+        fraction of its readout after row 0."""
+        led = self.led_pixels(positions)[:, 1]
+        sphere = self.panel_pixels(positions)[:, 1]
+        return float(np.mean(led) - 0.5) / self.camera_height, float(np.mean(sphere) - 0.5) / self.camera_height
+
     def display_row_fraction(self, position: np.ndarray) -> float:
         """Row of the display (0 top, 1 bottom) where a world position is drawn."""
         clip = self.world_to_clip @ np.append(position, 1.0)
@@ -79,16 +133,20 @@ def _bounding_rect(points: np.ndarray, margin: float, width: int, height: int) -
     return (x0, y0, x1 - x0, y1 - y0)
 
 
-def make_layout(pendulum: Pendulum, camera: CameraConfig, display: DisplayConfig) -> BenchLayout:
-    """Lay out the bench so the pendulum's full swing fills both halves of the camera image."""
+def make_layout(pendulum: Pendulum, camera: CameraConfig, display: DisplayConfig, layout: str = DEFAULT_LAYOUT) -> BenchLayout:
+    """Lay out the bench as `layout` places it (`placement`): the LED's full swing as wide as its
+    placement's width, the display's as wide as 70 % of the panel; ConfigError where the LED's
+    swing or the panel leaves the frame or they overlap."""
+    place = placement(layout)
     length = pendulum.length_m
     amplitude = np.radians(pendulum.config.amplitude_deg)
     swing_m = length * np.sin(amplitude)
     y_mid = -length * (1.0 + np.cos(amplitude)) / 2.0
     width, height = camera.width, camera.height
 
-    px_per_m = LED_SWING_FILL * (width / 4.0) / swing_m
-    led_centre = (width / 4.0, height / 2.0)
+    led_x, led_y, led_width = place.led
+    px_per_m = led_width * width / 2.0 / swing_m
+    led_centre = (led_x * width, led_y * height)
 
     half_width = swing_m / DISPLAY_SWING_FILL
     half_height = half_width * display.height / display.width
@@ -100,9 +158,10 @@ def make_layout(pendulum: Pendulum, camera: CameraConfig, display: DisplayConfig
             [0.0, 0.0, 0.0, 1.0],
         ]
     )
-    panel_w = int(round(PANEL_WIDTH_FRACTION * width))
+    panel_x, panel_y, panel_width = place.display
+    panel_w = int(round(panel_width * width))
     panel_h = int(round(panel_w * display.height / display.width))
-    panel = (width // 2 + (width // 2 - panel_w) // 2, (height - panel_h) // 2, panel_w, panel_h)
+    panel = (int(np.floor(panel_x * width - panel_w / 2)), int(np.floor(panel_y * height - panel_h / 2)), panel_w, panel_h)
     sphere_radius = SPHERE_RADIUS_PX * (2.0 * half_width) / panel_w
 
     arc = np.linspace(-amplitude, amplitude, 201)
@@ -123,7 +182,24 @@ def make_layout(pendulum: Pendulum, camera: CameraConfig, display: DisplayConfig
         sphere_roi=(0, 0, 0, 0),
     )
     led_roi = _bounding_rect(layout.led_pixels(arc_positions), ROI_MARGIN_PX, width, height)
+    _check_fits(layout.led_pixels(arc_positions), panel, led_roi, layout_name=layout, width=width, height=height)
     px, py, pw, ph = panel
     sphere_points = layout.panel_pixels(arc_positions) - (px, py)
     sx, sy, sw, sh = _bounding_rect(sphere_points, ROI_MARGIN_PX + SPHERE_RADIUS_PX, pw, ph)
     return replace(layout, led_roi=led_roi, sphere_roi=(px + sx, py + sy, sw, sh))
+
+
+def _check_fits(led_path: np.ndarray, panel: Rect, led_roi: Rect, layout_name: str, width: int, height: int) -> None:
+    """ConfigError unless the LED's swing (with its spot) and the panel lie inside the frame, apart."""
+    reach = 3.0
+    px, py, pw, ph = panel
+    if (
+        led_path[:, 0].min() - reach < 0 or led_path[:, 0].max() + reach > width
+        or led_path[:, 1].min() - reach < 0 or led_path[:, 1].max() + reach > height
+    ):
+        raise ConfigError(f"layout {layout_name!r} puts the LED's swing partly outside the {width}x{height} frame")
+    if px < 0 or py < 0 or px + pw > width or py + ph > height:
+        raise ConfigError(f"layout {layout_name!r} puts the display panel partly outside the {width}x{height} frame")
+    lx, ly, lw, lh = led_roi
+    if lx < px + pw and px < lx + lw and ly < py + ph and py < ly + lh:
+        raise ConfigError(f"layout {layout_name!r} puts the LED's swing over the display panel; move them apart")

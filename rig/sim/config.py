@@ -10,11 +10,16 @@ import numpy as np
 
 from rig.errors import ConfigError
 from rig.session.timing import DEFAULT_SERVER_MS, PhotonTarget
+from rig.sim.bench import DEFAULT_LAYOUT, placement
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
 from rig.sim.tracker import TrackerConfig
+
+
+# (section, field) of settings a run's record leaves out at their defaults (`SimulationConfig.to_dict`).
+FILM_DEFAULTS = (("camera", "readout_s"), ("camera", "frame_jitter_s"), ("camera", "container"), ("camera", "codec"), ("", "layout"))
 
 
 @dataclass(frozen=True)
@@ -28,6 +33,7 @@ class SimulationConfig:
     (`rig.session.PhotonTarget`).
     scene_load: what the load's scene_triangles make (`rig.render.gl.LOAD_SHAPES`; the renderer
     checks it when it opens).
+    layout: where the LED and the display sit in the camera's frame (`rig.sim.bench.placement`).
     """
 
     duration_s: float = 10.0
@@ -47,8 +53,10 @@ class SimulationConfig:
     persistence: float = 1.0
     warmup_s: float = 0.5
     board: SimulatedBoardConfig | None = None
+    layout: str = DEFAULT_LAYOUT
 
     def __post_init__(self) -> None:
+        placement(self.layout)
         if not (np.isfinite(self.duration_s) and 0.5 <= self.duration_s <= 3600.0):
             raise ConfigError(f"duration must be 0.5-3600 s, got {self.duration_s}")
         if self.scene_triangles < 0:
@@ -75,4 +83,20 @@ class SimulationConfig:
             )
 
     def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
+        """The config as plain values; the camera's rolling shutter, frame timing and film file and
+        the bench's layout are left out where they are the defaults (`FILM_DEFAULTS`), so that a
+        global-shutter run's record is what it was before cameras had them."""
+        record = asdict(self)
+        for section, name in FILM_DEFAULTS:
+            if self._film_default(section, name):
+                del (record[section] if section else record)[name]
+        return record
+
+    def films_by_default(self) -> bool:
+        """Whether the camera has a global shutter, a constant rate and an MJPEG AVI, on the default layout."""
+        return all(self._film_default(section, name) for section, name in FILM_DEFAULTS)
+
+    def _film_default(self, section: str, name: str) -> bool:
+        if section == "camera":
+            return getattr(self.camera, name) == getattr(CameraConfig(), name)
+        return getattr(self, name) == getattr(SimulationConfig, name)

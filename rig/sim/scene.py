@@ -52,14 +52,16 @@ class FilmedScene:
         """The LED's drive level 0..255 at each instant; None for an LED always fully on."""
         return self._board.led_level(instants) if self._board is not None else None
 
-    def panel_light(self, start: float, exposure: float) -> np.ndarray:
-        """The display panel's light averaged over the exposure [start, start + exposure], row by row:
-        each refresh a row shows counts for exactly the time it shows it during the exposure
+    def panel_light(self, starts: np.ndarray, exposure: float) -> np.ndarray:
+        """The display panel's light averaged over each panel row's exposure [start, start + exposure]
+        (`starts`, one per panel row from the top: a rolling shutter exposes lower rows later):
+        each refresh a row shows counts for exactly the time it shows it during the row's exposure
         (scan-out), so where a refresh switches inside an exposure is not rounded to an instant."""
         display = self.display
+        start = np.asarray(starts, dtype=np.float64)
         end = start + exposure
-        first = display.refresh_shown(np.array(start), self._rows)
-        last = display.refresh_shown(np.array(end), self._rows)
+        first = display.refresh_shown(start, self._rows)
+        last = display.refresh_shown(end, self._rows)
         refresh = first[None, :] + np.arange(int((last - first).max()) + 1)[:, None]
         begins = display.vblank_time(refresh) + display.scanout_delay(self._rows)[None, :]
         shown = np.clip(np.minimum(begins + display.period_s, end) - np.maximum(begins, start), 0.0, None) / exposure

@@ -93,6 +93,23 @@ class RefreshCount:
 
 
 @dataclass(frozen=True)
+class FilmTruth:
+    """How the camera filmed, beyond its rate: readout_ms, the rolling shutter's readout (0: a global
+    shutter; row y of H exposed (y / H) x readout after row 0); led_row, sphere_row, the LED's and
+    the sphere's mean rows over the film as fractions of the frame's height, so the sphere's timing
+    in the video is shifted by (sphere_row - led_row) x readout against the LED's; container and
+    codec, the film's file; frame_times, the file beside it listing each frame's exposure start and
+    presentation time (None for an AVI, whose frame i is at i / fps)."""
+
+    readout_ms: float
+    led_row: float
+    sphere_row: float
+    container: str
+    codec: str
+    frame_times: str | None
+
+
+@dataclass(frozen=True)
 class Truth:
     """What a simulated run knows to be true, as written to truth.json.
 
@@ -105,7 +122,9 @@ class Truth:
     the film's rate and frame count (a decimated film's, where the camera's impairments decimate);
     led_roi, sphere_roi: where the LED and the sphere swing in the video (mirrored with the film);
     board: the rig board's clock offset, the pendulum's release and the blink (None without a
-    board); config: the run's whole configuration.
+    board); config: the run's whole configuration; film: how the camera filmed (`FilmTruth`), left
+    out of truth.json for a global-shutter, constant-rate MJPEG film on the default layout, as the
+    film settings are left out of its config (`SimulationConfig.to_dict`).
     """
 
     latency_ms: float
@@ -121,10 +140,14 @@ class Truth:
     sphere_roi: list[int]
     board: dict[str, Any] | None
     config: SimulationConfig
+    film: FilmTruth | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON-ready record (the config as plain values)."""
-        return asdict(self)
+        record = asdict(self) | {"config": self.config.to_dict()}
+        if self.film is None:
+            del record["film"]
+        return record
 
     def write(self, path: Path) -> None:
         try:
@@ -143,6 +166,7 @@ def run_truth(
     rois: tuple[list[int], list[int]],
     costs: tuple[dict[str, Any], dict[str, Any] | None],
     board: dict[str, Any] | None,
+    film: FilmTruth | None = None,
 ) -> Truth:
     """The truth of a finished run: what its display showed (`log`), against the pendulum's motion;
     `costs` are the application frames' and the composed display frames' (`Truth`)."""
@@ -182,4 +206,5 @@ def run_truth(
         sphere_roi=rois[1],
         board=board,
         config=config,
+        film=film,
     )

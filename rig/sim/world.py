@@ -31,7 +31,7 @@ class SimulatedWorld:
         # the truth's latency search (rig.sim.truth) looks up to half a period past the filmed span
         swing_s = config.pendulum.small_angle_period_s
         self.pendulum = Pendulum(config.pendulum, t_start=self.t_begin - 1.0, t_end=self.t_end + 1.0 + swing_s)
-        self.layout: BenchLayout = make_layout(self.pendulum, config.camera, config.display)
+        self.layout: BenchLayout = make_layout(self.pendulum, config.camera, config.display, config.layout)
         self._display = SimDisplay(DisplayConfig(**{**asdict(config.display), "t0": self.t_begin}))
 
     def tracker(self) -> SimTracker:

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from analysis import AnalysisError, analyse
-from analysis.timing import check_count, frame_times, implausible_period_warning, repeated_frames
+from analysis.timing import check_count, frame_times, implausible_period_warning, recorder_repeats
 
 
 def test_constant_rate_stamps_give_uniform_times_without_warnings():
@@ -77,12 +77,18 @@ def test_constant_rate_is_recovered_whatever_the_start(fps, count, start):
     assert not times.variable and times.dropped == 0
 
 
-def test_repeated_frames_are_those_where_every_blob_stands_still_exactly():
-    x = np.array([1.0, 2.0, 2.0, 3.0, np.nan, np.nan])
-    y = np.array([5.0, 6.0, 6.0, 6.0, np.nan, np.nan])
-    other_x = np.array([9.0, 8.0, 8.0, 7.0, 6.0, 6.0])
-    other_y = np.zeros(6)
-    assert repeated_frames((x, y), (other_x, other_y)).tolist() == [False, False, True, False, False, False]
+def test_a_whole_repeat_at_a_constant_rate_is_the_recorders():
+    whole = np.array([False, False, True, False, False, False])
+    times = frame_times(np.arange(6) / 30.0, None, 30.0, "container")
+    assert recorder_repeats(whole, times).tolist() == whole.tolist()
+
+
+def test_a_whole_repeat_among_varying_timestamps_is_a_capture_of_its_own():
+    """A phone's film stamps each capture: a recorder missing one leaves a gap, not a copy."""
+    stamps = np.arange(8) / 30.0 + np.array([0.0, 4e-3, -3e-3, 5e-3, 0.0, -4e-3, 3e-3, 0.0]) * 3
+    times = frame_times(stamps, None, 30.0, "container")
+    assert times.variable
+    assert not recorder_repeats(np.array([False, False, True, False, False, False, False, False]), times).any()
 
 
 def test_implausible_period_and_frame_count_warnings():

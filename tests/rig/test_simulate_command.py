@@ -75,3 +75,40 @@ def test_the_cameras_impairments_are_options_and_reach_truth_json(tmp_path: Path
     assert truth["frames"] == int(video.get(cv2.CAP_PROP_FRAME_COUNT)) == 119  # of the sensor's 239 exposures
     led_x, sphere_x = truth["led_roi"][0], truth["sphere_roi"][0]
     assert sphere_x < camera["width"] / 2 < led_x  # mirrored: the LED films on the right
+
+
+def test_a_phone_like_film_from_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    options = ["--camera-fps", "60", "--exposure", "0.5", "--readout-ms", "8", "--frame-jitter-ms", "2", "--layout", "led-below",
+               "--container", "mov", "--codec", "hevc"]  # fmt: skip
+    assert main(["simulate", "--out", str(tmp_path), "--duration", "1", *options, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["video"].endswith("video.mov")
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    camera = truth["config"]["camera"]
+    assert (camera["readout_s"], camera["frame_jitter_s"], camera["container"], camera["codec"]) == (0.008, 0.002, "mov", "hevc")
+    assert truth["config"]["layout"] == "led-below"
+    film = truth["film"]
+    assert film["readout_ms"] == 8.0 and film["frame_times"] == "frame_times.csv"
+    assert film["led_row"] - film["sphere_row"] == pytest.approx(0.35, abs=0.02)
+    rows = (tmp_path / "frame_times.csv").read_text().splitlines()
+    assert rows[0] == "frame,t_start,pts,t_presented" and len(rows) == truth["frames"] + 1
+
+
+def test_a_default_films_truth_holds_no_film_settings(tmp_path: Path) -> None:
+    assert main(["simulate", "--out", str(tmp_path), "--duration", "0.5"]) == 0
+    truth = json.loads((tmp_path / "truth.json").read_text())
+    assert "film" not in truth and "layout" not in truth["config"] and "readout_s" not in truth["config"]["camera"]
+    assert not (tmp_path / "frame_times.csv").exists()
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--frame-jitter-ms", "1", "--exposure", "0.5"], "mp4 or mov"),
+        (["--readout-ms", "5"], "readout"),
+        (["--container", "mp4", "--codec", "mjpeg"], "not written here"),
+        (["--layout", "0.9,0.5,0.4/0.2,0.5,0.4"], "outside"),
+    ],
+)
+def test_impossible_films_are_refused_with_exit_status_2(tmp_path: Path, capsys: pytest.CaptureFixture[str], options: list[str], message: str) -> None:
+    assert main(["simulate", "--out", str(tmp_path), "--duration", "0.5", *options]) == 2
+    assert message in capsys.readouterr().err

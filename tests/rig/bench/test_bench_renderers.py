@@ -7,7 +7,6 @@ import csv
 import json
 import re
 import tomllib
-from dataclasses import asdict
 from pathlib import Path
 
 import pytest
@@ -109,7 +108,7 @@ def test_the_films_spec_sweeps_exactly_the_simulations_the_bench_filmed(quick_ru
     assert [point.labels for point in points] == [{"renderer": r["renderer"], "triangles": str(r["triangles"])} for r in filmed]
     for point, row in zip(points, filmed):
         truth = json.loads((Path(row["video"]).parent / "truth.json").read_text())
-        assert json.loads(json.dumps(asdict(point.config))) == truth["config"]
+        assert json.loads(json.dumps(point.config.to_dict())) == truth["config"]
         assert point.simulated_rois
 
 

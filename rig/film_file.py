@@ -1,0 +1,131 @@
+"""The files a camera's film may be written to: an MJPEG AVI (`rig.records.VideoRecord`, frame i at
+i / fps), or H.264 or HEVC in an MP4 or a MOV, as phones record, written through PyAV
+(`StampedVideoRecord`), where every frame carries its own presentation time.
+
+A stamped film's times are on a 1/90000 s time base (that of MPEG streams): each frame's
+presentation time is its exposure's start rounded to it, counted from the first frame's, and
+`frame_times.csv` beside the film lists both for every frame. The grey image is written as
+full-range luma (chroma neutral), so decoding the film to grey gives back the pixels the codec kept.
+"""
+
+from __future__ import annotations
+
+import os
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+
+from rig.errors import ConfigError, RigError
+from rig.records import CsvRecord
+
+CONTAINERS = ("avi", "mp4", "mov")
+CODECS = ("mjpeg", "h264", "hevc")
+STAMPED_CONTAINERS = ("mp4", "mov")
+TIME_BASE = Fraction(1, 90_000)
+FRAME_TIMES_FILE = "frame_times.csv"
+FRAME_TIME_COLUMNS = ("frame", "t_start", "pts", "t_presented")
+# What PyAV encodes each codec with, and its settings: quality close to a phone's, at a speed a
+# simulation can afford.
+_ENCODERS = {
+    "h264": ("libx264", {"preset": "veryfast", "crf": "16"}),
+    "hevc": ("libx265", {"preset": "fast", "crf": "18", "x265-params": "log-level=error"}),
+}
+_FULL_RANGE = 2  # AVCOL_RANGE_JPEG: luma 0..255
+_NEUTRAL_CHROMA = 128
+
+
+def check_film_format(container: str, codec: str, stamped: bool) -> None:
+    """ConfigError unless `codec` goes in `container` here, and (`stamped`) the container stamps each
+    frame with its own time."""
+    if container not in CONTAINERS:
+        raise ConfigError(f"a film's container is one of {', '.join(CONTAINERS)}, got {container!r}")
+    if codec not in CODECS:
+        raise ConfigError(f"a film's codec is one of {', '.join(CODECS)}, got {codec!r}")
+    if (container == "avi") != (codec == "mjpeg"):
+        raise ConfigError(
+            f"{codec} in {container} is not written here: an AVI holds MJPEG, an MP4 or a MOV holds h264 or hevc"
+        )
+    if stamped and container not in STAMPED_CONTAINERS:
+        raise ConfigError(
+            "a film with variable frame timing needs a container that stamps each frame: give --container mp4 or mov"
+        )
+
+
+def default_codec(container: str) -> str:
+    """The codec a film in `container` is written with unless another is asked for."""
+    return "mjpeg" if container == "avi" else "h264"
+
+
+def video_file_name(container: str) -> str:
+    """The name of a run's film in its folder."""
+    return f"video.{container}"
+
+
+class StampedVideoRecord:
+    """Writes 8-bit grey frames, each with its presentation time, as H.264 or HEVC in an MP4 or a
+    MOV, and lists every frame's time in `frame_times.csv` beside it. Release it on any exit (use it
+    as a context manager): frames the encoder still holds are written then."""
+
+    def __init__(self, path: str | os.PathLike[str], container: str, codec: str, fps: float, width: int, height: int) -> None:
+        check_film_format(container, codec, stamped=False)
+        if container not in STAMPED_CONTAINERS:
+            raise ConfigError(f"an {container} film is written by rig.records.VideoRecord, not with timestamps")
+        import av  # here: only a run writing such a film loads FFmpeg
+
+        self.path = Path(path)
+        encoder, options = _ENCODERS[codec]
+        try:
+            self._file = av.open(str(self.path), "w", format=container)
+        except OSError as error:
+            raise RigError(f"cannot write video {self.path}: {error.strerror}") from None
+        self._stream = self._file.add_stream(encoder, rate=Fraction(fps).limit_denominator(1001), options=options)
+        self._stream.width, self._stream.height = width, height
+        self._stream.pix_fmt = "yuv420p"
+        self._stream.time_base = TIME_BASE
+        self._stream.codec_context.time_base = TIME_BASE
+        self._stream.codec_context.color_range = _FULL_RANGE
+        self._frame_type = av.VideoFrame
+        self._size = (width, height)
+        self._times = CsvRecord(self.path.parent / FRAME_TIMES_FILE, FRAME_TIME_COLUMNS, overwrite=True, flush_each_row=False)
+        self._first: float | None = None
+        self._last_pts = -1
+        self.frames = 0
+
+    def write(self, grey: np.ndarray, t_start: float | None = None) -> None:
+        """Append a frame whose exposure started at `t_start` (s on the rig clock)."""
+        if t_start is None:
+            raise ValueError("a stamped film needs each frame's start time")
+        if self._first is None:
+            self._first = t_start
+        pts = round((t_start - self._first) / TIME_BASE)
+        if pts <= self._last_pts:
+            raise RigError(f"frame {self.frames} of {self.path} does not follow the one before on the film's time base")
+        width, height = self._size
+        planes = np.full((height * 3 // 2, width), _NEUTRAL_CHROMA, dtype=np.uint8)
+        planes[:height] = grey
+        frame = self._frame_type.from_ndarray(planes, format="yuv420p")
+        frame.color_range = _FULL_RANGE
+        frame.pts, frame.time_base = pts, TIME_BASE
+        for packet in self._stream.encode(frame):
+            self._file.mux(packet)
+        self._times.write([self.frames, float(t_start), pts, float(pts * TIME_BASE)])
+        self._last_pts = pts
+        self.frames += 1
+
+    def close(self) -> None:
+        if self._file is None:
+            return
+        try:
+            for packet in self._stream.encode(None):
+                self._file.mux(packet)
+        finally:
+            self._file.close()
+            self._file = None
+            self._times.close()
+
+    def __enter__(self) -> StampedVideoRecord:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
