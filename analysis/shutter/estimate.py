@@ -48,18 +48,20 @@ RAMPS_MEET = 0.85
 DUTY_TOLERANCE = 0.03
 # An exposure this much over the longest the camera can take is still possible (timing rounding).
 EXPOSURE_SLACK = 1.02
-# A rolling shutter's readout known no better than this share (95 %) is not an answer.
+# A rolling shutter's readout known no better than this share (95 %), or a global shutter's bound
+# above this share of the frame interval, is not an answer.
 MAX_READOUT_SPREAD = 0.25
 # Without the display's scan-out share, it is taken to lie in this range.
 SCANOUT_SHARES = (0.88, 1.0)
-# A display panel's edges in the film are known to this many rows (95 %).
-PANEL_EDGE_ROWS = 2.0
+# A display panel's height in the film is known to this many rows (95 %): its edges are placed to
+# a fraction of a row (``analysis.shutter.film``), which the panel's own light at its border blurs.
+PANEL_EDGE_ROWS = 0.5
 # The frames' times disagree with the bands when each frame's best shift spreads by more than this
 # share of the exposure; the exposure's interval then reaches down by this many times that spread.
 TIMING_SHARE = 0.1
 TIMING_WIDENING = 2.0
 SCANOUTS = ("top-down", "bottom-up")
-# No interval is narrower than these shares (and the exposure's than SWITCHING_S): what the model
+# No interval is narrower than these shares, nor than SWITCHING_S either way: what the model
 # leaves out (rows not read at exactly equal intervals, a light that does not switch instantly,
 # pixels not exactly linear), which the jackknife over frames cannot see.
 READOUT_FLOOR = 0.005
@@ -87,14 +89,14 @@ class DisplayScan:
     def line_s(self, film: RowFilm) -> tuple[float, float]:
         """The display's time per camera row, signed as the camera's line time (positive for a
         scan-out that moves down the film), and its 95 % half-width."""
-        first, last = film.lit_rows
+        first, last = film.edges
         x, y, w, h = film.region
-        if first <= y or last >= y + h - 1:
+        if first < y + 0.5 or last > y + h - 0.5:
             raise AnalysisError(
                 "the flashing display reaches the edge of the frame (or of --roi): film the panel's whole height, "
                 "its top and bottom edges in view, so that its scan-out can be accounted for"
             )
-        rows = last - first + 1
+        rows = last - first
         low, high = (self.scanout_share, self.scanout_share) if self.scanout_share is not None else SCANOUT_SHARES
         scan = (low + high) / 2 / self.refresh_hz
         sign = 1.0 if self.direction == "top-down" else -1.0
@@ -147,8 +149,10 @@ def estimate_shutter(
     line = bands.line_s + display_line
     line_half = math.hypot(T95 * fit.sd["line_s"], display_spread)
     readout = abs(line) * film.height
-    readout_half = max(line_half * film.height, READOUT_FLOOR * readout)
-    global_shutter = abs(line) <= line_half
+    readout_half = max(line_half * film.height, READOUT_FLOOR * readout, SWITCHING_S)
+    global_shutter = bool(readout <= readout_half)
+    if global_shutter and readout + readout_half > MAX_READOUT_SPREAD * interval:
+        raise AnalysisError(_undecided_readout(0.0, readout + readout_half, display_spread > T95 * fit.sd["line_s"], exposure_s, bands.duty))
     if not global_shutter and readout_half > MAX_READOUT_SPREAD * readout:
         raise AnalysisError(_undecided_readout(readout, readout_half, display_spread > T95 * fit.sd["line_s"], exposure_s, bands.duty))
     exposure_half = max(T95 * fit.sd["exposure_s"], EXPOSURE_FLOOR * exposure_s, SWITCHING_S)
@@ -185,7 +189,9 @@ def estimate_shutter(
 
 
 def _undecided_readout(readout: float, half: float, display_dominates: bool, exposure_s: float, duty: float) -> str:
-    known = f"the readout is only known to be {readout * 1e3:.2f} +- {half * 1e3:.2f} ms"
+    """Why the readout is not decided (known to ``readout`` +- ``half``; below ``half`` where
+    ``readout`` is 0), and what to change."""
+    known = f"the readout is only known to be {readout * 1e3:.2f} +- {half * 1e3:.2f} ms" if readout > 0 else f"the readout is only known to be below {half * 1e3:.2f} ms"
     if display_dominates:
         return (
             f"{known}, most of that from the display's scan-out: give the share of each refresh its scan-out takes, "

@@ -30,9 +30,12 @@ LARGEST_SWING_PERCENTILE = 99.5
 MIN_SWING_DN = 8.0
 # An 8-bit level this high is taken as clipped.
 SATURATED_DN = 254.0
-# A row the light reaches with at least this share of the median lit row's pixels counts as inside
-# the lit area (where a display's panel begins and ends).
-EDGE_ROW_SHARE = 0.5
+# The lit area's columns are those the light reaches in at least this share of the rows it reaches
+# most; its rows are inside while their swing over those columns is at least this share of the
+# median inside row's (where a display's panel begins and ends).
+EDGE_SHARE = 0.5
+# Beyond the inside rows, this many are looked at for a partly lit edge (blur, a row half covered).
+EDGE_REACH = 6
 # Rows beyond this many frame-row samples are thinned, every n-th row kept (thinning, unlike
 # averaging neighbours, keeps each row's exposure window exact).
 MAX_SAMPLES = 300_000
@@ -47,7 +50,8 @@ class RowFilm:
 
     levels (frames, rows) the mean of each row's usable pixels; rows their indices in the whole
     frame, pixels how many were averaged; times each frame's time (s); height the whole frame's
-    rows; lit_rows the first and last row inside the lit area (saturated pixels included); region
+    rows; edges where the lit area begins and ends, in rows of the whole frame from its top (the light
+reaches rows edges[0] to edges[1], fractions of a row where it covers part of one); region
     the rectangle searched (x, y, w, h); lit and saturated the pixels the light reaches and those
     left out for clipping.
     """
@@ -57,7 +61,7 @@ class RowFilm:
     pixels: np.ndarray
     times: np.ndarray
     height: int
-    lit_rows: tuple[int, int]
+    edges: tuple[float, float]
     region: Rect
     lit: int
     saturated: int
@@ -66,8 +70,10 @@ class RowFilm:
 
     @property
     def frame_interval_s(self) -> float:
-        """The median time between frames (s)."""
-        return float(np.median(np.diff(self.times)))
+        """The time between frames (s): their mean step, or the median where frames are missing."""
+        steps = np.diff(self.times)
+        median = float(np.median(steps))
+        return float(np.mean(steps)) if np.max(steps) < 1.5 * median else median
 
 
 def read_film(video: str | Path | np.ndarray, fps: float | None = None, roi: Rect | None = None,
@@ -94,10 +100,22 @@ def read_film(video: str | Path | np.ndarray, fps: float | None = None, roi: Rec
             yield frame
 
     def timing() -> tuple[np.ndarray, str, list[str]]:
-        times = frame_times(np.array(stamps), fps, source.container_fps, source.stamp_origin)
-        return times.t, times.source, times.warnings
+        return _film_times(np.array(stamps), fps, source.container_fps, source.stamp_origin)
 
     return _rows_of(frames, timing, (width, height), region)
+
+
+def _film_times(stamps: np.ndarray, fps: float | None, stated_fps: float | None, origin: str) -> tuple[np.ndarray, str, list[str]]:
+    """The frames' times, their source and warnings: ``analysis.timing``'s, except that stamps
+    within a quarter frame of a constant rate are kept as recorded, rescaled alike, unless they are
+    rounded to whole milliseconds. The bands time each frame to a small share of the exposure, so a
+    phone's own capture jitter matters here where the latency analysis may snap it to the rate."""
+    times = frame_times(stamps, fps, stated_fps, origin)
+    relative = stamps - stamps[0]
+    rounded = bool(np.all(np.abs(stamps * 1e3 - np.rint(stamps * 1e3)) < 1e-6))
+    if times.variable or rounded or not relative[-1] > 0:
+        return times.t, times.source, times.warnings
+    return relative * (times.t[-1] / relative[-1]), f"{times.source}, as recorded", times.warnings
 
 
 def film_of_frames(frames: np.ndarray, times: np.ndarray, roi: Rect | None = None) -> RowFilm:
@@ -151,7 +169,7 @@ def _rows_of(frames: Callable[[], Iterable[np.ndarray]], timing: Callable[[], tu
         pixels=usable_per_row[used],
         times=times,
         height=size[1],
-        lit_rows=_lit_extent(lit_per_row, top),
+        edges=_edges(swing, lit, top),
         region=region,
         lit=int(lit.sum()),
         saturated=int(lit.sum() - usable.sum()),
@@ -183,8 +201,24 @@ def _row_means(frames: Iterable[np.ndarray], mask: np.ndarray, rows: np.ndarray)
     return np.array([np.einsum("yx,yx->y", frame[rows].astype(np.float64, copy=False), weights) for frame in frames])
 
 
-def _lit_extent(lit_per_row: np.ndarray, top: int) -> tuple[int, int]:
-    """The first and last row (in the whole frame) that the light reaches across a good share of
-    the lit rows' width."""
-    inside = np.flatnonzero(lit_per_row >= EDGE_ROW_SHARE * np.median(lit_per_row[lit_per_row > 0]))
-    return int(inside[0]) + top, int(inside[-1]) + top
+def _edges(swing: np.ndarray, lit: np.ndarray, top: int) -> tuple[float, float]:
+    """Where the lit area begins and ends (rows of the whole frame, fractional). From a row
+    EDGE_REACH rows inside each edge, the edge lies as many rows out as the rows' shares of light
+    over the next 2 EDGE_REACH rows outwards add up to: each row's share its swing (over the lit
+    columns, less the unlit rows' swing, sensor noise) over that of the rows just inside it. Blur
+    spreads an edge over rows but keeps that sum."""
+    columns = lit.sum(axis=0) >= EDGE_SHARE * lit.sum(axis=0).max()
+    profile = swing[:, columns].mean(axis=1)
+    outside = ~lit[:, columns].any(axis=1)
+    profile = profile - (np.median(profile[outside]) if outside.any() else 0.0)
+    inside = np.flatnonzero(profile >= EDGE_SHARE * np.median(profile[profile >= EDGE_SHARE * profile.max()]))
+    first, last = int(inside[0]), int(inside[-1])
+    reach = max(1, min(EDGE_REACH, (last - first) // 4))
+
+    def shares(anchor: int, step: int) -> float:  # from the anchor row outwards
+        level = float(np.median(profile[anchor : anchor - 3 * step : -step]))
+        rows = anchor + step * np.arange(1, 2 * reach + 1)
+        rows = rows[(rows >= 0) & (rows < len(profile))]
+        return float(np.clip(profile[rows] / max(level, 1e-9), 0.0, 1.0).sum())
+
+    return top + first + reach - shares(first + reach, -1), top + last - reach + 1 + shares(last - reach, 1)

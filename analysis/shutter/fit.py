@@ -41,6 +41,8 @@ MIN_RAMP_ROWS = 3
 DUTY_BOUNDS = (0.01, 0.99)
 EXPOSURE_BOUNDS = (1e-4, 0.999)
 MAX_ITERATIONS = 100
+# Exposures a fit may start from, as shares of the shorter of the light's on and off times.
+EXPOSURE_STARTS = np.array([0.03, 0.1, 0.2, 0.35, 0.5, 0.7])
 
 
 @dataclass(frozen=True)
@@ -179,10 +181,7 @@ def _starts(data: _Data, line_max_s: float) -> list[Bands]:
         i, j = np.unravel_index(int(np.argmax(power)), power.shape)
         if power[i, j] <= 0:
             break
-        peak = spectrum[i, j]
-        exposure = _exposure_from_amplitude(abs(peak) / centred.size, duty)
-        phase = (np.pi * (exposure - duty) - np.angle(peak)) / (2 * np.pi)
-        starts.append(Bands(row_freqs[j] / (f + nus[i]), float(nus[i]), float(phase), duty, exposure))
+        starts.append(_best_exposure(data, row_freqs[j] / (f + nus[i]), float(nus[i]), spectrum[i, j], duty))
         power[max(0, i - 5) : i + 6, max(0, j - 5) : j + 6] = 0.0
     return starts
 
@@ -193,13 +192,15 @@ def _symmetric_grid(largest: float, step: float) -> np.ndarray:
     return np.arange(-count, count + 1) * step
 
 
-def _exposure_from_amplitude(amplitude: float, duty: float) -> float:
-    """The exposure (cycles) whose trapezoid's first harmonic has ``amplitude``: it is
-    sin(pi duty) / pi times sinc(exposure), for rows normalised to swing from 0 to 1."""
-    target = np.clip(amplitude * np.pi / np.sin(np.pi * duty), 0.0, 1.0)
-    grid = np.linspace(0.005, 0.995, 199)
-    sinc = np.sinc(grid)
-    return float(np.clip(grid[np.argmin(np.abs(sinc - target))], 0.01, 0.8 * min(duty, 1.0 - duty)))
+def _best_exposure(data: _Data, line_s: float, nu_hz: float, peak: complex, duty: float) -> Bands:
+    """The start at a Fourier peak whose exposure (tried at shares of the shorter plateau) fits
+    best. The first harmonic's phase is the light's less pi (duty - exposure); its size hardly
+    depends on a short exposure, so the exposure is searched rather than read from it."""
+    trials = [
+        Bands(line_s, nu_hz, float((np.pi * (exposure - duty) - np.angle(peak)) / (2 * np.pi)), duty, exposure)
+        for exposure in EXPOSURE_STARTS * min(duty, 1.0 - duty)
+    ]
+    return min(trials, key=lambda bands: float(np.sum(data.residuals(data.to_x(bands))[0] ** 2)))
 
 
 def _refine(data: _Data, start: Bands) -> tuple[Bands, float]:
