@@ -15,6 +15,7 @@ from rig.sim.bench import DEFAULT_LAYOUT, LAYOUT_HELP
 from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
+from rig.sim.flash import FlashTarget
 from rig.sim.impairments import OCCLUDABLE, FilmImpairments
 from rig.sim.pendulum import MAX_AMPLITUDE_DEG, PendulumConfig
 from rig.sim.tracker import TrackerConfig
@@ -244,6 +245,47 @@ def add_lab_options(parser: argparse.ArgumentParser) -> None:
         f"{board.blink_end_s:g} s) and records its LED changes and the pendulum encoder on its own clock "
         f"({board.board_offset_s:g} s ahead) in DIR/{BOARD_FOLDER}/, as `rig board record` does",
     )
+
+
+def add_flash_options(parser: argparse.ArgumentParser) -> None:
+    """A calibration target filmed instead of the bench (`rig.sim.flash`), for `rig calibrate-camera`."""
+    light = FlashTarget()
+    group = parser.add_argument_group(
+        "calibration target",
+        "Film a flashing light instead of the bench, to measure the camera's readout and exposure with "
+        "`rig calibrate-camera` (the pendulum, tracker and renderer still run, unseen).",
+    )
+    target = group.add_mutually_exclusive_group()
+    target.add_argument("--flash-hz", type=options.positive_float, metavar="F",
+                        help="a white card lit by an LED flashing at F Hz fills the view")  # fmt: skip
+    target.add_argument("--flash-display", type=_flash_refreshes, metavar="N",
+                        help="the display flashes full-field: white for the first half of every N refreshes (N = 2 "
+                        "alternates white and black), black for the rest")  # fmt: skip
+    group.add_argument("--flash-duty", type=_duty, default=light.duty, metavar="D",
+                       help="with --flash-hz, the share of each period the LED is on (default: %(default)s)")  # fmt: skip
+
+
+def with_flash_options(config: SimulationConfig, args: argparse.Namespace) -> SimulationConfig:
+    """The config with the calibration target the flash options ask for, if any."""
+    if args.flash_hz is not None:
+        return replace(config, flash=FlashTarget("light", hz=args.flash_hz, duty=args.flash_duty))
+    if args.flash_display is not None:
+        return replace(config, flash=FlashTarget("display", refreshes=args.flash_display))
+    return config
+
+
+def _flash_refreshes(text: str) -> int:
+    value = options.positive_int(text)
+    if value < 2:
+        raise argparse.ArgumentTypeError(f"a flashing display needs at least 2 refreshes a period, got {text}")
+    return value
+
+
+def _duty(text: str) -> float:
+    value = options.positive_float(text)
+    if value >= 1.0:
+        raise argparse.ArgumentTypeError(f"a duty cycle is a share of each period below 1, got {text}")
+    return value
 
 
 def with_lab_options(config: SimulationConfig, args: argparse.Namespace) -> SimulationConfig:

@@ -14,12 +14,15 @@ from rig.sim.bench import DEFAULT_LAYOUT, placement
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
+from rig.sim.flash import FlashTarget
 from rig.sim.pendulum import PendulumConfig
 from rig.sim.tracker import TrackerConfig
 
 
 # (section, field) of settings a run's record leaves out at their defaults (`SimulationConfig.to_dict`).
-FILM_DEFAULTS = (("camera", "readout_s"), ("camera", "frame_jitter_s"), ("camera", "container"), ("camera", "codec"), ("", "layout"))
+FILM_DEFAULTS = (
+    ("camera", "readout_s"), ("camera", "frame_jitter_s"), ("camera", "container"), ("camera", "codec"), ("", "layout"), ("", "flash"),
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -34,6 +37,7 @@ class SimulationConfig:
     scene_load: what the load's scene_triangles make (`rig.render.gl.LOAD_SHAPES`; the renderer
     checks it when it opens).
     layout: where the LED and the display sit in the camera's frame (`rig.sim.bench.placement`).
+    flash: a calibration target the camera films instead of the bench (`rig.sim.flash`), or None.
     """
 
     duration_s: float = 10.0
@@ -54,6 +58,7 @@ class SimulationConfig:
     warmup_s: float = 0.5
     board: SimulatedBoardConfig | None = None
     layout: str = DEFAULT_LAYOUT
+    flash: FlashTarget | None = None
 
     def __post_init__(self) -> None:
         placement(self.layout)

@@ -16,6 +16,7 @@ from rig.sim.board import SimulatedBoard
 from rig.sim.camera import SimCamera
 from rig.sim.config import SimulationConfig
 from rig.sim.display import DisplayConfig, SimDisplay
+from rig.sim.flash import FlashingDisplayScene, FlashingLightScene
 from rig.sim.pendulum import Pendulum
 from rig.sim.scene import FilmedScene
 from rig.sim.tracker import SimTracker
@@ -43,10 +44,17 @@ class SimulatedWorld:
         return self._display
 
     def camera(self) -> SimCamera:
+        """The world's camera, filming the bench, or the calibration target the config puts in
+        front of it (`rig.sim.flash`)."""
         c = self.config
-        scene = FilmedScene(
-            self.pendulum, self._display, self.layout, c.camera.display_black_dn, c.camera.display_white_dn, c.board
-        )
+        bench = (self.pendulum, self._display, self.layout, c.camera.display_black_dn, c.camera.display_white_dn, c.board)
+        scene: FilmedScene | FlashingLightScene
+        if c.flash is None:
+            scene = FilmedScene(*bench)
+        elif c.flash.source == "light":
+            scene = FlashingLightScene(c.flash, self.layout, self._display)
+        else:
+            scene = FlashingDisplayScene(c.flash, *bench)
         return SimCamera(c.camera, scene, c.duration_s, seed=c.seed + 1, impairment_seed=c.seed)
 
     def board(self, out_dir: Path) -> SimulatedBoard | None:
