@@ -37,12 +37,17 @@ T95 = 2.262
 # A row sample is on a ramp while its on-fraction is strictly between these.
 RAMP = (0.02, 0.98)
 MIN_RAMP_ROWS = 3
-# The fit's parameters (see _Data.to_x) stay within these; duty and exposure in cycles.
+# The fit's parameters (see _Data.to_x) stay within these: the duty in cycles, the exposure as a
+# share of the shorter of the on and off times (so the ramps never meet in a fit, and of the four
+# readings of the bands, ``analysis.shutter.model.other_readings``, the fit holds the one whose
+# ramps are the exposure).
 DUTY_BOUNDS = (0.01, 0.99)
 EXPOSURE_BOUNDS = (1e-4, 0.999)
 MAX_ITERATIONS = 100
-# Exposures a fit may start from, as shares of the shorter of the light's on and off times.
+# Exposures a fit may start from, as shares of the shorter of the light's on and off times, and
+# row frequencies, in steps of the Fourier grid's about each peak's.
 EXPOSURE_STARTS = np.array([0.03, 0.1, 0.2, 0.35, 0.5, 0.7])
+ROW_OFFSETS = (-1.0, -0.5, 0.0, 0.5, 1.0)
 
 
 @dataclass(frozen=True)
@@ -93,13 +98,15 @@ class _Data:
         self.upper = np.array([np.inf, reach, np.inf, DUTY_BOUNDS[1], EXPOSURE_BOUNDS[1]])
 
     def to_x(self, bands: Bands) -> np.ndarray:
-        """Parameters of order one: band cycles across the rows, cycles gained over the film, psi, duty, e."""
+        """Parameters of order one: band cycles across the rows, cycles gained over the film, psi,
+        duty, and e over the shorter of the duty and its complement."""
         f = self.flash_hz + bands.nu_hz
-        return np.array([f * bands.line_s * self.span_rows, bands.nu_hz * self.span_s, bands.phase, bands.duty, bands.exposure])
+        shorter = min(bands.duty, 1.0 - bands.duty)
+        return np.array([f * bands.line_s * self.span_rows, bands.nu_hz * self.span_s, bands.phase, bands.duty, bands.exposure / shorter])
 
     def bands(self, x: np.ndarray) -> Bands:
         nu = x[1] / self.span_s
-        return Bands(x[0] / self.span_rows / (self.flash_hz + nu), nu, x[2], x[3], x[4])
+        return Bands(x[0] / self.span_rows / (self.flash_hz + nu), nu, x[2], x[3], x[4] * min(x[3], 1.0 - x[3]))
 
     def phases(self, bands: Bands, shifts: np.ndarray | float = 0.0) -> np.ndarray:
         """Where each sample's exposure starts, in cycles of the flash (frames, rows); ``shifts``
@@ -131,7 +138,9 @@ class _Data:
             return residuals, None
         slopes = on_fraction_derivatives(u, bands.exposure, bands.duty, g)
         by_u = slopes[0]
-        derivatives = np.stack([by_u * self.y / self.span_rows, by_u * self.t[:, None] / self.span_s, -by_u, slopes[2], slopes[1]])
+        shorter, side = (bands.duty, 1.0) if bands.duty <= 0.5 else (1.0 - bands.duty, -1.0)
+        by_duty = slopes[2] + slopes[1] * x[4] * side  # the exposure moves with the shorter plateau
+        derivatives = np.stack([by_u * self.y / self.span_rows, by_u * self.t[:, None] / self.span_s, -by_u, by_duty, slopes[1] * shorter])
         derivatives *= -(gain * self.weights)
         derivatives -= derivatives.mean(axis=1, keepdims=True)
         centred = g - g.mean(axis=0)
@@ -164,13 +173,17 @@ def fit_bands(film: RowFilm, flash_hz: float, line_max_s: float) -> BandFit:
 
 def _starts(data: _Data, line_max_s: float) -> list[Bands]:
     """Starting points from the strongest peaks of the film's Fourier transform near the flash
-    frequency: row frequency (cycles per row) against the frame times' frequency."""
+    frequency: row frequency (cycles per row) against the frame times' frequency. Each peak's row
+    frequency is known only to a fraction of a cycle across the rows (a display's bands span less
+    than one), so a peak's starts are the best of several exposures at its own row frequency and the
+    best at the row frequencies about it."""
     low, high = np.percentile(data.levels, [5, 95], axis=0)
     shares = (data.levels - low) / np.maximum(high - low, 1e-9)
     centred = shares - shares.mean(axis=0)
     f = data.flash_hz
     row_max = min(1.25 * f * line_max_s, 0.5 / max(float(np.min(np.diff(data.y))), 1.0)) if len(data.y) > 1 else 0.0
-    row_freqs = _symmetric_grid(row_max, 0.2 / data.span_rows)
+    row_step = 0.2 / data.span_rows
+    row_freqs = _symmetric_grid(row_max, row_step)
     nus = _symmetric_grid(data.nu_max, 0.2 / data.span_s)
     by_time = np.exp(-2j * np.pi * (f + nus)[:, None] * data.t[None, :]) @ centred
     spectrum = by_time @ np.exp(-2j * np.pi * data.y[:, None] * row_freqs[None, :])
@@ -181,26 +194,23 @@ def _starts(data: _Data, line_max_s: float) -> list[Bands]:
         i, j = np.unravel_index(int(np.argmax(power)), power.shape)
         if power[i, j] <= 0:
             break
-        starts.append(_best_exposure(data, row_freqs[j] / (f + nus[i]), float(nus[i]), spectrum[i, j], duty))
-        power[max(0, i - 5) : i + 6, max(0, j - 5) : j + 6] = 0.0
+        nu, peak = float(nus[i]), spectrum[i, j]
+        phases = {exposure: float((np.pi * (exposure - duty) - np.angle(peak)) / (2 * np.pi)) for exposure in EXPOSURE_STARTS * min(duty, 1.0 - duty)}
+        trials = {
+            offset: [Bands((row_freqs[j] + offset * row_step) / (f + nu), nu, phase, duty, exposure) for exposure, phase in phases.items()]
+            for offset in ROW_OFFSETS
+        }
+        costs = {offset: [float(np.sum(data.residuals(data.to_x(bands))[0] ** 2)) for bands in row] for offset, row in trials.items()}
+        best = min(costs, key=lambda offset: min(costs[offset]))
+        starts += [trials[offset][int(np.argmin(costs[offset]))] for offset in dict.fromkeys((best, 0.0))]
+        power[max(0, i - 2) : i + 3, max(0, j - 2) : j + 3] = 0.0
     return starts
 
 
 def _symmetric_grid(largest: float, step: float) -> np.ndarray:
     """Multiples of ``step`` from -``largest`` to ``largest``, zero among them."""
-    count = int(np.ceil(largest / step))
+    count = int(np.floor(largest / step))
     return np.arange(-count, count + 1) * step
-
-
-def _best_exposure(data: _Data, line_s: float, nu_hz: float, peak: complex, duty: float) -> Bands:
-    """The start at a Fourier peak whose exposure (tried at shares of the shorter plateau) fits
-    best. The first harmonic's phase is the light's less pi (duty - exposure); its size hardly
-    depends on a short exposure, so the exposure is searched rather than read from it."""
-    trials = [
-        Bands(line_s, nu_hz, float((np.pi * (exposure - duty) - np.angle(peak)) / (2 * np.pi)), duty, exposure)
-        for exposure in EXPOSURE_STARTS * min(duty, 1.0 - duty)
-    ]
-    return min(trials, key=lambda bands: float(np.sum(data.residuals(data.to_x(bands))[0] ** 2)))
 
 
 def _refine(data: _Data, start: Bands) -> tuple[Bands, float]:
