@@ -19,6 +19,7 @@ from predictors import read_trace
 from rig.bench import analyser, batch
 from rig.bench import predictors as predictor_bench
 from rig.commands import choices, options, outputs
+from rig.commands.bench_camera_calibration import add_camera_calibration
 from rig.commands.bench_live import add_live
 from rig.commands.bench_renderers import add_renderers
 from rig.errors import ConfigError
@@ -273,6 +274,7 @@ SUBJECTS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
     "trackers": _add_trackers,
     "batch": _add_batch,
     "live": add_live,
+    "camera-calibration": add_camera_calibration,
 }
 
 
