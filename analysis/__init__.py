@@ -1,24 +1,27 @@
 """Video to latency: blob tracking, phase, correlation, fit and posterior estimators, reports.
 
-``analyse(video)`` tracks the pendulum's LED and the rendered sphere, and measures by how much the
-sphere lags the LED. It is two parts, which can be called alone: ``track(video) -> Tracks`` (read,
-calibrate, track, time and check) and ``estimate(tracks, method) -> LatencyResult`` (the free
-swing, the whole number of periods, the estimators). ``Tracks.write_csv`` saves tracks; the
-estimators are listed by ``methods()``, and ``register_estimator`` adds one (see
-``analysis.estimators``). JAX is imported only when a fit (sinefit, bayes) is asked for, and no
-import changes a JAX setting.
+``analyse(video, AnalysisOptions(...))`` tracks the pendulum's LED and the rendered sphere, and
+measures by how much the sphere lags the LED. It is two parts, which can be called alone, each
+taking the same options: ``track(video, options) -> Tracks`` (read, calibrate, track, time and
+check) and ``estimate(tracks, options) -> LatencyResult`` (the free swing, the whole number of
+periods, the estimators). ``AnalysisOptions`` declares every option once (``analysis.options``).
+``Tracks.write_csv`` saves tracks; the estimators are listed by ``methods()``, and
+``register_estimator`` adds one (see ``analysis.estimators``). JAX is imported only when a fit
+(sinefit, bayes) is asked for, and no import changes a JAX setting.
 """
 
 from analysis.errors import AnalysisError
 from analysis.estimation import estimate
 from analysis.estimators.contract import EstimationContext, Estimator
 from analysis.estimators.registry import methods, register_estimator, unregister_estimator
+from analysis.options import AnalysisOptions
 from analysis.pipeline import analyse
 from analysis.result import LatencyResult, MethodResult
 from analysis.tracks import Tracks, track
 
 __all__ = [
     "AnalysisError",
+    "AnalysisOptions",
     "EstimationContext",
     "Estimator",
     "LatencyResult",

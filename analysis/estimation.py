@@ -12,18 +12,17 @@ widens the interval by it); each adds a warning when it changed something.
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
-from analysis.cycles import DEFAULT_LATENCY_RANGE_S, resolve_cycles
-from analysis.errors import AnalysisError
+from analysis.cycles import resolve_cycles
 from analysis.estimators.contract import EstimationContext
 from analysis.estimators.registry import ALL, DEFAULT_METHOD, estimators_for
 from analysis.misfit import MisfitReport, check_fit
+from analysis.options import AnalysisOptions
 from analysis.phase import fft_phase_latency
 from analysis.result import LatencyResult, MethodResult
 from analysis.sampling import SamplingBias, measure_sampling
@@ -35,40 +34,28 @@ from analysis.tracks import Tracks
 from analysis.windows import windowed_latency
 
 
-def latency_range_s(latency_range_ms: Sequence[float]) -> tuple[float, float]:
-    """The plausible latency range in s; AnalysisError unless it is two finite numbers, low < high (ms)."""
-    low, high = (float(v) for v in latency_range_ms)
-    if not (math.isfinite(low) and math.isfinite(high) and low < high):
-        raise AnalysisError(f"latency range {list(latency_range_ms)!r} ms must be two finite numbers, low < high")
-    return low / 1e3, high / 1e3
-
-
 def estimate(
     tracks: Tracks,
-    method: str = DEFAULT_METHOD,
+    options: AnalysisOptions = AnalysisOptions(),
     *,
-    latency_range_ms: Sequence[float] = tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S),
-    seed: int = 0,
     reference_departures: Callable[[Track], Mapping[str, float]] | None = None,
-    refresh_hz: float | None = None,
-    exposure_ms: float | None = None,
 ) -> LatencyResult:
     """Measure by how much the sphere lags the LED in tracks from ``analysis.tracks.track``.
 
-    ``method`` is a registered estimator's name (``analysis.estimators.registry.methods()``: fft,
-    xcorr, sinefit, bayes, and any registered since) or "all" (every one, the default method's
-    result reported). Latencies are looked for in ``latency_range_ms``. ``seed`` seeds the bayes
-    sampler. ``reference_departures(led_track)`` names times (s, on the video's clock) at which
-    other instruments saw the pendulum depart from rest, in the sense of ``analysis.onset`` (e.g. a
-    rig board's encoder, its clock aligned by the LED's blink code, which it reads from the LED
-    track); with the sphere's departure each gives a lag that fixes the whole number of periods.
-    ``refresh_hz`` (the display's refresh rate) and ``exposure_ms`` (the camera's exposure) are
-    what the user knows of them; without them the video is searched for both
-    (``analysis.sampling``).
+    Of the ``options`` (``analysis.options.AnalysisOptions``), ``method`` is a registered
+    estimator's name (``analysis.estimators.registry.methods()``: fft, xcorr, sinefit, bayes, and
+    any registered since) or "all" (every one, the default method's result reported); latencies are
+    looked for in ``latency_range_ms``; ``seed`` seeds the bayes sampler; ``display_hz`` (the
+    display's refresh rate) and ``exposure_ms`` (the camera's exposure) are what the user knows of
+    them, and without them the video is searched for both (``analysis.sampling``).
+    ``reference_departures(led_track)`` names times (s, on the video's clock) at which other
+    instruments saw the pendulum depart from rest, in the sense of ``analysis.onset`` (e.g. a rig
+    board's encoder, its clock aligned by the LED's blink code, which it reads from the LED track);
+    with the sphere's departure each gives a lag that fixes the whole number of periods.
     """
+    method = options.method
     estimators = estimators_for(method)
-    range_s = latency_range_s(latency_range_ms)
-    check_sampling_options(refresh_hz, exposure_ms)
+    range_s = options.latency_range_s
     started = time.perf_counter()
     warnings = list(tracks.warnings)
     references = reference_departures(tracks.led) if reference_departures is not None else {}
@@ -81,7 +68,7 @@ def estimate(
     cycles = resolve_cycles(wrapped, swing.period_s, swing.windows, swing.damping, range_s, swing.events_s)
     if cycles.warning:
         warnings.append(cycles.warning)
-    context = EstimationContext(swing, cycles, seed, warnings)
+    context = EstimationContext(swing, cycles, options.seed, warnings)
     results = {estimator.name: estimator.estimate(context) for estimator in estimators}
     primary_name = DEFAULT_METHOD if method == ALL else method
     measured = results[primary_name]
@@ -89,7 +76,9 @@ def estimate(
     half_width_s = (measured.ci95_ms[1] - measured.ci95_ms[0]) / 2e3 if measured.ci95_ms is not None else 0.0
     checks = check_fit(swing, windowed_latency(swing.windows, measured.latency_ms / 1e3), residuals, half_width_s)
     sampling = (
-        measure_sampling(residuals, tracks.led, swing.period_s, refresh_hz, None if exposure_ms is None else exposure_ms / 1e3)
+        measure_sampling(
+            residuals, tracks.led, swing.period_s, options.display_hz, None if options.exposure_ms is None else options.exposure_ms / 1e3
+        )
         if residuals is not None
         else None
     )
@@ -131,14 +120,6 @@ def estimate(
         led_track=tracks.led,
         sphere_track=tracks.sphere,
     )
-
-
-def check_sampling_options(refresh_hz: float | None, exposure_ms: float | None) -> None:
-    """AnalysisError unless the display's refresh and the camera's exposure, where given, are
-    positive finite numbers."""
-    for name, value, unit in (("refresh_hz", refresh_hz, "Hz"), ("exposure_ms", exposure_ms, "ms")):
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise AnalysisError(f"{name} must be a positive number of {unit}, not {value!r}")
 
 
 def _adjusted(result: MethodResult, checks: MisfitReport, sampling: SamplingBias | None) -> MethodResult:

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.cycles import DEFAULT_LATENCY_RANGE_S
-from analysis.estimation import check_sampling_options, estimate, latency_range_s
+from analysis.estimation import estimate
 from analysis.estimators.contract import Estimator
-from analysis.estimators.registry import DEFAULT_METHOD, estimators_for
+from analysis.estimators.registry import estimators_for
+from analysis.options import AnalysisOptions
 from analysis.result import LatencyResult
 from analysis.tracking import Track
 from analysis.tracks import track
@@ -20,64 +20,39 @@ from analysis.tracks import track
 
 def analyse(
     source: str | Path | np.ndarray,
+    options: AnalysisOptions = AnalysisOptions(),
     *,
-    fps: float | None = None,
-    led_roi: Sequence[float] | None = None,
-    sphere_roi: Sequence[float] | None = None,
-    led_side: str | None = None,
-    method: str = DEFAULT_METHOD,
-    latency_range_ms: Sequence[float] = tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S),
     progress: Callable[[int, int], object] | None = None,
     tracks_csv: str | Path | None = None,
-    seed: int = 0,
     reference_departures: Callable[[Track], Mapping[str, float]] | None = None,
-    refresh_hz: float | None = None,
-    exposure_ms: float | None = None,
 ) -> LatencyResult:
     """Measure the latency between the LED and the rendered sphere in a video.
 
     ``source`` is a video file, a folder of numbered images, or an array of frames, (N, H, W) grey
-    or (N, H, W, 3) BGR; ``fps`` overrides the file's frame rate and is required for arrays and
-    image folders. ROIs are [x, y, width, height] in pixels: give both or neither; without them the
-    two largest moving bright regions are used, the LED being the one on ``led_side`` ("left" or
-    "right") if given, else the one the physical evidence names (``analysis.identity``; an
-    AnalysisError asks for the ROIs when it does not decide). ``method`` is a registered estimator's name (fft, xcorr,
-    sinefit, bayes, see ``analysis.estimators.registry``) or all (every one, sinefit reported
-    first). Latencies are looked for in ``latency_range_ms``.
+    or (N, H, W, 3) BGR. ``options`` (``analysis.options.AnalysisOptions``) say how: the frame rate
+    (required for arrays and image folders), the regions or the LED's side (else the two largest
+    moving bright regions are used, the LED the one the physical evidence names, and an
+    AnalysisError asks for the regions when it does not decide), the estimator, the latencies
+    considered, the bayes sampler's seed, and what the user knows of the display's refresh rate and
+    the camera's exposure (else the video is searched for both, to work out how the camera's
+    sampling of the display biases the latency, ``analysis.sampling``).
     ``progress(done, total)`` is called as frames are tracked (for clips of
     ``analysis.tracks.PROGRESS_MIN_SECONDS`` or more); ``tracks_csv`` receives the tracks as they
-    are measured. ``seed`` seeds the bayes sampler. ``reference_departures(led_track)``
-    names times (s, on the video's clock) at which other instruments saw the pendulum depart from
-    rest, in the sense of ``analysis.onset`` (e.g. a rig board's encoder, its clock aligned by the
-    LED's blink code, which it reads from the LED track); with the sphere's departure each gives a
-    lag that fixes the whole number of periods. ``refresh_hz`` (the display's refresh rate) and
-    ``exposure_ms`` (the camera's exposure) are what the user knows of them; without them the video
-    is searched for both, to work out how the camera's sampling of the display biases the latency
-    (``analysis.sampling``).
+    are measured. ``reference_departures(led_track)`` names times (s, on the video's clock) at which
+    other instruments saw the pendulum depart from rest, in the sense of ``analysis.onset`` (e.g. a
+    rig board's encoder, its clock aligned by the LED's blink code, which it reads from the LED
+    track); with the sphere's departure each gives a lag that fixes the whole number of periods.
     """
-    # The options are checked before the video is read: a typo should not cost a tracking pass.
-    estimators = estimators_for(method)
-    latency_range_s(latency_range_ms)
-    check_sampling_options(refresh_hz, exposure_ms)
-    preparing = _prepare_in_background(estimators)
+    # The options were checked when they were made, before the video is read: a typo costs no tracking pass.
+    preparing = _prepare_in_background(estimators_for(options.method))
     try:
-        tracks = track(
-            source, fps=fps, led_roi=led_roi, sphere_roi=sphere_roi, led_side=led_side, progress=progress, tracks_csv=tracks_csv
-        )
+        tracks = track(source, options, progress=progress, tracks_csv=tracks_csv)
     except BaseException as error:
         if not isinstance(error, KeyboardInterrupt):  # an interrupt stops at once; the imports end on their own
             preparing.join()
         raise
     preparing.join()
-    return estimate(
-        tracks,
-        method,
-        latency_range_ms=latency_range_ms,
-        seed=seed,
-        reference_departures=reference_departures,
-        refresh_hz=refresh_hz,
-        exposure_ms=exposure_ms,
-    )
+    return estimate(tracks, options, reference_departures=reference_departures)
 
 
 def _prepare_in_background(estimators: Sequence[Estimator]) -> threading.Thread:

@@ -29,7 +29,6 @@ import numpy as np
 
 from analysis.calibration import (
     CALIBRATION_MAX_BYTES,
-    SIDES,
     Calibration,
     calibrate,
     calibration_plan,
@@ -37,6 +36,7 @@ from analysis.calibration import (
 )
 from analysis.errors import AnalysisError
 from analysis.identity import Identity, decide
+from analysis.options import AnalysisOptions
 from analysis.phase import estimate_frequency
 from analysis.signals import swing_signals
 from analysis.timing import FrameTimes, check_count, frame_times, recorder_repeats
@@ -247,37 +247,33 @@ def _rois(
 
 def track(
     source: str | Path | np.ndarray,
+    options: AnalysisOptions = AnalysisOptions(),
     *,
-    fps: float | None = None,
-    led_roi: Sequence[float] | None = None,
-    sphere_roi: Sequence[float] | None = None,
-    led_side: str | None = None,
     progress: Callable[[int, int], object] | None = None,
     tracks_csv: str | Path | None = None,
 ) -> Tracks:
     """Track the LED and the rendered sphere in every frame of a video.
 
     ``source`` is a video file, a folder of numbered images, or an array of frames, (N, H, W) grey
-    or (N, H, W, 3) BGR; ``fps`` overrides the file's frame rate and is required for arrays and
-    image folders. ROIs are [x, y, width, height] in pixels: give both or neither; without them the
-    two largest moving bright regions are used, the LED being the one on ``led_side`` ("left" or
-    "right") if given, else the one the physical evidence names (``analysis.identity``; an
-    AnalysisError asks for the ROIs when it does not decide). ``progress(done, total)`` is called
+    or (N, H, W, 3) BGR. Of the ``options``, ``fps`` overrides the file's frame rate and is required
+    for arrays and image folders; the ROIs are [x, y, width, height] in pixels: give both or
+    neither; without them the two largest moving bright regions are used, the LED being the one on
+    ``led_side`` ("left" or "right") if given, else the one the physical evidence names
+    (``analysis.identity``; an AnalysisError asks for the ROIs when it does not decide). ``progress(done, total)`` is called
     as frames are tracked (for clips of PROGRESS_MIN_SECONDS or more). ``tracks_csv`` receives
     every frame's row as it is measured (the left blob first as the LED while that is undecided),
     then the final table once the frame times are decided (``analysis.tracks_csv``); it is
     written before the tracks are checked, so tracks that fail a check stay on disk to look at.
     """
-    if led_side is not None and led_side not in SIDES:
-        raise AnalysisError(f"led_side must be left or right, not {led_side!r}")
+    fps = options.fps
     video = open_frames(source, fps)
-    given = _rois(video, led_roi, sphere_roi)
+    given = _rois(video, options.led_roi, options.sphere_roi)
     if video.fps is not None and video.frame_count < PROGRESS_MIN_SECONDS * video.fps:
         progress = None
     warnings: list[str] = []
     started = time.perf_counter()
     noted = Repeats()
-    calibration, tracked = _read(video, given, led_side, progress, tracks_csv, warnings, noted)
+    calibration, tracked = _read(video, given, options.led_side, progress, tracks_csv, warnings, noted)
     seconds = time.perf_counter() - started
     stamps = np.array(tracked.stamps, dtype=np.float64)
     times = frame_times(stamps, video.fps if fps is not None else None, video.container_fps, video.stamp_origin)

@@ -28,7 +28,9 @@ declares its own beside its class and takes one line in `predictors.registry`:
         def __init__(self, **values: float | None) -> None:
             self.params.assign(self, values)
 
-This module imports no JAX: the transforms' JAX forms import it when tuning calls them.
+A parameter's `Range` (and the common ones, POSITIVE, NON_NEGATIVE, OPEN_UNIT) is the project's one
+(`declared`), which the analyser's and the rig's settings use too. This module imports no JAX: the
+transforms' JAX forms import it when tuning calls them.
 """
 
 from __future__ import annotations
@@ -41,38 +43,8 @@ from typing import Any, Callable, Iterator, Literal, Mapping, TypeVar
 
 import numpy as np
 
+from declared import NON_NEGATIVE, OPEN_UNIT, POSITIVE, Range
 from predictors.errors import PredictorError
-
-
-@dataclass(frozen=True)
-class Range:
-    """The values a parameter may take: above `low` (or at it, where `includes_low`) and below
-    `high` (never at it: no parameter here may be infinite)."""
-
-    low: float
-    high: float = math.inf
-    includes_low: bool = False
-
-    def contains(self, value: float) -> bool:
-        """Whether `value` is in the range (NaN never is)."""
-        above = self.low <= value if self.includes_low else self.low < value
-        return above and value < self.high
-
-    def describe(self, unit: str) -> str:
-        """The range in words, for messages and docstrings: "a positive number of seconds"."""
-        of = f" of {unit}" if unit else ""
-        if self.high == math.inf:
-            if self.low == 0.0:
-                return f"zero or a positive number{of}" if self.includes_low else f"a positive number{of}"
-            return f"a number{of} {'at least' if self.includes_low else 'above'} {self.low:g}"
-        if self.includes_low:
-            return f"a number{of} from {self.low:g} (inclusive) to {self.high:g} (exclusive)"
-        return f"a number{of} between {self.low:g} and {self.high:g} (exclusive)"
-
-
-POSITIVE = Range(0.0)
-NON_NEGATIVE = Range(0.0, includes_low=True)
-OPEN_UNIT = Range(0.0, 1.0)
 
 
 def _exp_jax(x: Any) -> Any:

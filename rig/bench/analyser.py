@@ -28,6 +28,7 @@ machine touches the ratio less.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from typing import Any, Callable
@@ -131,7 +132,7 @@ def _case_record(point: SweepPoint, row: dict[str, Any], log: Log, started: floa
     if refused is None:
         try:
             analysed_started = time.perf_counter()
-            result = analysis.analyse(video, method="all", seed=config.seed)
+            result = analysis.analyse(video, replace(point.analysis.options, method="all", seed=config.seed))
             total_s = time.perf_counter() - analysed_started
             second_decode, _ = decode_seconds(video)
         except analysis.AnalysisError as error:

@@ -1,5 +1,7 @@
 """What the board reports, as plain values: each event carries its board tick (on the board's full
-time line), its board time in seconds and its time on the rig clock."""
+time line), its board time in seconds and its time on the rig clock. An event's fields are declared
+in the order of its recording file's columns (`analysis.board.recording`), in which the recorder
+writes them."""
 
 from __future__ import annotations
 

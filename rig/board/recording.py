@@ -7,6 +7,7 @@ nothing received is lost if the run stops.
 from __future__ import annotations
 
 import json
+from dataclasses import astuple
 from pathlib import Path
 from typing import Any
 
@@ -39,22 +40,8 @@ FILES: dict[type, Table] = {
 
 
 def _row(event: BoardEvent) -> list[Any]:
-    """The event's cells, in the order of its file's columns."""
-    if isinstance(event, EncoderEdge):
-        return [event.board_tick, event.board_time, event.rig_time, event.count, event.step, event.edges]
-    if isinstance(event, PhotodiodeCrossing):
-        return [event.board_tick, event.board_time, event.rig_time, int(event.rising)]
-    if isinstance(event, PhotodiodePassage):
-        return [event.board_tick, event.board_time, event.rig_time, event.start_tick, event.end_tick, event.peak]
-    if isinstance(event, PhotodiodeSample):
-        return [event.board_tick, event.board_time, event.rig_time, event.value]
-    if isinstance(event, LedChange):
-        return [event.board_tick, event.board_time, event.rig_time, event.level, event.bit]
-    if isinstance(event, BoardStatus):
-        return [event.board_tick, event.board_time] + [getattr(event, column) for column in STATUS.columns[2:]]
-    if isinstance(event, ClockSynced):
-        return [event.rig_time, event.low, event.high, event.round_trips, event.left_out]
-    return [event.rig_time, event.kind, event.detail]
+    """The event's cells: its fields, declared in the order of its file's columns (a flag as 0 or 1)."""
+    return [int(value) if isinstance(value, bool) else value for value in astuple(event)]
 
 
 class BoardRecorder:

@@ -10,13 +10,12 @@ import argparse
 import json
 from pathlib import Path
 
-import analysis
-from analysis.cycles import DEFAULT_LATENCY_RANGE_S
-from analysis.estimators.registry import DEFAULT_METHOD
+from analysis import AnalysisError, AnalysisOptions
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options, outputs
 from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
 from rig.commands.choices import methods_listing
+from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.commands.formatting import board_line, summary_line
 from rig.progress import ProgressBar
 from rig.service import AnalysisRequest, analyse
@@ -25,20 +24,8 @@ from rig.service.batch import find_videos
 
 def _run(args: argparse.Namespace) -> int:
     videos = find_videos(args.videos)
-    request = AnalysisRequest(
-        video=videos[0],
-        fps=args.fps,
-        led_roi=args.led_roi,
-        sphere_roi=args.sphere_roi,
-        led_side=args.led_side,
-        method=args.method,
-        latency_range_ms=args.latency_range,
-        seed=args.seed,
-        tracks_csv=args.csv,
-        board=args.board,
-        display_hz=args.display_hz,
-        exposure_ms=args.exposure_ms,
-    )
+    how = config_from_args(AnalysisOptions, args, AnalysisError)
+    request = AnalysisRequest(videos[0], how, board=args.board, tracks_csv=args.csv)
     if is_batch(args, videos):
         check_batch_options(args)
         return run_batch_command(args, request, videos)
@@ -65,40 +52,7 @@ def _run(args: argparse.Namespace) -> int:
     return EXIT_WARNINGS if result.warnings else 0
 
 
-def _latency_range(text: str) -> tuple[float, float]:
-    """LOW,HIGH in ms."""
-    try:
-        low, high = (float(part) for part in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected LOW,HIGH in ms, got {text!r}") from None
-    if not low < high:
-        raise argparse.ArgumentTypeError(f"LOW must be below HIGH, got {text}")
-    return low, high
-
-
-def add_analysis_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--led-roi", type=options.roi, metavar="X,Y,W,H", help="region the LED swings in (pixels)")
-    parser.add_argument("--sphere-roi", type=options.roi, metavar="X,Y,W,H", help="region the sphere moves in (pixels)")
-    parser.add_argument("--fps", type=options.positive_float, help="camera frame rate, overriding the file's (needed for image folders)")
-    parser.add_argument(
-        "--led-side",
-        choices=("left", "right"),
-        help="the LED is the blob on this side (default: told apart by refresh steps, saturation, size and side)",
-    )
-    parser.add_argument(
-        "--display-hz",
-        type=options.positive_float,
-        help="the display's refresh rate, if known (default: looked for in the video); it fixes how the camera samples it",
-    )
-    parser.add_argument(
-        "--exposure-ms",
-        type=options.positive_float,
-        help="the camera's exposure in ms, if known (default: estimated from the LED's motion blur)",
-    )
-
-
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
-    low, high = (v * 1e3 for v in DEFAULT_LATENCY_RANGE_S)
     parser = subparsers.add_parser(
         "analyse",
         help="measure latency from a video of the LED and the sphere",
@@ -118,15 +72,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="video file (mp4, avi, mov, mkv), folder of numbered images, folder of videos, or glob; "
         "more than one makes a batch",
     )
-    add_analysis_options(parser)
-    parser.add_argument("--method", choices=(*analysis.methods(), "all"), default=DEFAULT_METHOD, help="estimator (default: %(default)s)")
-    parser.add_argument(
-        "--latency-range",
-        type=_latency_range,
-        default=(low, high),
-        metavar="LOW,HIGH",
-        help=f"latencies considered, in ms, to fix the whole number of swing periods (default: {low:g},{high:g})",
-    )
+    add_declared_options(parser, AnalysisOptions)
     parser.add_argument(
         "--board",
         type=Path,
@@ -134,7 +80,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="a `rig board record --blink` folder made while filming: the LED's blink code puts the video on the "
         "board's clock and the encoder's start of swing fixes the whole number of periods",
     )
-    parser.add_argument("--seed", type=int, default=0, help="random seed of the bayes sampler (default: %(default)s)")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--csv", type=outputs.csv_file, metavar="FILE.csv", help="write both tracks as CSV, row by row as they are measured")
     parser.add_argument(

@@ -26,8 +26,10 @@ from typing import Any
 from analysis.board.blink_code import BlinkSchedule
 from analysis.board.photodiode_latency import estimate_from_recording, plot_board_latency
 from rig.board.clock_sync import OffsetInterval
+from rig.board.instrument import DEFAULT_FALL, DEFAULT_RISE, BoardInstrument, BoardSettings
 from rig.board.microcontroller import Microcontroller
 from rig.board.recording import BoardRecorder
+from rig.clock import MonotonicClock
 from rig.commands import outputs
 from rig.commands.options import non_negative_float, non_negative_int, positive_float
 from rig.errors import RigError
@@ -41,8 +43,6 @@ BLINK_LEAD_S = 0.2
 BLINK_TAIL_S = 0.1
 # How long past the wall-clock end of a blink the board's own clock may take to get there.
 BOARD_CLOCK_LIMIT_S = 10.0
-DEFAULT_RISE = 512
-DEFAULT_FALL = 256
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -107,10 +107,14 @@ def _add_port(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--port", default=os.environ.get(PORT_VARIABLE), help=f"serial port or pyserial URL of the board (default ${PORT_VARIABLE})")
 
 
-def _board(args: argparse.Namespace, **options: Any) -> Microcontroller:
+def _port(args: argparse.Namespace) -> str:
     if not args.port:
         raise RigError(f"no board port: pass --port /dev/ttyACM0 (or your board's port), or set {PORT_VARIABLE}")
-    return Microcontroller(args.port, **options)
+    return args.port
+
+
+def _board(args: argparse.Namespace, **options: Any) -> Microcontroller:
+    return Microcontroller(_port(args), **options)
 
 
 def _interval_dict(interval: OffsetInterval) -> dict[str, float]:
@@ -170,42 +174,21 @@ def run_sync(args: argparse.Namespace) -> int:
 def run_record(args: argparse.Namespace) -> int:
     if args.blink and _blink_seconds(args) > args.duration:
         raise RigError(f"--duration {args.duration:g} s is shorter than the blink ({_blink_seconds(args):.2f} s): record for longer")
-    board = _board(args, resync_every_s=args.resync_every)
-    recorder = BoardRecorder(args.out)
-    board.add_listener(recorder)
+    settings = BoardSettings(args.encoder_rate, args.rise, args.fall, args.raw_every, args.resync_every)
+    instrument = BoardInstrument(_port(args), args.out, settings, options={"requested_s": args.duration, "blink": args.blink})
+    clock = MonotonicClock()
     try:
-        with board:
-            board.configure_encoder(args.encoder_rate)
-            board.configure_photodiode(args.rise, args.fall, args.raw_every)
-            board.stream(encoder=True, photodiode=True, samples=args.raw_every > 0)
-            started = time.monotonic()
-            if args.blink:
-                _play_blink(board, args, args.out, ProgressBar("blinking"))
-                board.set_led(args.level)
-            _wait(board, max(args.duration - (time.monotonic() - started), 0.0), ProgressBar(f"recording {args.out}"))
-            board.stream()
-            board.sync()
-            status = board.status()
-            recorder.write_metadata(
-                {
-                    "identity": asdict(board.identity),
-                    "options": {
-                        "duration_s": args.duration,
-                        "encoder_rate_hz": args.encoder_rate,
-                        "rise": args.rise,
-                        "fall": args.fall,
-                        "raw_every": args.raw_every,
-                        "blink": args.blink,
-                    },
-                    "events": recorder.counts,
-                    "link": board.counters,
-                    "board_status": asdict(status),
-                    "drift": asdict(drift) if (drift := board.clock_model.drift()) else None,
-                }
-            )
+        instrument.connect(clock)
+        board, started = instrument.board, clock.now()
+        if args.blink:
+            _play_blink(board, args, args.out, ProgressBar("blinking"))
+            board.set_led(args.level)
+        _wait(board, max(args.duration - (clock.now() - started), 0.0), ProgressBar(f"recording {args.out}"))
+        instrument.finish()
     finally:
-        recorder.close()
-    print(f"recorded {args.duration:g} s in {args.out}: " + ", ".join(f"{count} {name}" for name, count in recorder.counts.items() if count))
+        instrument.close()
+    counts = instrument.recorder.counts
+    print(f"recorded {args.duration:g} s in {args.out}: " + ", ".join(f"{count} {name}" for name, count in counts.items() if count))
     return 0
 
 

@@ -5,12 +5,12 @@
 
 The rig runs live (tracker, predictor, renderer, an on-screen window; or an external renderer over
 LSL) while the camera films the pendulum's LED and the screen; then the video is analysed and the
-latency printed with its 95 % interval beside the rig's own log's answer (and, with --board DIR,
-the photodiode's). Everything is in DIR: the run's logs as they were written, the video, and
-measure.json and measure.png with all three answers. --guided says what to do and checks the first
-seconds of video before the long run. --self-test runs the whole chain with stand-ins (an emulated
-tracker, a frame clock, a camera twin reading the window back) under an X display such as xvfb-run,
-and checks that the video and the log agree.
+latency printed with its 95 % interval beside the rig's own log's answer (and, with --board PORT,
+the photodiode's: the rig board records beside the run into DIR/board). Everything is in DIR: the
+run's logs as they were written, the video, and measure.json and measure.png with all three answers.
+--guided says what to do and checks the first seconds of video before the long run. --self-test
+runs the whole chain with stand-ins (an emulated tracker, a frame clock, a camera twin reading the
+window back) under an X display such as xvfb-run, and checks that the video and the log agree.
 """
 
 from __future__ import annotations
@@ -22,11 +22,12 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from analysis import AnalysisOptions
 from rig.commands import choices, options, outputs
 from rig.commands.record import CAMERA_SPECS, add_camera_options
 from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
-from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, VideoOptions, measure
+from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, measure
 from rig.live.record import check_first_seconds, record_camera
 from rig.live.run import EXTERNAL, LiveConfig
 from rig.lsl import StreamNames
@@ -119,8 +120,8 @@ def _run(args: argparse.Namespace) -> int:
         _guided_check(args)
         print("4. Filming: keep the pendulum swinging and the camera still.", file=sys.stderr)
     report = measure(
-        config, args.camera.removeprefix("camera:"), args.out, board=args.board,
-        options=VideoOptions(args.led_roi, args.sphere_roi, args.led_side),
+        config, args.camera.removeprefix("camera:"), args.out, board_port=args.board,
+        options=AnalysisOptions(led_roi=args.led_roi, sphere_roi=args.sphere_roi, led_side=args.led_side),
         accept_camera_settings=args.accept_camera_settings, overwrite=args.overwrite, progress=ProgressBar("measuring"),
     )  # fmt: skip
     return _print(report, args.json)
@@ -149,7 +150,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         help="what each frame's pose is predicted for (default: %(default)s)")  # fmt: skip
     parser.add_argument("--mirror", action="store_true", help="mirror the screen's x (when the camera sees the sphere move against the LED)")
     parser.add_argument("--led-side", choices=("left", "right"), help="which side of the video the LED is on")
-    parser.add_argument("--board", type=Path, metavar="DIR", help="a `rig board record` folder of the same run: the photodiode's latency too")
+    parser.add_argument("--board", metavar="PORT",
+                        help="the rig board's serial port or pyserial URL: it records beside the run (DIR/board), and the "
+                        "photodiode's latency is given too")  # fmt: skip
     parser.add_argument("--pose-stream", default=StreamNames.pose, help="LSL name of the rig's pose stream (default: %(default)s)")
     parser.add_argument("--tracker-stream", default=StreamNames.tracker, help="LSL name of the rig's tracker stream (default: %(default)s)")
     parser.add_argument("--marker-stream", default=StreamNames.markers,

@@ -50,7 +50,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "simulate",
         help="simulate the rig and write a video with known latency",
         description="Simulate pendulum, tracker, predictor, renderer, display and camera on a virtual clock. "
-        "Writes DIR/video.avi, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and DIR/display_frames.csv, "
+        "Writes DIR/video.avi, DIR/camera_frames.csv, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and "
+        "DIR/display_frames.csv, "
         f"and with --board the board's recording in DIR/{BOARD_FOLDER}/.",
     )
     parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="output folder")

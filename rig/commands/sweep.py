@@ -32,8 +32,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="simulate and analyse a grid of simulated rigs into one summary",
         description="SPEC.toml names [base] simulation settings, a [grid] of settings and the values to sweep each "
         "over (every combination runs) and/or [[points]] given one by one (each its settings, and its row's labels "
-        "as labels = {...}), and optional [analysis] options (method, latency_range_ms, seed, led_side, and "
-        "simulated_rois = true to analyse within the regions the simulation put the LED and the sphere in). A cost "
+        "as labels = {...}), and optional [analysis] options (rig analyse's, by their setting names: method, "
+        "latency_range_ms, display_hz...; and simulated_rois = true to analyse within the regions the simulation put the LED and the sphere in). A cost "
         "(app_frame_ms, warp_ms) may be \"measured\". "
         "Each point is simulated into DIR/pointNNN and analysed; DIR/summary.csv (and .json) gets one row per point "
         "as it finishes, with the truth and the error beside the measured latency.",

@@ -3,8 +3,8 @@
 1. the video's: the analyser (`rig.service.analyse`) on the camera's video, with its 95 % interval;
 2. the rig's own log's: the latency its logged swaps and tracker samples imply (`rig.live.log_latency`),
    at the instants the camera filmed (so that both weight the run alike) and over the whole run;
-3. with a rig board recording (`--board DIR`, from `rig board record` during the run), the
-   photodiode's (`analysis.board.photodiode_latency`).
+3. with the rig board (`--board PORT`: it records beside the run into `board/`, an instrument of
+   the session, `rig.board.instrument`), the photodiode's (`analysis.board.photodiode_latency`).
 
 All three go into `measure.json` and `measure.png`, beside the run's files.
 """
@@ -13,33 +13,26 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
+from analysis import AnalysisOptions
 from analysis.board.photodiode_latency import estimate_from_recording
-from rig.devices.camera.frames import FRAMES_FILE
-from rig.devices.camera.opencv_camera import OpenCvCamera, opencv_camera
+from rig.board.instrument import BoardInstrument
+from rig.devices.camera.opencv_camera import opencv_camera
 from rig.errors import RigError
 from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
 from rig.live.run import EXTERNAL, LiveConfig, run_live
 from rig.live.view import View
 from rig.render.protocol import RenderSetup
 from rig.service.analyse import AnalysisRequest, analyse
+from rig.session.record import BOARD_FOLDER, FRAMES_FILE
 
 MEASURE_FILE = "measure.json"
 PLOT_FILE = "measure.png"
-
-
-@dataclass(frozen=True)
-class VideoOptions:
-    """How to read the run's video: its regions of interest (None: found), which side the LED is on."""
-
-    led_roi: tuple[int, int, int, int] | None = None
-    sphere_roi: tuple[int, int, int, int] | None = None
-    led_side: str | None = None
 
 
 @dataclass
@@ -86,11 +79,11 @@ def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[s
     return {**filmed, "whole_run_latency_ms": log_latency(out_dir, shown, scanout).latency_ms}
 
 
-def analyse_run(out_dir: Path, fps: float | None, options: VideoOptions, board: Path | None, run: dict[str, Any],
+def analyse_run(out_dir: Path, fps: float | None, options: AnalysisOptions, board: Path | None, run: dict[str, Any],
                 progress: Callable[[int, int], object] | None = None) -> MeasureReport:  # fmt: skip
-    """The three answers for a filmed live run in `out_dir`; written to measure.json and measure.png."""
-    request = AnalysisRequest(out_dir / "video.avi", fps=fps, led_roi=options.led_roi, sphere_roi=options.sphere_roi,
-                              led_side=options.led_side, tracks_csv=out_dir / "tracks.csv")  # fmt: skip
+    """The three answers for a filmed live run in `out_dir` (its video analysed as `options` say, at
+    the frame rate the camera measured); written to measure.json and measure.png."""
+    request = AnalysisRequest(out_dir / "video.avi", replace(options, fps=fps), tracks_csv=out_dir / "tracks.csv")
     video = analyse(request, progress).to_dict()
     log = logged_latency(out_dir, run["renderer"] == EXTERNAL, run)
     board_result = None
@@ -143,16 +136,18 @@ def measure(
     out_dir: Path,
     *,
     view: View | None = None,
-    options: VideoOptions = VideoOptions(),
-    board: Path | None = None,
+    options: AnalysisOptions = AnalysisOptions(),
+    board_port: str | None = None,
     accept_camera_settings: bool = False,
     overwrite: bool = False,
     progress: Callable[[float, float], None] | None = None,
 ) -> MeasureReport:
-    """Run `config` live while `camera_spec` films it, then analyse (see the module docstring)."""
-    camera: OpenCvCamera = opencv_camera(camera_spec, out_dir, accept_refused=accept_camera_settings, overwrite=overwrite)
-    result = run_live(config, out_dir, view=view, camera=camera, overwrite=overwrite, progress=progress)
-    fps = camera.writer.measured_fps() if camera.writer else None
-    if camera.writer is None or camera.writer.frames < 2:
+    """Run `config` live while `camera_spec` films it and, given its port, the rig board records;
+    then analyse (see the module docstring)."""
+    camera = opencv_camera(camera_spec, accept_refused=accept_camera_settings)
+    board = [BoardInstrument(board_port, out_dir / BOARD_FOLDER)] if board_port else []
+    result = run_live(config, out_dir, view=view, camera=camera, instruments=board, overwrite=overwrite, progress=progress)
+    film = result.summary["film"]
+    if film is None or film["frames"] < 2:
         raise RigError(f"the camera {camera_spec} recorded no video; check it films while the run goes")
-    return analyse_run(out_dir, fps, options, board, result.summary)
+    return analyse_run(out_dir, film["measured_fps"], options, out_dir / BOARD_FOLDER if board else None, result.summary)

@@ -1,9 +1,10 @@
 """Recording a camera (`rig record`), its live preview, and the guided check of the first seconds.
 
-`record_camera` films for a duration into a folder (`video.avi`, `camera_frames.csv`,
-`camera.json`: see `rig.devices.camera`); Ctrl-C or an unplugged camera stops it with every frame
-kept. With a preview, a window shows the newest frame with both regions of interest drawn (given,
-or found by the analyser's calibration on the first second and a half of swing).
+`record_camera` films for a duration into a folder: the film a run's camera makes
+(`rig.session.record.FilmRecord`: `video.avi`, `camera_frames.csv`) and `camera.json` (the camera's
+report and the film's); Ctrl-C or an unplugged camera stops it with every frame kept. With a
+preview, a window shows the newest frame with both regions of interest drawn (given, or found by
+the analyser's calibration on the first second and a half of swing).
 
 `check_first_seconds` is the guided mode's check before a long run: it records a few seconds and
 asks whether both blobs are found and whether the exposure leaves them unsaturated.
@@ -11,6 +12,7 @@ asks whether both blobs are found and whether the exposure leaves them unsaturat
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
@@ -22,11 +24,15 @@ from analysis.calibration import calibrate
 from analysis.errors import AnalysisError
 from analysis.video.sources import open_frames
 from rig.clock import MonotonicClock
-from rig.devices.camera.opencv_camera import OpenCvCamera, opencv_camera
+from rig.devices.camera.opencv_camera import opencv_camera
+from rig.devices.protocols import CameraFrame
 from rig.devices.window.gl_window import GlWindow, WindowSettings
+from rig.errors import RigError
+from rig.session.record import FilmRecord
 
 PREVIEW_EVERY_S = 1.0 / 30.0
 ROI_FRAMES = 90
+SETTINGS_FILE = "camera.json"
 SATURATED = 255
 SATURATED_SHARE = 0.002
 """More of the image than this at full scale is an exposure too long (the LED's core aside)."""
@@ -88,26 +94,40 @@ def record_camera(
     progress: Callable[[float, float], None] = lambda done, total: None,
 ) -> CameraRecording:
     """Film `spec` for `duration_s` into `out_dir` (see the module docstring)."""
-    camera: OpenCvCamera = opencv_camera(spec, out_dir, accept_refused=accept_refused, overwrite=overwrite)
+    camera = opencv_camera(spec, accept_refused=accept_refused)
     window = Preview(rois) if preview else None
     clock = MonotonicClock()
+    film: FilmRecord | None = None
+    report: dict[str, Any] = {"partial": True}
     try:
         camera.connect(clock)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        film = FilmRecord(out_dir, camera.fps, camera.width, camera.height, overwrite=overwrite)
         end = clock.now() + duration_s
-        while (now := clock.now()) < end and not camera.finished:
-            camera.poll()
-            if window is not None and (frame := camera.latest()) is not None:
-                window.show(frame.image)
+        while (now := clock.now()) < end and not camera.finished and camera.fault() is None:
+            _film(camera.poll(), film, window)
             progress(min(now, end), end)
             clock.wait_until(min(end, clock.now() + PREVIEW_EVERY_S))
-    except KeyboardInterrupt:
-        camera.partial = True
-        raise
+        report["partial"] = False
     finally:
         camera.close()
         if window is not None:
             window.close()
-    return CameraRecording(out_dir, camera.report())
+        if film is not None:
+            _film(camera.poll(), film, None)
+            film.close()
+            report = {**camera.report(), **film.report(), **report}
+            (out_dir / SETTINGS_FILE).write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
+    if (fault := camera.fault()) is not None:
+        raise RigError(f"{fault.reason} at {fault.since:.3f} s; everything captured before is in {out_dir}")
+    return CameraRecording(out_dir, report)
+
+
+def _film(frames: list[CameraFrame], film: FilmRecord, window: Preview | None) -> None:
+    for frame in frames:
+        film.write(frame)
+    if window is not None and frames:
+        window.show(frames[-1].image)
 
 
 def check_first_seconds(video: Path, led_side: str | None = None) -> list[str]:

@@ -1,16 +1,17 @@
 """A live run: the session of a simulated run (`rig.session.Session`) on the monotonic clock, with a
 real tracker, a predictor, a renderer and a display (an on-screen window, or an external renderer
-through LSL).
+through LSL), and where given a camera and instruments (the rig board).
 
 The run's folder gets what a simulated run writes (`tracker.csv`, `app_frames.csv`,
-`display_frames.csv`), and beside it `published_poses.csv` (every display frame's pose with the
-photon time it was predicted for and the newest sample behind it, also pushed on the `RigPose`
-LSL outlet), the display's own log (`display_swaps.csv` for a window, `renderer_markers.csv` for an
-external renderer) and at the end `live.json` (devices, timing sources, counts, why it ended).
-Every row is written as it happens; samples that arrive after the session last took any are
-written when it ends. A `Watchdog` instrument ends the run with a clear message when
-the tracker or the camera goes away (what was recorded stays); so does closing the window. With
-`until_still` the run also ends, normally, once the pendulum has stopped swinging.
+`display_frames.csv`, and with a camera its film, `video.avi` and `camera_frames.csv`), and beside it
+`published_poses.csv` (every display frame's pose with the photon time it was predicted for and the
+newest sample behind it, also pushed on the `RigPose` LSL outlet), the display's own log
+(`display_swaps.csv` for a window, `renderer_markers.csv` for an external renderer) and at the end
+`live.json` (each device's report, the film's, why the run ended). Every row is written as it
+happens; samples that arrive after the session last took any are written when it ends. A
+`Watchdog` instrument ends the run with a clear message when the tracker or the camera goes away
+(`fault()`; what was recorded stays); so does closing the window. With `until_still` the run also
+ends, normally, once the pendulum has stopped swinging.
 """
 
 from __future__ import annotations
@@ -20,21 +21,21 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
 import predictors
-from rig.clock import MonotonicClock
-from rig.devices.protocols import Camera, Display
-from rig.devices.registry import DeviceContext, make_device
-from rig.devices.trackers.stream import TrackerStream
+from rig.clock import Clock, MonotonicClock
+from rig.devices.protocols import Camera, Display, Instrument, TrackerSource
+from rig.devices.registry import make_tracker
+from rig.devices.tap import TappedTracker
 from rig.devices.window import SWAP_COLUMNS, FrameClock, WindowDisplay, WindowSettings
 from rig.errors import ConfigError, RigError
 from rig.live.still import RunEnded, SwingWatch
 from rig.live.view import View, view_from_positions
 from rig.lsl import MARKER_COLUMNS, PUBLISHED_COLUMNS, ExternalRenderer, LslPublisher, MarkerDisplay, PublishingRenderer
-from rig.lsl import PublishingTracker, StreamNames
+from rig.lsl import StreamNames
 from rig.records import CsvRecord
 from rig.render import RenderSetup, make_renderer
 from rig.session import PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
@@ -84,59 +85,45 @@ class LiveResult:
 
 
 class Watchdog:
-    """The instrument beside a live run: connected last, it starts the camera once everything else
-    is open (and tells `on_connected`), and ends the run when a device has gone: a tracker whose link
-    was lost and has stayed silent, a camera that stopped delivering."""
+    """The instrument beside a live run: it tells `on_connected(display)` once everything is open,
+    and ends the run when a device has gone (a tracker lost and silent for TRACKER_SILENCE_S, a
+    camera that stopped delivering) or, with a swing watch, once the pendulum has stopped."""
 
     def __init__(
-        self, tracker: Any, camera: Camera | None, display: Display, on_connected: Callable[[Display], None],
+        self, tracker: TrackerSource, camera: Camera | None, display: Display, on_connected: Callable[[Display], None],
         swing: SwingWatch | None = None,
     ) -> None:  # fmt: skip
         self._tracker = tracker
-        self._swing = swing
         self._camera = camera
         self._display = display
         self._on_connected = on_connected
-        self._clock: Any = None
+        self._swing = swing
+        self._clock: Clock | None = None
 
-    def connect(self, clock: Any) -> None:
+    def connect(self, clock: Clock) -> None:
         self._clock = clock
         self._on_connected(self._display)
-        if self._camera is not None:
-            self._camera.connect(clock)
 
     def poll(self) -> None:
         if self._swing is not None and self._swing.stopped:
             raise RunEnded("the pendulum stopped swinging")
-        stream = self._tracker
-        if isinstance(stream, TrackerStream) and stream.events and stream.events[-1].what == "lost":
-            if self._clock.now() - stream.events[-1].t > TRACKER_SILENCE_S:
-                raise RigError(f"tracker {stream.name} was lost ({stream.events[-1].detail}) and has not come back; the run ended")
-        if self._camera is None:
-            return
-        self._camera.poll()
-        failure = getattr(self._camera, "failure", None)
-        if failure:
-            raise RigError(f"{failure}; the run ended")
+        lost = self._tracker.fault()
+        if lost is not None and self._clock.now() - lost.since > TRACKER_SILENCE_S:
+            raise RigError(f"{lost.reason} and has not come back; the run ended")
+        gone = self._camera.fault() if self._camera is not None else None
+        if gone is not None:
+            raise RigError(f"{gone.reason} at {gone.since:.3f} s; the run ended")
 
     def finish(self) -> None:
         """Nothing to complete."""
 
     def close(self) -> None:
-        if self._camera is not None:
-            self._camera.close()
-
-
-def _record_left_over(tracker: Any, record: RunRecord) -> None:
-    """Samples that arrived after the session last took any (it has closed the tracker): recorded too."""
-    if isinstance(tracker, TrackerStream):
-        for left in tracker.take_queued():
-            record.tracker.write(left.sample_row())
+        """Nothing to release."""
 
 
 def frame_view(tracker_spec: str, clock: MonotonicClock, width: int, height: int, mirror: bool, seconds: float = FRAMING_S) -> View:
     """The view framing the swing the tracker sees for `seconds` (`rig.live.view`)."""
-    tracker = make_device("tracker", tracker_spec, DeviceContext())
+    tracker = make_tracker(tracker_spec)
     tracker.connect(clock)
     positions = []
     try:
@@ -155,15 +142,16 @@ def run_live(
     view: View | None = None,
     frame_clock: FrameClock | None = None,
     camera: Camera | None = None,
+    instruments: Sequence[Instrument] = (),
     clock: MonotonicClock | None = None,
     overwrite: bool = False,
     progress: Progress | None = None,
     on_connected: Callable[[Display], None] = lambda display: None,
 ) -> LiveResult:
     """Run `config` live into `out_dir`. `frame_clock` paces the window instead of the monitor (the
-    self-test's, under a virtual X server); `camera` runs beside the session and is watched; `view`
-    frames the renderer (None: framed from the tracker first); `on_connected(display)` is called
-    once the display is open."""
+    self-test's, under a virtual X server); `camera` films the run into its record and is watched;
+    `instruments` record beside it (the rig board); `view` frames the renderer (None: framed from
+    the tracker first); `on_connected(display)` is called once everything is open."""
     clock = clock or MonotonicClock()
     out_dir = Path(out_dir)
     try:
@@ -188,29 +176,27 @@ def run_live(
             swaps = files.enter_context(CsvRecord(out_dir / SWAPS_FILE, SWAP_COLUMNS, overwrite=overwrite))
             display = WindowDisplay(config.window, scanout_fraction=config.scanout_fraction, frame_clock=frame_clock,
                                     swap_log=lambda swap: swaps.write(swap.row()))  # fmt: skip
-        publisher = LslPublisher(config.streams, display.refresh_hz, published)
-        tracker = make_device("tracker", config.tracker, DeviceContext())
-        swing = SwingWatch(tracker) if config.until_still else None
+        publisher = LslPublisher(config.streams, display, published)
+        swing = SwingWatch() if config.until_still else None
+        tracker = TappedTracker(make_tracker(config.tracker), publisher.samples, *([swing] if swing else []))
         setup = RenderSetup(width=display.width, height=display.height, world_to_clip=view.world_to_clip,
                             sphere_radius_m=view.sphere_radius_m, scene_triangles=config.scene_triangles, wait_for_gpu=True)  # fmt: skip
         parts = SessionParts(
             clock=clock,
-            tracker=PublishingTracker(swing or tracker, publisher),
+            tracker=tracker,
             predictor=predictor,
             renderer=PublishingRenderer(renderer, publisher, clock),
             render_setup=setup,
             timing=timing_for(renderer, cost_model(None)),
             app_cost=cost_model(None),
             display=display,
-            instruments=[Watchdog(tracker, camera, display, on_connected, swing)],
+            camera=camera,
+            instruments=[*instruments, Watchdog(tracker, camera, display, on_connected, swing)],
             target=PhotonTarget(config.photon_target, config.persistence),
         )
+        record = files.enter_context(RunRecord(out_dir, overwrite=overwrite))
         try:
-            with RunRecord(out_dir, None, overwrite=overwrite) as record:
-                try:
-                    Session(parts, clock.now(), clock.now() + config.duration_s, record, progress, from_connect=True).run()
-                finally:
-                    _record_left_over(tracker, record)
+            Session(parts, clock.now(), clock.now() + config.duration_s, record, progress, live=True).run()
             ended = "completed"
         except RunEnded as reason:
             ended = str(reason)
@@ -218,12 +204,12 @@ def run_live(
             ended = str(error)
             raise
         finally:
+            record.close()
             result.summary = {
                 "tracker": config.tracker, "renderer": config.renderer, "predictor": config.predictor,
-                "duration_s": config.duration_s, "ended": ended,
-                "display": display.report() if hasattr(display, "report") else {"display": type(display).__name__},
-                "tracker_report": tracker.report() if isinstance(tracker, TrackerStream) else None,
-                "camera": camera.report() if camera is not None and hasattr(camera, "report") else None,
+                "duration_s": config.duration_s, "ended": ended, "display": display.report(),
+                "tracker_report": tracker.report(), "camera": camera.report() if camera is not None else None,
+                "film": record.film.report() if record.film is not None else None,
                 "lsl": {"pose": config.streams.pose, "tracker": config.streams.tracker, "markers": config.streams.markers}
                 if config.streams else None,
                 "view": {"world_to_clip": view.world_to_clip.tolist(), "sphere_radius_m": view.sphere_radius_m},

@@ -1,15 +1,13 @@
-"""Ending a live run when the pendulum stops: `SwingWatch` passes a tracker's samples on and
-compares each `WINDOW_S` of their swing (the positions' peak-to-peak extent) with the first; once
-it has fallen below `STILL_FRACTION` of it, the swing has died away and `stopped` is set."""
+"""Ending a live run when the pendulum stops: `SwingWatch` watches a tracker's samples (a tap,
+`rig.devices.tap`) and compares each `WINDOW_S` of their swing (the positions' peak-to-peak
+extent) with the first; once it has fallen below `STILL_FRACTION` of it, the swing has died away
+and `stopped` is set."""
 
 from __future__ import annotations
-
-from typing import Any
 
 import numpy as np
 
 from predictors import PoseSample
-from rig.clock import Clock
 
 WINDOW_S = 2.0
 STILL_FRACTION = 0.1
@@ -20,28 +18,15 @@ class RunEnded(Exception):
 
 
 class SwingWatch:
-    """A tracker source that watches the swing of the samples it hands on."""
+    """Watches the swing of the samples it is shown."""
 
-    def __init__(self, tracker: Any) -> None:
-        self.tracker = tracker
+    def __init__(self) -> None:
         self.stopped = False
         self._first_extent: float | None = None
         self._window: list[np.ndarray] = []
         self._window_start: float | None = None
 
-    def connect(self, clock: Clock) -> None:
-        self.tracker.connect(clock)
-
-    def poll(self) -> list[PoseSample]:
-        return self._watch(self.tracker.poll())
-
-    def wait(self, timeout_s: float) -> list[PoseSample]:
-        return self._watch(self.tracker.wait(timeout_s))
-
-    def close(self) -> None:
-        self.tracker.close()
-
-    def _watch(self, samples: list[PoseSample]) -> list[PoseSample]:
+    def __call__(self, samples: list[PoseSample]) -> None:
         for sample in samples:
             if self._window_start is None:
                 self._window_start = sample.t_sensor
@@ -51,4 +36,3 @@ class SwingWatch:
                 self.stopped = self.stopped or extent < STILL_FRACTION * self._first_extent
                 self._window, self._window_start = [], sample.t_sensor
             self._window.append(sample.position)
-        return samples

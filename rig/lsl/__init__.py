@@ -2,7 +2,7 @@
 marker stream, and the rig's side of an external renderer (see `rig.lsl.streams` for the streams)."""
 
 from rig.lsl.external import MARKER_COLUMNS, ExternalRenderer, MarkerDisplay
-from rig.lsl.publish import PUBLISHED_COLUMNS, LslPublisher, PublishingRenderer, PublishingTracker
+from rig.lsl.publish import PUBLISHED_COLUMNS, LslPublisher, PublishingRenderer
 from rig.lsl.streams import MARKER_CHANNELS, POSE_CHANNELS, StreamNames
 
 __all__ = [
@@ -14,6 +14,5 @@ __all__ = [
     "LslPublisher",
     "MarkerDisplay",
     "PublishingRenderer",
-    "PublishingTracker",
     "StreamNames",
 ]

@@ -1,11 +1,12 @@
 """The rig's LSL outlets (`rig.lsl.streams`): the predicted pose per display frame and the raw
 tracker stream, and the wrappers that feed them from a session without the session knowing.
 
-`PublishingTracker` wraps a tracker source: every sample the session takes is pushed on
-`RigTracker`. `PublishingRenderer` wraps a renderer: every pose it draws a display frame with (an
-application frame of a renderer that shows one image per frame, each composed frame of one that
-composes at every refresh) is pushed on `RigPose` with the photon time it was predicted for, the
-newest sample behind it and, as its stamp, when the renderer was handed it. Pushing never blocks.
+`LslPublisher.samples` taps a tracker source (`rig.devices.tap`): every sample the session takes
+is pushed on `RigTracker`. `PublishingRenderer` wraps a renderer: every pose it draws a display
+frame with (an application frame of a renderer that shows one image per frame, each composed frame
+of one that composes at every refresh) is pushed on `RigPose` with the photon time it was predicted
+for, the newest sample behind it and, as its stamp, when the renderer was handed it. Pushing never
+blocks.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 
 from predictors import Pose, PoseSample
 from rig.clock import Clock
+from rig.devices.protocols import Display
 from rig.devices.trackers.lsl_tracker import CHANNELS, lsl_origin, pylsl
 from rig.lsl.streams import POSE_CHANNELS, POSE_UNITS, StreamNames, describe_channels
 from rig.render.protocol import (
@@ -36,12 +38,14 @@ PUBLISHED_COLUMNS = ("frame", "t_pose", *POSE_CHANNELS[1:])
 
 
 class LslPublisher:
-    """The outlets of one run (none where `names` is None: the poses are only recorded); `record`
-    (optional) gets every pose published, on the rig clock."""
+    """The outlets of one run (none where `names` is None: the poses are only recorded) for the
+    frames of `display`, whose refresh the pose stream states (read once the display is connected:
+    the outlets open with the renderer, after the devices); `record` (optional) gets every pose
+    published, on the rig clock."""
 
-    def __init__(self, names: StreamNames | None, refresh_hz: float, record: CsvRecord | None = None) -> None:
+    def __init__(self, names: StreamNames | None, display: Display, record: CsvRecord | None = None) -> None:
         self.names = names
-        self.refresh_hz = refresh_hz
+        self.display = display
         self.newest_sensor_time = -math.inf
         self._record = record
         self._clock: Clock | None = None
@@ -56,12 +60,13 @@ class LslPublisher:
         lsl = pylsl()
         self._origin = lsl_origin(clock)
         source = f"latency-rig-{self.names.pose}"
-        pose = lsl.StreamInfo(self.names.pose, "Pose", len(POSE_CHANNELS), self.refresh_hz, lsl.cf_double64, source)
+        refresh_hz = self.display.refresh_hz
+        pose = lsl.StreamInfo(self.names.pose, "Pose", len(POSE_CHANNELS), refresh_hz, lsl.cf_double64, source)
         describe_channels(pose, POSE_CHANNELS, POSE_UNITS)
         view = pose.desc().append_child("view")
         view.append_child_value("world_to_clip", " ".join(repr(float(v)) for v in np.asarray(setup.world_to_clip).ravel()))
         view.append_child_value("sphere_radius_m", repr(float(setup.sphere_radius_m)))
-        pose.desc().append_child_value("refresh_hz", repr(float(self.refresh_hz)))
+        pose.desc().append_child_value("refresh_hz", repr(float(refresh_hz)))
         tracker = lsl.StreamInfo(self.names.tracker, "MoCap", len(CHANNELS), 0.0, lsl.cf_double64, f"latency-rig-{self.names.tracker}")
         describe_channels(tracker, CHANNELS, ("metres",) * 3 + ("normalised",) * 4)
         self._pose = lsl.StreamOutlet(pose)
@@ -88,30 +93,6 @@ class LslPublisher:
 
     def close(self) -> None:
         self._pose = self._tracker = None
-
-
-class PublishingTracker:
-    """A tracker source whose samples are also pushed on the rig's tracker outlet."""
-
-    def __init__(self, tracker: Any, publisher: LslPublisher) -> None:
-        self.tracker = tracker
-        self.publisher = publisher
-
-    def connect(self, clock: Clock) -> None:
-        self.tracker.connect(clock)
-
-    def poll(self) -> list[PoseSample]:
-        samples = self.tracker.poll()
-        self.publisher.samples(samples)
-        return samples
-
-    def wait(self, timeout_s: float) -> list[PoseSample]:
-        samples = self.tracker.wait(timeout_s)
-        self.publisher.samples(samples)
-        return samples
-
-    def close(self) -> None:
-        self.tracker.close()
 
 
 class PublishingRenderer:

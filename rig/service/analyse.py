@@ -13,32 +13,19 @@ from pathlib import Path
 from typing import Any, Callable
 
 import analysis
-from analysis import LatencyResult
+from analysis import AnalysisOptions, LatencyResult
 from analysis.board.reference import BoardReference
-from analysis.cycles import DEFAULT_LATENCY_RANGE_S
-from analysis.estimators.registry import DEFAULT_METHOD
-
-DEFAULT_LATENCY_RANGE_MS = (DEFAULT_LATENCY_RANGE_S[0] * 1e3, DEFAULT_LATENCY_RANGE_S[1] * 1e3)
 
 
 @dataclass(frozen=True)
 class AnalysisRequest:
-    """What to analyse and how (see `analysis.analyse`); `board` is a board recording folder;
-    `display_hz` and `exposure_ms` are the display's refresh rate and the camera's exposure, where
-    the lab knows them (else the video is searched for both)."""
+    """A video to analyse, how (`analysis.AnalysisOptions`), where its tracks go as they are
+    measured (`tracks_csv`), and the board recording made beside it (`board`, a folder)."""
 
     video: Path
-    fps: float | None = None
-    led_roi: tuple[int, int, int, int] | None = None
-    sphere_roi: tuple[int, int, int, int] | None = None
-    led_side: str | None = None
-    method: str = DEFAULT_METHOD
-    latency_range_ms: tuple[float, float] = DEFAULT_LATENCY_RANGE_MS
-    seed: int = 0
-    tracks_csv: Path | None = None
+    options: AnalysisOptions = AnalysisOptions()
     board: Path | None = None
-    display_hz: float | None = None
-    exposure_ms: float | None = None
+    tracks_csv: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -55,19 +42,8 @@ class Measurement:
 def analyse(request: AnalysisRequest, progress: Callable[[int, int], object] | None = None) -> Measurement:
     """Analyse the request's video; `progress(done, total)` as frames are tracked."""
     board = BoardReference.load(request.board) if request.board is not None else None
+    departures = board.departures if board is not None else None
     result = analysis.analyse(
-        request.video,
-        fps=request.fps,
-        led_roi=request.led_roi,
-        sphere_roi=request.sphere_roi,
-        led_side=request.led_side,
-        method=request.method,
-        latency_range_ms=request.latency_range_ms,
-        progress=progress,
-        tracks_csv=request.tracks_csv,
-        seed=request.seed,
-        reference_departures=board.departures if board is not None else None,
-        refresh_hz=request.display_hz,
-        exposure_ms=request.exposure_ms,
+        request.video, request.options, progress=progress, tracks_csv=request.tracks_csv, reference_departures=departures
     )
     return Measurement(result, board)

@@ -175,7 +175,7 @@ def _config(request: PlanRequest, fps: float, exposure: float, duration_s: float
 def _measure(request: PlanRequest, config: SimulationConfig, folder: Path) -> tuple[SimulationResult, analysis.LatencyResult]:
     run = simulate(config, folder, overwrite=True)
     result = analysis.analyse(
-        run.video_path, refresh_hz=request.display_hz, exposure_ms=config.camera.exposure * 1e3
+        run.video_path, analysis.AnalysisOptions(display_hz=request.display_hz, exposure_ms=config.camera.exposure * 1e3)
     )
     return run, result
 

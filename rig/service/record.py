@@ -22,7 +22,7 @@ from typing import Any, Callable
 
 from predictors import SAMPLE_COLUMNS
 from rig.clock import MonotonicClock
-from rig.devices.registry import DeviceContext, make_device
+from rig.devices.registry import make_tracker
 from rig.devices.trackers.stream import TrackerRecord, TrackerStream
 from rig.errors import RigError
 from rig.records import CsvRecord
@@ -64,7 +64,7 @@ def record_tracker(
 
     `on_batch(records)` sees every batch as it is written.
     """
-    tracker = make_device("tracker", spec, DeviceContext())
+    tracker = make_tracker(spec)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as error:
@@ -108,7 +108,7 @@ def record_tracker(
                 "partial": interrupted,
                 "samples": samples,
                 "files": {"samples": TRACKER_FILE, "device": DEVICE_FILE},
-                **(tracker.report() if isinstance(tracker, TrackerStream) else {"tracker": spec}),
+                **tracker.report(),
             }
             (out_dir / SIDECAR_FILE).write_text(json.dumps(sidecar, indent=1) + "\n", encoding="utf-8")
     return TrackerRecording(out_dir, samples, sidecar)

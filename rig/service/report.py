@@ -19,7 +19,6 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any, Sequence
 
-
 from analysis import LatencyResult
 from analysis.board.recording import METADATA
 from rig.errors import ConfigError
@@ -28,11 +27,11 @@ from rig.report.figures import latency_over_time_figure, residuals_figure, summa
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
 from rig.service.batch import RESULT_COLUMNS
 from rig.service.compare import Z95, differences, group_latencies
+from rig.session.record import BOARD_FOLDER
 
 PACKAGES = ("latency-rig", "numpy", "scipy", "opencv-contrib-python-headless", "jax", "jaxopt", "emcee", "matplotlib", "moderngl")
 RUN_VIDEO = "video.avi"
 TRUTH = "truth.json"
-BOARD = "board"
 # Diagnostics a good film passes, and the test each must pass.
 DIAGNOSTIC_CHECKS = {
     "dropped_frames": lambda value: value == 0,
@@ -104,7 +103,7 @@ def run_report(path: Path) -> tuple[Report, Measurement]:
     video = folder / RUN_VIDEO if folder is not None else path
     truth_path = (folder or video.parent) / TRUTH
     truth = json.loads(truth_path.read_text()) if truth_path.exists() else None
-    board = (folder or video.parent) / BOARD
+    board = (folder or video.parent) / BOARD_FOLDER
     request = AnalysisRequest(video, board=board if (board / METADATA).exists() else None)
     measurement = analyse(request)
     result = measurement.result
@@ -121,7 +120,7 @@ def run_report(path: Path) -> tuple[Report, Measurement]:
     report.sections.append(Section("Diagnostics", [(("diagnostic", "value", "verdict"), rows)]))
     if measurement.board is not None:
         report.sections.append(Section("Board", [(("field", "value"), _flatten(measurement.board.to_dict()))]))
-    configuration = [("video", str(video)), ("method", request.method), ("latency range (ms)", request.latency_range_ms)]
+    configuration = [("video", str(video)), ("method", request.options.method), ("latency range (ms)", request.options.latency_range_ms)]
     if truth is not None:
         configuration += [(f"simulation.{k}", v) for k, v in _flatten(truth["config"])]
     report.sections.append(Section("Configuration and devices", [(("setting", "value"), configuration)]))

@@ -1,10 +1,10 @@
 """Simulate the rig: a session on a virtual clock with the simulated devices, and the run's truth.
 
 A run writes into its output folder as it goes (`rig.session.record`): `tracker.csv`,
-`app_frames.csv`, `display_frames.csv` and `video.avi` (or the camera's `video.mp4` or `video.mov`
-with `frame_times.csv`, `rig.film_file`), with a simulated board its recording in `board/`
-(`rig.sim.board`), and at the end `truth.json` (`rig.sim.truth`). A folder that already holds a
-run is refused unless `overwrite` is given.
+`app_frames.csv`, `display_frames.csv`, `video.avi` and `camera_frames.csv` (or the camera's
+`video.mp4` or `video.mov` with `frame_times.csv` too, `rig.film_file`), with a simulated board its
+recording in `board/` (`rig.sim.board`), and at the end `truth.json` (`rig.sim.truth`). A folder
+that already holds a run is refused unless `overwrite` is given.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 
 import predictors
 from rig.clock import VirtualClock
-from rig.devices.registry import DeviceContext, make_device
+from rig.devices.registry import DeviceContext, make_camera, make_display, make_tracker
 from rig.errors import RigError
 from rig.film_file import FRAME_TIMES_FILE, STAMPED_CONTAINERS, video_file_name
 from rig.render import RenderSetup, make_renderer
@@ -115,9 +115,8 @@ def simulate(
     """Run the simulated rig of `config` and write its video, samples, frame logs and truth into out_dir."""
     out_dir = Path(out_dir)
     world = SimulatedWorld(config)
-    context = DeviceContext(simulation=world)
-    display = make_device("display", "sim", context)
-    camera = make_device("camera", "sim", context)
+    context = DeviceContext(world.twins())
+    display, camera = world.display(), world.camera()  # the registry's `sim` devices, whose details the truth reads
     renderer = make_renderer(config.renderer)
     board = world.board(out_dir / BOARD_FOLDER)
     timing = timing_for(renderer, cost_model(config.warp_ms))
@@ -134,20 +133,19 @@ def simulate(
     app_cost = cost_model(config.app_frame_ms)
     parts = SessionParts(
         clock=VirtualClock(world.t_begin),
-        tracker=make_device("tracker", "sim", context),
+        tracker=make_tracker("sim", context),
         predictor=predictors.make(config.predictor, **config.predictor_params),
         renderer=renderer,
         render_setup=setup,
         timing=timing,
         app_cost=app_cost,
-        display=display,
-        camera=camera,
+        display=make_display("sim", context),
+        camera=make_camera("sim", context),
         instruments=[board] if board is not None else [],
         target=PhotonTarget(config.photon_target, config.persistence),
     )
     _prepare(out_dir, overwrite)
-    film = (config.camera.container, config.camera.codec)
-    with RunRecord(out_dir, (camera.fps, camera.width, camera.height), overwrite=overwrite, film=film) as record:
+    with RunRecord(out_dir, overwrite=overwrite, film=(config.camera.container, config.camera.codec)) as record:
         log = Session(parts, world.t_begin, world.t_end, record, progress).run()
     impairments = config.camera.impairments
     truth = run_truth(

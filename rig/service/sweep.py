@@ -16,7 +16,7 @@ A sweep is a TOML file:
     labels = { case = "dim LED" } # the row's labels (default: the settings the point names)
     camera.impairments.dim_led = 0.35
 
-    [analysis]                   # how each video is analysed (rig analyse's options)
+    [analysis]                   # how each video is analysed (analysis.AnalysisOptions' fields)
     method = "sinefit"
     simulated_rois = true        # the LED's and the sphere's regions the simulation knows
 
@@ -37,7 +37,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from analysis import LatencyResult
+from analysis import AnalysisError, AnalysisOptions, LatencyResult
+from declared import from_table
 from rig.errors import ConfigError
 from rig.film_file import video_file_name
 from rig.executor import executor
@@ -47,7 +48,6 @@ from rig.service.simulate import SimulationResult, simulate
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.config import SimulationConfig
 
-ANALYSIS_OPTIONS = ("method", "latency_range_ms", "seed", "led_side")
 SIMULATED_ROIS = "simulated_rois"
 """The [analysis] option that analyses each video within its simulation's regions."""
 MEASURED = "measured"
@@ -73,7 +73,7 @@ class SweepPoint:
 class Sweep:
     """base: settings every point shares; grid: settings and the values each takes (every
     combination is a point); explicit: points given one by one (dotted settings, and optionally
-    their labels under "labels"); analysis: `AnalysisRequest` options."""
+    their labels under "labels"); analysis: `AnalysisOptions` settings, and SIMULATED_ROIS."""
 
     base: dict[str, Any]
     grid: dict[str, list[Any]]
@@ -101,16 +101,23 @@ class Sweep:
         return Sweep({}, {}, self.analysis, [{**settings, "labels": labels} for settings, labels in self.settings() if keep(labels)])
 
     def points(self, out: Path) -> list[SweepPoint]:
-        options = {k: tuple(v) if isinstance(v, list) else v for k, v in self.analysis.items() if k != SIMULATED_ROIS}
-        template = AnalysisRequest(Path(), **options)
+        options = analysis_options(self.analysis)
         rois = bool(self.analysis.get(SIMULATED_ROIS, False))
         points = []
         for index, (settings, labels) in enumerate(self.settings()):
             folder = out / f"point{index:03d}"
             config = build(SimulationConfig, settings)
-            request = dataclasses.replace(template, video=folder / video_file_name(config.camera.container))
+            request = AnalysisRequest(folder / video_file_name(config.camera.container), options)
             points.append(SweepPoint(index, config, labels, folder, request, rois))
         return points
+
+
+def analysis_options(table: Mapping[str, Any]) -> AnalysisOptions:
+    """The analysis options a sweep's [analysis] table gives (besides SIMULATED_ROIS), every key and value checked."""
+    try:
+        return from_table(AnalysisOptions, {k: v for k, v in table.items() if k != SIMULATED_ROIS}, AnalysisError, "[analysis]")
+    except AnalysisError as error:
+        raise ConfigError(str(error)) from None
 
 
 def _dotted(mapping: Mapping[str, Any]) -> dict[str, Any]:
@@ -250,9 +257,10 @@ def read_sweep(path: Path) -> Sweep:
         if "labels" in point and not isinstance(point["labels"], dict):
             raise ConfigError(f"{path}: point {number}'s labels must be a table of names and values")
     analysis = spec.get("analysis", {})
-    bad = set(analysis) - {*ANALYSIS_OPTIONS, SIMULATED_ROIS}
-    if bad:
-        raise ConfigError(f"{path}: [analysis] takes {', '.join((*ANALYSIS_OPTIONS, SIMULATED_ROIS))}, not {', '.join(sorted(bad))}")
+    try:
+        analysis_options(analysis)
+    except ConfigError as error:
+        raise ConfigError(f"{path}: {error}") from None
     if not isinstance(analysis.get(SIMULATED_ROIS, False), bool):
         raise ConfigError(f"{path}: [analysis] {SIMULATED_ROIS} is true or false, not {analysis[SIMULATED_ROIS]!r}")
     return Sweep(spec.get("base", {}), grid, analysis, explicit)
@@ -275,7 +283,8 @@ def simulate_and_analyse(point: SweepPoint) -> PointRun:
     truth = simulation.truth
     request = point.analysis
     if point.simulated_rois:
-        request = dataclasses.replace(request, led_roi=tuple(truth.led_roi), sphere_roi=tuple(truth.sphere_roi))
+        rois = dataclasses.replace(request.options, led_roi=tuple(truth.led_roi), sphere_roi=tuple(truth.sphere_roi))
+        request = dataclasses.replace(request, options=rois)
     row, result = analysed_row(BatchItem(request, point.labels))
     row["index"] = point.index
     row["truth_ms"] = truth.latency_ms

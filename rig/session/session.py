@@ -6,8 +6,8 @@ The session handles events in time order against the devices' protocols
 renderer is ready, and ask the predictor for the pose at the time the photon target says
 (`rig.session.timing.PhotonTarget`) of the refresh they expect to reach; at every refresh the
 renderer's own work happens (`rig.session.timing`), the refresh is logged (with whether it missed,
-repeating the last image), the camera's finished frames are recorded, and the instruments beside the
-rig record up to the present.
+repeating the last image), the camera's finished frames go to the run's film, and the instruments
+beside the rig record up to the present.
 
 On a virtual clock that is a simulation, deterministic for a seed; on a monotonic clock, waiting
 means sleeping until an event is due. Every file is written as the run goes (`rig.session.record`),
@@ -28,7 +28,7 @@ from rig.clock import Clock
 from rig.devices.protocols import NO_IMAGE, Camera, Display, Instrument, TrackerSource
 from rig.errors import RigError
 from rig.records import CsvRecord
-from rig.render.protocol import AppFrameRequest, Renderer, RenderSetup
+from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, DisplayFrameResult, Renderer, RenderSetup
 from rig.session.record import RunRecord
 from rig.session.timing import CostModel, PhotonTarget, TimingPolicy
 
@@ -108,14 +108,16 @@ class Session:
         t_end: float,
         record: RunRecord,
         progress: Progress | None = None,
-        from_connect: bool = False,
+        live: bool = False,
     ) -> None:
         self.parts = parts
         self.t_begin = t_begin
         self.t_end = t_end
-        self.from_connect = from_connect
-        """Count the run's span from when its devices are connected (a live run: opening a window
-        and finding a tracker take as long as they take) rather than from `t_begin` as given."""
+        self.live = live
+        """A live run: its span counts from when its devices are connected (opening a window and
+        finding a tracker take as long as they take) rather than from `t_begin` as given, and the
+        samples that arrive after the last application frame took any are recorded too, up to
+        closing the tracker (nothing a live tracker sent is lost)."""
         self.record = record
         self.progress = progress
         self.display = parts.display
@@ -125,7 +127,7 @@ class Session:
         """The display row the sphere was last drawn at: where the next image's photons are expected."""
         self.log = SessionLog()
         self._app_frames = 0
-        self._last_cost = parts.app_cost.expected_s(1.0 / parts.display.refresh_hz)
+        self._last_cost = math.nan
 
     def run(self) -> SessionLog:
         """Connect everything, run to `t_end`, release everything (on any exit); what was shown."""
@@ -135,11 +137,17 @@ class Session:
             for device in devices:
                 device.connect(parts.clock)
                 stack.callback(device.close)
+                if device is parts.tracker and self.live:
+                    stack.callback(self._record_late_samples)
+                if device is parts.camera:
+                    self.record.open_film(parts.camera.fps, parts.camera.width, parts.camera.height)
+                    stack.callback(self._record_camera)  # the frames since the last refresh, before the camera closes
             parts.renderer.open(parts.render_setup)
             stack.callback(parts.renderer.close)
-            if self.from_connect:
+            if self.live:
                 shift = parts.clock.now() - self.t_begin
                 self.t_begin, self.t_end = self.t_begin + shift, self.t_end + shift
+            self._last_cost = parts.app_cost.expected_s(1.0 / parts.display.refresh_hz)  # the refresh as connected
             self._loop()
         return self.log
 
@@ -155,6 +163,12 @@ class Session:
             float(position[0]), self.row_estimate, self.feed.newest_sensor_time, float(cost_s), cost_source
         )
         return self.display.present(image, t_ready, image_id)
+
+    def compose(self, k: int, ready: int) -> DisplayFrameResult:
+        """The renderer's composed image for refresh k from application frame `ready`."""
+        self.feed.deliver()
+        request = DisplayFrameRequest(k, self.display.vblank_time(k), self.photon_target(k), self.feed.predict, ready)
+        return self.renderer.render_display_frame(request)
 
     def photon_target(self, k: int) -> float:
         """The instant refresh k's pose is predicted for, at the row the sphere was last drawn at."""
@@ -203,7 +217,7 @@ class Session:
             [index, start, cost, self.parts.app_cost.source, finish, t_photon, self.feed.newest_sensor_time, *position.tolist()]
         )
         self._app_frames += 1
-        return self.parts.timing.app_frame_done(self, index, result, finish, cost)
+        return self.parts.timing.app_frame_done(self, index, result, finish, cost, self.parts.app_cost.source)
 
     def _log_refresh(self, k: int) -> None:
         """Log refresh k; it missed if it repeats the previous refresh's image."""
@@ -220,8 +234,16 @@ class Session:
             int(missed), shown.cost_s, shown.cost_source,
         ])  # fmt: skip
 
+    def _record_late_samples(self) -> None:
+        try:
+            late = self.parts.tracker.poll()
+        except RigError:
+            return  # a source that failed has nothing more to give; its failure is the run's
+        for sample in late:
+            self.record.tracker.write(sample_row(sample))
+
     def _record_camera(self) -> None:
-        if self.parts.camera is None or self.record.video is None:
+        if self.parts.camera is None or self.record.film is None:
             return
         for frame in self.parts.camera.poll():
-            self.record.video.write(frame.image, frame.t_start)
+            self.record.film.write(frame)

@@ -33,23 +33,20 @@ the moment the frame's scan-out reaches the tracked object's row, or the middle 
 during which that row then emits it (scan-out plus half the persistence).
 
 The session (`rig.session.session`) is handed one policy and never asks what kind of renderer it
-drives.
+drives; the policy sees the session only as a `Stage` (the display, `show` and `compose`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Sequence
+from typing import Any, ClassVar, Protocol, Sequence
 
 import numpy as np
 
+from rig.devices.protocols import Display
 from rig.errors import ConfigError
-from rig.render.protocol import AppFrameResult, DisplayFrameRequest, Renderer
-
-if TYPE_CHECKING:
-    from rig.devices.protocols import Display
-    from rig.session.session import Session
+from rig.render.protocol import AppFrameResult, DisplayFrameResult, Renderer
 
 PLANNED_COST_WINDOW = 60
 """How many of the latest measured server costs the plan for the next one weighs."""
@@ -159,6 +156,23 @@ class PhotonTarget:
         return t
 
 
+class Stage(Protocol):
+    """What a timing policy drives (the session): the display, and the two ways an image reaches it."""
+
+    display: Display
+
+    def show(self, image: np.ndarray | None, t_ready: float, image_id: int, position: np.ndarray, cost_s: float,
+             cost_source: str) -> int:  # fmt: skip
+        """Hand the display an image drawn at `position`, ready at `t_ready` after work that cost
+        `cost_s` (`cost_source`: measured or modelled); the refresh it appears at."""
+        ...
+
+    def compose(self, k: int, ready: int) -> DisplayFrameResult:
+        """The renderer's composed image for refresh k from application frame `ready`, with the
+        tracker samples arrived by now."""
+        ...
+
+
 class TimingPolicy(Protocol):
     """When the renderer works and when its images reach the display."""
 
@@ -166,11 +180,12 @@ class TimingPolicy(Protocol):
         """When refresh k's own work starts (application frames starting by then come first);
         no later than the start of any work the policy has planned for a later refresh."""
 
-    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float, cost_s: float) -> float:
-        """Take application frame `index`, finished at `finish` after `cost_s` on the clock; when
-        the next one starts."""
+    def app_frame_done(self, stage: Stage, index: int, result: AppFrameResult, finish: float, cost_s: float,
+                       cost_source: str) -> float:  # fmt: skip
+        """Take application frame `index`, finished at `finish` after `cost_s` on the clock (as
+        `cost_source` says); when the next one starts."""
 
-    def at_refresh(self, session: Session, k: int, t_start: float) -> None:
+    def at_refresh(self, stage: Stage, k: int, t_start: float) -> None:
         """Refresh k's own work, at `t_start`."""
 
     def display_frame_cost(self) -> dict[str, Any] | None:
@@ -183,11 +198,12 @@ class OneImagePerAppFrame:
     def refresh_start(self, display: Display, k: int) -> float:
         return display.vblank_time(k)
 
-    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float, cost_s: float) -> float:
-        refresh = session.show(result.image, finish, index, result.pose.position, cost_s, session.parts.app_cost.source)
-        return session.display.vblank_time(refresh)
+    def app_frame_done(self, stage: Stage, index: int, result: AppFrameResult, finish: float, cost_s: float,
+                       cost_source: str) -> float:  # fmt: skip
+        refresh = stage.show(result.image, finish, index, result.pose.position, cost_s, cost_source)
+        return stage.display.vblank_time(refresh)
 
-    def at_refresh(self, session: Session, k: int, t_start: float) -> None:
+    def at_refresh(self, stage: Stage, k: int, t_start: float) -> None:
         """Nothing: the display repeats the newest image."""
 
     def display_frame_cost(self) -> dict[str, Any] | None:
@@ -221,29 +237,27 @@ class CompositeEveryRefresh:
         start = self._plan(display, self._target)
         return start if k == self._target else min(display.vblank_time(k), start)
 
-    def app_frame_done(self, session: Session, index: int, result: AppFrameResult, finish: float, cost_s: float) -> float:
+    def app_frame_done(self, stage: Stage, index: int, result: AppFrameResult, finish: float, cost_s: float,
+                       cost_source: str) -> float:  # fmt: skip
         self._finished.append(finish)
         return finish
 
-    def at_refresh(self, session: Session, k: int, t_start: float) -> None:
+    def at_refresh(self, stage: Stage, k: int, t_start: float) -> None:
         """Compose for refresh k if the server aimed at it, from the newest application frame
         finished by now; before the first one is, the server has nothing to warp (nor, maybe, a
         tracker sample to warp with): the display stays dark."""
         if k != self._target:
             return
-        display = session.display
+        display = stage.display
         ready = int(np.searchsorted(self._finished, t_start, side="right")) - 1
         if ready < 0:
             self._aim_after(display, k, t_start)
             return
-        session.feed.deliver()
-        result = session.renderer.render_display_frame(
-            DisplayFrameRequest(k, display.vblank_time(k), session.photon_target(k), session.feed.predict, ready)
-        )
+        result = stage.compose(k, ready)
         cost = self.server_cost.charge(result.cost_s)
         self._charged.append(cost)
         finish = t_start + cost
-        shown = session.show(result.image, finish, k, result.pose.position, cost, self.server_cost.source)
+        shown = stage.show(result.image, finish, k, result.pose.position, cost, self.server_cost.source)
         self._aim_after(display, shown, finish)
 
     def _aim_after(self, display: Display, k: int, free_at: float) -> None:

@@ -20,11 +20,11 @@ scale and offset, which the analyser does not care about).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 
 from rig.errors import ConfigError
-from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum
 
@@ -44,6 +44,13 @@ LAYOUT_HELP = (
 )
 
 Rect = tuple[int, int, int, int]
+
+
+class CameraImage(Protocol):
+    """What the layout needs of the camera (a `rig.sim.camera.CameraConfig`): its image's size in pixels."""
+
+    width: int
+    height: int
 
 
 @dataclass(frozen=True)
@@ -133,7 +140,7 @@ def _bounding_rect(points: np.ndarray, margin: float, width: int, height: int) -
     return (x0, y0, x1 - x0, y1 - y0)
 
 
-def make_layout(pendulum: Pendulum, camera: CameraConfig, display: DisplayConfig, layout: str = DEFAULT_LAYOUT) -> BenchLayout:
+def make_layout(pendulum: Pendulum, camera: CameraImage, display: DisplayConfig, layout: str = DEFAULT_LAYOUT) -> BenchLayout:
     """Lay out the bench as `layout` places it (`placement`): the LED's full swing as wide as its
     placement's width, the display's as wide as 70 % of the panel; ConfigError where the LED's
     swing or the panel leaves the frame or they overlap."""

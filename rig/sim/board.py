@@ -41,9 +41,10 @@ from rig.board.protocol import protocol
 from rig.board.recording import BoardRecorder
 from rig.clock import Clock
 from rig.errors import ConfigError
+from rig.session.record import BOARD_FOLDER
 from rig.sim.pendulum import Pendulum
 
-BOARD_FOLDER = "board"
+__all__ = ["BOARD_FOLDER", "SimulatedBoard", "SimulatedBoardConfig", "encoder_count", "remove_recording"]
 MIN_COUNTS_PER_REV = 4
 # Simulation seconds of encoder edges worked out at a time, and the grid they are bracketed on.
 _ENCODER_BLOCK_S = 0.25

@@ -25,12 +25,12 @@ Gaussian draws would dominate the simulation's cost, and the analyser cannot tel
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rig.clock import Clock
-from rig.devices.protocols import CameraFrame
+from rig.devices.protocols import CameraFrame, Fault
 from rig.errors import ConfigError
 from rig.film_file import check_film_format
 from rig.sim.impairments import FilmImpairments, FrameImpairer
@@ -297,6 +297,13 @@ class SimCamera:
         pixels = self.scene.led_pixels(instants.ravel()).reshape(len(rows), c.subsamples, 2)
         levels = self.scene.led_levels(instants.ravel())
         return first, pixels, None if levels is None else levels.reshape(instants.shape)
+
+    def fault(self) -> Fault | None:
+        """None: the simulated camera films to the end."""
+        return None
+
+    def report(self) -> dict[str, Any]:
+        return {"camera": "sim", "fps": self.fps, "frames": self._filmed}
 
     def close(self) -> None:
         self._sensor = None

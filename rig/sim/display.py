@@ -16,6 +16,7 @@ per refresh, as with a double-buffered swap chain under vsync.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -73,6 +74,10 @@ class SimDisplay:
 
     def connect(self, clock: Clock) -> None:
         """Nothing to open: the simulated display's timing is its configuration's."""
+
+    def report(self) -> dict[str, Any]:
+        return {"display": "sim", "refresh_hz": self.refresh_hz, "scanout_fraction": self.config.scanout_fraction,
+                "refreshes": len(self.content)}  # fmt: skip
 
     def close(self) -> None:
         """Nothing to release."""

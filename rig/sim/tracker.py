@@ -23,11 +23,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from predictors import PoseSample
 from rig.clock import Clock
+from rig.devices.protocols import Fault
 from rig.errors import ConfigError, RigError
 from rig.sim.pendulum import Pendulum
 
@@ -140,6 +142,13 @@ class SimTracker:
             if arrival <= clock.now() + timeout_s:
                 clock.wait_until(arrival)
         return self.poll()
+
+    def fault(self) -> Fault | None:
+        """None: the simulated transport never stops."""
+        return None
+
+    def report(self) -> dict[str, Any]:
+        return {"tracker": "sim", "samples": len(self._samples), "delivered": self._next}
 
     def close(self) -> None:
         self._clock = None

@@ -2,14 +2,16 @@
 
 The rig clock starts `warmup_s` before the camera (at `t_begin`), so the tracker, predictor and
 display are in steady state when filming starts at t = 0; the run ends at `t_end`, the film's
-length. The device registry (`rig.devices.registry`) makes the `sim` tracker, display and camera
-from here; the camera films the display this world made.
+length. A simulated run passes the world's `twins()` to the device registry
+(`rig.devices.registry.DeviceContext`), whose `sim` spec makes them; the camera films the display
+this world made.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict
 from pathlib import Path
+from typing import Callable
 
 from rig.sim.bench import BenchLayout, make_layout
 from rig.sim.board import SimulatedBoard
@@ -34,6 +36,7 @@ class SimulatedWorld:
         self.pendulum = Pendulum(config.pendulum, t_start=self.t_begin - 1.0, t_end=self.t_end + 1.0 + swing_s)
         self.layout: BenchLayout = make_layout(self.pendulum, config.camera, config.display, config.layout)
         self._display = SimDisplay(DisplayConfig(**{**asdict(config.display), "t0": self.t_begin}))
+        self._camera: SimCamera | None = None
 
     def tracker(self) -> SimTracker:
         c = self.config
@@ -43,19 +46,25 @@ class SimulatedWorld:
         """The world's one display (the camera films it)."""
         return self._display
 
+    def twins(self) -> dict[str, Callable[[], object]]:
+        """What makes the `sim` device of each kind."""
+        return {"tracker": self.tracker, "display": self.display, "camera": self.camera}
+
     def camera(self) -> SimCamera:
-        """The world's camera, filming the bench, or the calibration target the config puts in
-        front of it (`rig.sim.flash`)."""
-        c = self.config
-        bench = (self.pendulum, self._display, self.layout, c.camera.display_black_dn, c.camera.display_white_dn, c.board)
-        scene: FilmedScene | FlashingLightScene
-        if c.flash is None:
-            scene = FilmedScene(*bench)
-        elif c.flash.source == "light":
-            scene = FlashingLightScene(c.flash, self.layout, self._display)
-        else:
-            scene = FlashingDisplayScene(c.flash, *bench)
-        return SimCamera(c.camera, scene, c.duration_s, seed=c.seed + 1, impairment_seed=c.seed)
+        """The world's one camera, filming its display's bench, or the calibration target the
+        config puts in front of it (`rig.sim.flash`)."""
+        if self._camera is None:
+            c = self.config
+            bench = (self.pendulum, self._display, self.layout, c.camera.display_black_dn, c.camera.display_white_dn, c.board)
+            scene: FilmedScene | FlashingLightScene
+            if c.flash is None:
+                scene = FilmedScene(*bench)
+            elif c.flash.source == "light":
+                scene = FlashingLightScene(c.flash, self.layout, self._display)
+            else:
+                scene = FlashingDisplayScene(c.flash, *bench)
+            self._camera = SimCamera(c.camera, scene, c.duration_s, seed=c.seed + 1, impairment_seed=c.seed)
+        return self._camera
 
     def board(self, out_dir: Path) -> SimulatedBoard | None:
         """The rig board beside the pendulum, recording into `out_dir`; None without one."""

@@ -5,7 +5,7 @@ import csv
 import numpy as np
 import pytest
 
-from analysis import AnalysisError, analyse
+from analysis import AnalysisError, AnalysisOptions, analyse
 from analysis.tracks_csv import TRACKS_CSV_HEADER
 
 COLUMN = {name: index for index, name in enumerate(TRACKS_CSV_HEADER)}
@@ -21,7 +21,7 @@ def test_tracks_csv_has_a_row_per_frame_with_the_final_times(tmp_path, scene, re
     frames = render_video(clip).copy()
     frames[10, :, 80:] = 21
     path = tmp_path / "tracks.csv"
-    result = analyse(frames, fps=clip.fps, method="fft", tracks_csv=path)
+    result = analyse(frames, AnalysisOptions(fps=clip.fps, method="fft"), tracks_csv=path)
     rows = read(path)
     assert tuple(rows[0]) == TRACKS_CSV_HEADER
     assert len(rows) == clip.frame_count + 1
@@ -40,7 +40,7 @@ def test_tracks_measured_before_a_failure_are_kept(tmp_path, scene, render_video
     clip = scene(period_s=1.0, duration_s=1.6, fps=120.0)
     path = tmp_path / "tracks.csv"
     with pytest.raises(AnalysisError, match="periods"):
-        analyse(render_video(clip), fps=clip.fps, tracks_csv=path)
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps), tracks_csv=path)
     rows = read(path)
     assert len(rows) == clip.frame_count + 1
     assert all(row[COLUMN["led_valid"]] == "1" for row in rows[1:])
@@ -55,7 +55,7 @@ def test_tracks_are_on_disk_as_the_video_is_tracked(tmp_path, scene, render_vide
         rows = read(path)
         seen.append((done, len(rows) - 1, tuple(rows[0]), {row[COLUMN["t"]] for row in rows[1:]}))
 
-    analyse(render_video(clip), fps=clip.fps, method="fft", tracks_csv=path, progress=progress)
+    analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft"), tracks_csv=path, progress=progress)
     # Rows are flushed in blocks: by the time 128 frames are tracked, at least the first 64 are on disk.
     assert read(path)[0] and seen[1][0] == 128 and seen[1][1] >= 64
     # The rows written while tracking have the final table's columns; the frame times are not decided yet.
@@ -71,7 +71,7 @@ def test_an_interrupted_analysis_keeps_every_frame_it_tracked(tmp_path, scene, r
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        analyse(render_video(clip), fps=clip.fps, method="fft", tracks_csv=path, progress=progress)
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft"), tracks_csv=path, progress=progress)
     rows = read(path)
     assert tuple(rows[0]) == TRACKS_CSV_HEADER
     assert [int(row[COLUMN["frame"]]) for row in rows[1:]] == list(range(128))

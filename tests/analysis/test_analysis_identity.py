@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from analysis import AnalysisError, analyse, track
+from analysis import AnalysisError, AnalysisOptions, analyse, track
 from analysis.identity import SATURATION_WEIGHT, decide, step_score
 from analysis.tracking import Roi
 from rig.cli import EXIT_USER_ERROR, main
@@ -26,7 +26,7 @@ def centre(roi: Roi) -> float:
 def decided(clip, render_video, led_side=None):
     """Both blobs' tracks in ``clip`` (the LED's side given where the evidence cannot tell), and the
     decision on them in either order: the LED first, then the sphere first."""
-    tracks = track(render_video(clip), fps=clip.fps, led_side=led_side)
+    tracks = track(render_video(clip), AnalysisOptions(fps=clip.fps, led_side=led_side))
     signals = (tracks.led.x - np.nanmean(tracks.led.x), tracks.sphere.x - np.nanmean(tracks.sphere.x))
     as_given = decide(tracks.led, tracks.sphere, signals, 1 / clip.fps, clip.period_s)
     swapped = decide(tracks.sphere, tracks.led, signals[::-1], 1 / clip.fps, clip.period_s)
@@ -36,7 +36,7 @@ def decided(clip, render_video, led_side=None):
 def test_a_dim_led_beside_a_bright_sphere_is_still_the_led(scene, render_video):
     # The sphere is the brighter blob; the display's steps (240 fps on 60 Hz) say it is the sphere.
     clip = scene(latency_s=0.04, led_gain=120.0, sphere_gain=700.0, duration_s=4.1)
-    result = analyse(render_video(clip), fps=clip.fps, method="fft")
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft"))
     assert result.latency_ms == pytest.approx(40.0, abs=0.3)
     assert centre(result.led_roi) < clip.width / 2 < centre(result.sphere_roi)
     assert "refresh steps +" in result.led_rule
@@ -44,7 +44,7 @@ def test_a_dim_led_beside_a_bright_sphere_is_still_the_led(scene, render_video):
 
 def test_an_led_on_the_right_is_found_against_the_side_convention(scene, render_video):
     clip = scene(latency_s=0.04, led_centre=(115.0, 55.0), sphere_centre=(40.0, 60.0), duration_s=4.1)
-    tracks = track(render_video(clip), fps=clip.fps)
+    tracks = track(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert centre(tracks.led_roi) > clip.width / 2
     assert "side +1.0" in tracks.led_rule and "total -" in tracks.led_rule
 
@@ -53,8 +53,8 @@ def test_without_evidence_the_analysis_asks_for_the_regions(scene, render_video)
     # Nothing decides, so no number at all rather than a sign-flipped one.
     clip = scene(**UNDECIDABLE)
     with pytest.raises(AnalysisError, match="cannot tell the LED from the sphere.*--led-roi"):
-        analyse(render_video(clip), fps=clip.fps, method="fft")
-    result = analyse(render_video(clip), fps=clip.fps, method="fft", led_side="right")
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft"))
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft", led_side="right"))
     assert result.latency_ms == pytest.approx(40.0, abs=0.5)
 
 
@@ -87,7 +87,7 @@ def test_the_users_regions_decide_where_the_evidence_cannot(scene, render_video)
     # The same undecidable scene: the regions the user gives are taken as given, with no vote.
     clip = scene(**UNDECIDABLE)
     result = analyse(
-        render_video(clip), fps=clip.fps, method="fft", led_roi=UNDECIDABLE_LED_ROI, sphere_roi=UNDECIDABLE_SPHERE_ROI
+        render_video(clip), AnalysisOptions(fps=clip.fps, method="fft", led_roi=UNDECIDABLE_LED_ROI, sphere_roi=UNDECIDABLE_SPHERE_ROI)
     )
     assert result.roi_source == "given"
     assert result.latency_ms == pytest.approx(40.0, abs=0.5)
@@ -98,12 +98,11 @@ def test_the_users_regions_overrule_the_evidence(scene, render_video):
     # The evidence (steps, saturation, size, side) all say the left blob is the LED; regions given
     # the other way round are still what is measured: the latency comes out negative, not corrected.
     clip = scene(latency_s=0.03, duration_s=3.0, fps=120.0)
-    tracks = track(render_video(clip), fps=clip.fps)
+    tracks = track(render_video(clip), AnalysisOptions(fps=clip.fps))
     led, sphere = tracks.led_roi, tracks.sphere_roi
-    swapped = track(
-        render_video(clip), fps=clip.fps,
-        led_roi=[sphere.x, sphere.y, sphere.width, sphere.height], sphere_roi=[led.x, led.y, led.width, led.height],
-    )  # fmt: skip
+    swapped = track(render_video(clip), AnalysisOptions(
+        fps=clip.fps, led_roi=[sphere.x, sphere.y, sphere.width, sphere.height], sphere_roi=[led.x, led.y, led.width, led.height],
+    ))  # fmt: skip
     assert swapped.roi_source == "given"
     assert centre(swapped.led_roi) > clip.width / 2 > centre(swapped.sphere_roi)
 

@@ -7,7 +7,7 @@ import threading
 import numpy as np
 import pytest
 
-from analysis import AnalysisError, analyse
+from analysis import AnalysisError, AnalysisOptions, analyse
 from analysis.plots import plot_tracks
 from analysis.tracking import Track
 from analysis.tracks import check_track
@@ -67,7 +67,7 @@ def test_latency_is_recovered_on_the_grid(scene, render_video, latency_ms, perio
     clip = scene(
         latency_s=latency_ms / 1e3, period_s=period_s, fps=fps, display_hz=display_hz, decay=decay, duration_s=seconds
     )
-    result = analyse(render_video(clip), fps=fps, refresh_hz=display_hz, exposure_ms=clip.exposure * 1e3 / fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=fps, display_hz=display_hz, exposure_ms=clip.exposure * 1e3 / fps))
     frame_ms = 1e3 / fps
     assert result.latency_ms == pytest.approx(latency_ms, abs=FRAMES_TOLERANCE * frame_ms)
     assert result.ci95_ms[0] < result.latency_ms < result.ci95_ms[1]
@@ -80,7 +80,7 @@ def test_latency_is_recovered_on_the_grid(scene, render_video, latency_ms, perio
 
 def test_every_method_agrees_on_one_clip(tmp_path, scene, render_video):
     clip = scene(latency_s=0.083, period_s=0.9, fps=120.0, duration_s=4.3)
-    result = analyse(render_video(clip), fps=clip.fps, method="all")
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="all"))
     assert plot_tracks(result, tmp_path / "all.png").stat().st_size > 10_000
     assert list(result.methods) == ["fft", "xcorr", "sinefit", "bayes"]
     assert result.method == "sinefit"
@@ -96,20 +96,20 @@ def test_every_method_agrees_on_one_clip(tmp_path, scene, render_video):
 
 def test_non_integer_number_of_swings(scene, render_video):
     clip = scene(latency_s=0.061, period_s=1.1, duration_s=4.37 * 1.1, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(61.0, abs=0.3)
 
 
 def test_strongly_damped_swing(scene, render_video):
     clip = scene(latency_s=0.045, decay=0.75, period_s=0.8, duration_s=4.4, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(45.0, abs=0.3)
     assert result.model.startswith("damped")
 
 
 def test_wide_swing_with_harmonics(scene, render_video):
     clip = scene(latency_s=0.07, swing_rad=0.75, arm_px=45.0, chirp=True, decay=0.3, duration_s=4.3, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(70.0, abs=0.3)
     assert "harmonics" in result.model
 
@@ -119,19 +119,19 @@ def test_wide_swing_with_harmonics(scene, render_video):
 )
 def test_blurred_blobs(scene, render_video, blur):
     clip = scene(latency_s=0.05, duration_s=4.2, fps=60.0, **blur)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(50.0, abs=0.5)
 
 
 def test_saturated_led_with_bloom(scene, render_video):
     clip = scene(latency_s=0.05, led_gain=3000.0, bloom_gain=400.0, duration_s=4.2, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(50.0, abs=0.3)
 
 
 def test_dim_sphere_next_to_a_bright_led(scene, render_video):
     clip = scene(latency_s=0.05, sphere_gain=22.0, led_gain=3000.0, duration_s=4.2, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(50.0, abs=0.5)
     assert result.led_rule.startswith(EVIDENCE_RULE)
 
@@ -139,7 +139,7 @@ def test_dim_sphere_next_to_a_bright_led(scene, render_video):
 def test_static_bright_clutter_in_both_regions(scene, render_video):
     clutter = ((40.0, 45.0, 600.0), (30.0, 58.0, 200.0), (118.0, 55.0, 300.0), (100.0, 62.0, 150.0))
     clip = scene(latency_s=0.05, clutter=clutter, duration_s=4.2, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(50.0, abs=0.3)
     assert result.frames_used == clip.frame_count
 
@@ -149,7 +149,7 @@ def test_missing_detections_are_left_out_and_reported(scene, render_video):
     frames = render_video(clip).copy()
     hidden = np.random.default_rng(7).choice(clip.frame_count, size=clip.frame_count * 5 // 100, replace=False)
     frames[hidden, :, 80:] = 21
-    result = analyse(frames, fps=clip.fps, refresh_hz=clip.display_hz, exposure_ms=1e3 / clip.fps)
+    result = analyse(frames, AnalysisOptions(fps=clip.fps, display_hz=clip.display_hz, exposure_ms=1e3 / clip.fps))
     assert result.latency_ms == pytest.approx(50.0, abs=0.3)
     assert result.frames_used == clip.frame_count - hidden.size
     assert not result.sphere_track.valid[hidden].any()
@@ -166,7 +166,7 @@ def test_beyond_half_a_period_resolved_by_the_chirp(scene, render_video):
         latency_s=0.45, period_s=0.6, swing_rad=0.7, arm_px=45.0, chirp=True, decay=0.85, duration_s=5.5, fps=60.0
     )
     for method in ("fft", "xcorr", "sinefit"):
-        result = analyse(render_video(clip), fps=clip.fps, method=method)
+        result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method=method))
         assert not result.ambiguous
         assert result.cycles.how == "chirp"
         assert result.latency_ms == pytest.approx(450.0, abs=1.5), method
@@ -174,7 +174,7 @@ def test_beyond_half_a_period_resolved_by_the_chirp(scene, render_video):
 
 def test_beyond_half_a_period_unresolvable_is_ambiguous(scene, render_video):
     clip = scene(latency_s=0.45, period_s=0.6, decay=0.05, duration_s=5.5, fps=60.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.ambiguous
     assert result.cycles.candidates_s == pytest.approx([-0.15, 0.45], abs=2e-3)
     assert result.latency_ms == pytest.approx(-150.0, abs=1.0)
@@ -183,7 +183,7 @@ def test_beyond_half_a_period_unresolvable_is_ambiguous(scene, render_video):
 
 def test_negative_latency_of_an_over_predicting_system(scene, render_video):
     clip = scene(latency_s=-0.025, duration_s=4.2, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(-25.0, abs=0.3)
     assert result.ci95_ms[0] < -25.0 < result.ci95_ms[1]
 
@@ -191,7 +191,7 @@ def test_negative_latency_of_an_over_predicting_system(scene, render_video):
 def test_latency_near_half_the_period(scene, render_video):
     # 490 ms of a 1 s period: the wrapped phase is next to its jump; the range keeps it a lag.
     clip = scene(latency_s=0.49, period_s=1.0, duration_s=4.3, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps)
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
     assert result.latency_ms == pytest.approx(490.0, abs=0.3)
     assert not result.ambiguous and result.cycles.how == "range"
 
@@ -211,7 +211,7 @@ def test_frames_as_float_or_colour_arrays(scene, render_video, form):
     clip = scene(latency_s=0.07, duration_s=4.1, fps=120.0)
     grey = render_video(clip)
     frames = grey / 255.0 if form == "float" else np.repeat(grey[..., None], 3, axis=3)
-    assert analyse(frames, fps=clip.fps, method="fft").latency_ms == pytest.approx(70.0, abs=0.5)
+    assert analyse(frames, AnalysisOptions(fps=clip.fps, method="fft")).latency_ms == pytest.approx(70.0, abs=0.5)
 
 
 def test_failed_analysis_of_a_file_leaves_no_decoder_threads(tmp_path, scene, render_video, mjpg_file):
@@ -230,7 +230,7 @@ def test_failed_analysis_of_a_file_leaves_no_decoder_threads(tmp_path, scene, re
 
 def test_led_on_the_right_is_told_by_the_evidence(scene, render_video, scene_truth):
     clip = scene(latency_s=0.04, led_centre=(115.0, 55.0), sphere_centre=(40.0, 60.0), duration_s=4.2, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps, method="fft")
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft"))
     assert result.latency_ms == pytest.approx(40.0, abs=0.5)
     led_x, _, sphere_x, _ = scene_truth(clip)
     assert result.led_roi.x < led_x.min() and led_x.max() < result.led_roi.x + result.led_roi.width
@@ -239,7 +239,7 @@ def test_led_on_the_right_is_told_by_the_evidence(scene, render_video, scene_tru
 
 def test_equally_bright_blobs_are_told_apart_by_the_refresh_steps(scene, render_video):
     clip = scene(latency_s=0.03, sphere_gain=700.0, panel=12.0, duration_s=4.1, fps=120.0)
-    result = analyse(render_video(clip), fps=clip.fps, method="fft")
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft"))
     assert result.latency_ms == pytest.approx(30.0, abs=0.5)
     assert result.led_rule.startswith(EVIDENCE_RULE) and "refresh steps +" in result.led_rule
 
@@ -247,7 +247,7 @@ def test_equally_bright_blobs_are_told_apart_by_the_refresh_steps(scene, render_
 def test_the_user_says_which_side_the_led_is_on(scene, render_video):
     clip = scene(latency_s=0.03, led_centre=(115.0, 55.0), sphere_centre=(40.0, 60.0), sphere_gain=700.0,
                  led_gain=150.0, duration_s=4.1, fps=120.0)  # fmt: skip
-    result = analyse(render_video(clip), fps=clip.fps, method="fft", led_side="right")
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft", led_side="right"))
     assert result.led_rule == "given: right blob is the LED"
     assert result.latency_ms == pytest.approx(30.0, abs=0.5)
 
@@ -255,7 +255,7 @@ def test_the_user_says_which_side_the_led_is_on(scene, render_video):
 def test_given_rois_are_used(scene, render_video):
     clip = scene(latency_s=0.06, duration_s=4.2, fps=120.0)
     led_roi, sphere_roi = [2, 30, 76, 40], [80, 30, 78, 45]
-    result = analyse(render_video(clip), fps=clip.fps, led_roi=led_roi, sphere_roi=sphere_roi, method="fft")
+    result = analyse(render_video(clip), AnalysisOptions(fps=clip.fps, led_roi=led_roi, sphere_roi=sphere_roi, method="fft"))
     assert result.latency_ms == pytest.approx(60.0, abs=0.5)
     assert (result.led_roi.as_list(), result.sphere_roi.as_list()) == (led_roi, sphere_roi)
     assert (result.roi_source, result.led_rule) == ("given", "given")
@@ -264,7 +264,7 @@ def test_given_rois_are_used(scene, render_video):
 def test_progress_is_reported_up_to_the_last_frame(scene, render_video):
     clip = scene(duration_s=4.1, fps=120.0)
     calls = []
-    analyse(render_video(clip), fps=clip.fps, method="fft", progress=lambda done, total: calls.append((done, total)))
+    analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft"), progress=lambda done, total: calls.append((done, total)))
     assert calls[-1] == (clip.frame_count, clip.frame_count)
     assert all(total == clip.frame_count for _, total in calls)
     assert [done for done, _ in calls] == sorted(done for done, _ in calls)
@@ -273,13 +273,13 @@ def test_progress_is_reported_up_to_the_last_frame(scene, render_video):
 def test_a_short_clip_reports_no_progress(scene, render_video):
     clip = scene(duration_s=2.5, fps=120.0)
     calls = []
-    analyse(render_video(clip), fps=clip.fps, method="fft", progress=lambda done, total: calls.append(done))
+    analyse(render_video(clip), AnalysisOptions(fps=clip.fps, method="fft"), progress=lambda done, total: calls.append(done))
     assert calls == []
 
 
 def test_summary_is_json_ready_and_carries_the_contract(scene, render_video):
     clip = scene(latency_s=0.02, duration_s=4.1, fps=120.0)
-    summary = analyse(render_video(clip), fps=clip.fps).to_dict()
+    summary = analyse(render_video(clip), AnalysisOptions(fps=clip.fps)).to_dict()
     assert json.loads(json.dumps(summary)) == summary
     assert summary["latency_ms"] == pytest.approx(20.0, abs=0.3)
     assert set(summary) >= {
@@ -297,13 +297,13 @@ def test_summary_is_json_ready_and_carries_the_contract(scene, render_video):
 def test_roi_outside_the_frame_raises(scene, render_video):
     clip = scene(duration_s=2.5, fps=120.0)
     with pytest.raises(AnalysisError, match="outside the frame"):
-        analyse(render_video(clip), fps=clip.fps, led_roi=[150, 30, 40, 40], sphere_roi=[80, 30, 78, 45])
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps, led_roi=[150, 30, 40, 40], sphere_roi=[80, 30, 78, 45]))
 
 
 def test_only_one_roi_raises(scene, render_video):
     clip = scene(duration_s=2.5, fps=120.0)
     with pytest.raises(AnalysisError, match="give both"):
-        analyse(render_video(clip), fps=clip.fps, led_roi=[2, 30, 76, 40])
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps, led_roi=[2, 30, 76, 40]))
 
 
 @pytest.mark.parametrize(
@@ -312,41 +312,41 @@ def test_only_one_roi_raises(scene, render_video):
 def test_led_that_never_moves_raises(scene, render_video, rois):
     clip = scene(led_moves=False, duration_s=3.0, fps=120.0)
     with pytest.raises(AnalysisError, match="moving"):
-        analyse(render_video(clip), fps=clip.fps, **rois)
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps, **rois))
 
 
 def test_only_one_blob_raises(scene, render_video):
     clip = scene(sphere_gain=0.0, duration_s=3.0, fps=120.0)
     with pytest.raises(AnalysisError, match="found 1 moving"):
-        analyse(render_video(clip), fps=clip.fps)
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
 
 
 def test_sphere_that_leaves_its_region_raises(scene, render_video):
     clip = scene(duration_s=3.0, fps=120.0)
     with pytest.raises(AnalysisError, match="sphere leaves its ROI"):
-        analyse(render_video(clip), fps=clip.fps, led_roi=[2, 30, 76, 40], sphere_roi=[100, 30, 30, 45])
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps, led_roi=[2, 30, 76, 40], sphere_roi=[100, 30, 30, 45]))
 
 
 def test_fewer_than_two_swings_raise(scene, render_video):
     clip = scene(period_s=1.0, duration_s=1.6, fps=120.0)
     with pytest.raises(AnalysisError, match="periods"):
-        analyse(render_video(clip), fps=clip.fps)
+        analyse(render_video(clip), AnalysisOptions(fps=clip.fps))
 
 
 def test_unknown_method_and_bad_range_raise(scene, render_video):
     frames = render_video(scene(duration_s=2.5, fps=120.0))
-    with pytest.raises(AnalysisError, match="unknown method"):
-        analyse(frames, fps=120.0, method="guess")
-    with pytest.raises(AnalysisError, match="latency range"):
-        analyse(frames, fps=120.0, latency_range_ms=(100.0, -100.0))
-    with pytest.raises(AnalysisError, match="led_side"):
-        analyse(frames, fps=120.0, led_side="top")
+    with pytest.raises(AnalysisError, match="method must be one of fft, xcorr, sinefit, bayes, all, got 'guess'"):
+        analyse(frames, AnalysisOptions(fps=120.0, method="guess"))
+    with pytest.raises(AnalysisError, match="latency_range_ms: LOW must be below HIGH"):
+        analyse(frames, AnalysisOptions(fps=120.0, latency_range_ms=(100.0, -100.0)))
+    with pytest.raises(AnalysisError, match="led_side must be one of left, right"):
+        analyse(frames, AnalysisOptions(fps=120.0, led_side="top"))
 
 
 def test_wrong_frame_rate_gives_an_implausible_period_warning(scene, render_video):
     # A slow-motion file played back at an eighth of its capture rate.
     clip = scene(latency_s=0.05, period_s=0.8, duration_s=4.1, fps=120.0)
-    result = analyse(render_video(clip), fps=15.0, method="fft")
+    result = analyse(render_video(clip), AnalysisOptions(fps=15.0, method="fft"))
     assert result.period_s == pytest.approx(6.4, rel=1e-2)
     assert any("slow motion" in w for w in result.warnings)
     assert math.isfinite(result.latency_ms)
@@ -375,10 +375,10 @@ def test_a_sinefit_analysis_is_the_same_whatever_the_callers_jax_precision(scene
 
     frames = render_video(scene(latency_s=0.02, duration_s=4.1, fps=120.0))
     with jax.enable_x64(False):
-        in_32_bit = analyse(frames, fps=120.0)
+        in_32_bit = analyse(frames, AnalysisOptions(fps=120.0))
         assert not jax.config.jax_enable_x64
     with jax.enable_x64(True):
-        in_64_bit = analyse(frames, fps=120.0)
+        in_64_bit = analyse(frames, AnalysisOptions(fps=120.0))
     assert in_32_bit.methods["sinefit"].fit.problem.data.tau.dtype == np.float64
     assert in_32_bit.latency_ms == in_64_bit.latency_ms
     assert in_32_bit.ci95_ms == in_64_bit.ci95_ms

@@ -5,20 +5,20 @@ import dataclasses
 
 import numpy as np
 
-from analysis import estimate, track
+from analysis import AnalysisOptions, estimate, track
 from analysis.misfit import check_fit
 from analysis.sampling.residuals import TimingResiduals
 from analysis.swing import measure_swing
 from analysis.tracking import Track
 
 # The scene's camera: 240 fps exposing whole frames, filming a 60 Hz display.
-KNOWN = {"refresh_hz": 60.0, "exposure_ms": 1e3 / 240.0}
+KNOWN = {"display_hz": 60.0, "exposure_ms": 1e3 / 240.0}
 
 
 def checked(clip, render_video, sphere_x=None, lag_s=None):
     """The estimate of ``clip`` with its sphere track changed: its x mapped by ``sphere_x(x, t)``,
     or delayed by a further ``lag_s(t)``; and the names of the checks that failed."""
-    tracks = track(render_video(clip), fps=clip.fps)
+    tracks = track(render_video(clip), AnalysisOptions(fps=clip.fps))
     sphere = tracks.sphere
     t = sphere.t
     if sphere_x is not None:
@@ -26,13 +26,13 @@ def checked(clip, render_video, sphere_x=None, lag_s=None):
     if lag_s is not None:
         lag = lag_s(t)
         sphere = dataclasses.replace(sphere, x=np.interp(t - lag, t, sphere.x), y=np.interp(t - lag, t, sphere.y))
-    result = estimate(dataclasses.replace(tracks, sphere=sphere), **KNOWN)
+    result = estimate(dataclasses.replace(tracks, sphere=sphere), AnalysisOptions(**KNOWN))
     return result, {check.name for check in result.checks.failed}
 
 
 def test_a_clean_swing_passes_every_check(scene, render_video):
     clip = scene(latency_s=0.05, duration_s=6.2)
-    result = estimate(track(render_video(clip), fps=clip.fps), **KNOWN)
+    result = estimate(track(render_video(clip), AnalysisOptions(fps=clip.fps)), AnalysisOptions(**KNOWN))
     assert [check.passed for check in result.checks.checks] == [True] * 4
     assert result.warnings == []
     assert result.ci95_ms[0] < 50.0 < result.ci95_ms[1]
@@ -41,12 +41,12 @@ def test_a_clean_swing_passes_every_check(scene, render_video):
 def test_a_latency_that_grows_over_the_clip_fails_the_checks_and_widens_the_interval(scene, render_video):
     # The sphere lags 3 ms more at the end of the clip than at its start.
     clip = scene(latency_s=0.05, duration_s=6.2)
-    tracks = track(render_video(clip), fps=clip.fps)
+    tracks = track(render_video(clip), AnalysisOptions(fps=clip.fps))
     sphere = tracks.sphere
     t = sphere.t
     lag = 0.003 * (t - t[0]) / (t[-1] - t[0])
     shifted = dataclasses.replace(sphere, x=np.interp(t - lag, t, sphere.x), y=np.interp(t - lag, t, sphere.y))
-    result = estimate(dataclasses.replace(tracks, sphere=shifted), **KNOWN)
+    result = estimate(dataclasses.replace(tracks, sphere=shifted), AnalysisOptions(**KNOWN))
     failed = {check.name for check in result.checks.failed}
     assert "drift" in failed
     assert any(warning.startswith("the model does not fit the swing") for warning in result.warnings)

@@ -75,7 +75,7 @@ def test_departure_moves_with_time_and_ignores_scale_and_position(scale, dx, dy,
 def test_a_video_of_the_release_or_the_stop_fixes_latencies_a_period_apart(scene, render_video, latency_s, release_s, stop_s, how):
     """Period 0.6 s, latencies from -200 to 1000 ms allowed: two candidates, too little chirp to tell."""
     video = scene(latency_s=latency_s, period_s=0.6, duration_s=7.0, release_s=release_s, stop_s=stop_s)
-    result = analysis.analyse(render_video(video), fps=video.fps, latency_range_ms=(-200, 1000))
+    result = analysis.analyse(render_video(video), analysis.AnalysisOptions(fps=video.fps, latency_range_ms=(-200, 1000)))
     assert result.cycles.how == how and not result.ambiguous
     assert result.latency_ms == pytest.approx(latency_s * 1e3, abs=0.3)
     for lag in result.cycles.events_s.values():
@@ -89,5 +89,5 @@ def test_a_video_of_the_release_or_the_stop_fixes_latencies_a_period_apart(scene
 
 def test_without_the_release_the_same_video_is_ambiguous(scene, render_video):
     video = scene(latency_s=0.8, period_s=0.6, duration_s=7.0, release_s=None)
-    result = analysis.analyse(render_video(video), fps=video.fps, latency_range_ms=(-200, 1000))
+    result = analysis.analyse(render_video(video), analysis.AnalysisOptions(fps=video.fps, latency_range_ms=(-200, 1000)))
     assert result.ambiguous and result.cycles.events_s == {}

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from analysis import AnalysisError, analyse
+from analysis import AnalysisError, AnalysisOptions, analyse
 from analysis.timing import check_count, frame_times, implausible_period_warning, recorder_repeats
 
 
@@ -105,7 +105,7 @@ def test_duplicated_frames_in_a_video_are_left_out(scene, render_video):
     # The recorder lost three frames and repeated the one before in their place.
     copies = [200, 350, 420]
     frames[[c + 1 for c in copies]] = frames[copies]
-    result = analyse(frames, fps=clip.fps, method="fft")
+    result = analyse(frames, AnalysisOptions(fps=clip.fps, method="fft"))
     assert result.diagnostics["repeated_frames"] == 3
     assert not result.led_track.valid[[201, 351, 421]].any()
     assert result.latency_ms == pytest.approx(40.0, abs=0.3)

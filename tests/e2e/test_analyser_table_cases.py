@@ -47,14 +47,14 @@ def test_a_60_fps_camera_on_a_60_hz_display(tmp_path: Path) -> None:
     # biased; the video cannot show the refresh, and the interval allows for an exposure a little
     # short of the whole frame.
     frames, truth = _run(tmp_path, 60.0, 60.0)
-    result = analysis.analyse(frames, fps=60.0)
+    result = analysis.analyse(frames, analysis.AnalysisOptions(fps=60.0))
     _holds_truth(result, truth)
     assert result.latency_ms == pytest.approx(truth, abs=0.3)
 
 
 def test_a_144_fps_camera_on_a_144_hz_display(tmp_path: Path) -> None:
     frames, truth = _run(tmp_path, 144.0, 144.0)
-    result = analysis.analyse(frames, fps=144.0)
+    result = analysis.analyse(frames, analysis.AnalysisOptions(fps=144.0))
     _holds_truth(result, truth)
     assert result.latency_ms == pytest.approx(truth, abs=0.3)
 
@@ -66,7 +66,7 @@ def test_a_240_fps_run_with_every_fourth_frame_kept_at_each_of_four_phases(tmp_p
     # and say why it is wide.
     frames, truth = _run(tmp_path, 240.0, 60.0)
     for phase in range(4):
-        result = analysis.analyse(frames[phase::4], fps=60.0)
+        result = analysis.analyse(frames[phase::4], analysis.AnalysisOptions(fps=60.0))
         _holds_truth(result, truth)
         assert any("does not show the display's refresh" in w or "phase-locked" in w for w in result.warnings), phase
         assert result.ci95_ms[1] - result.ci95_ms[0] > 8.0
@@ -78,7 +78,7 @@ def test_the_led_half_of_the_image_dimmed_to_35_percent(tmp_path: Path) -> None:
     half = frames.shape[2] // 2
     dimmed = frames.copy()
     dimmed[:, :, :half] = np.rint(dimmed[:, :, :half] * 0.35).astype(np.uint8)
-    result = analysis.analyse(dimmed, fps=240.0)
+    result = analysis.analyse(dimmed, analysis.AnalysisOptions(fps=240.0))
     _holds_truth(result, truth)
     assert result.latency_ms > 0
     assert "refresh steps +" in result.led_rule
@@ -95,7 +95,7 @@ OFF_STEP_PHASE = 0.37
 @pytest.mark.parametrize("display_hz", [60.0, 120.0])
 def test_a_240_fps_camera_exposing_half_of_each_frame_the_settings_unknown(tmp_path: Path, display_hz: float) -> None:
     frames, truth = _run(tmp_path, 240.0, display_hz, exposure=HALF_FRAME, phase=OFF_STEP_PHASE)
-    result = analysis.analyse(frames, fps=240.0)
+    result = analysis.analyse(frames, analysis.AnalysisOptions(fps=240.0))
     _holds_truth(result, truth)
     assert any(warning.startswith("the camera (240 fps") for warning in result.warnings)
 
@@ -116,6 +116,6 @@ def test_a_240_fps_camera_exposing_half_of_each_frame_the_settings_unknown(tmp_p
 )
 def test_a_240_fps_camera_exposing_half_of_each_frame_the_settings_given(tmp_path: Path, display_hz: float) -> None:
     frames, truth = _run(tmp_path, 240.0, display_hz, exposure=HALF_FRAME, phase=OFF_STEP_PHASE)
-    result = analysis.analyse(frames, fps=240.0, refresh_hz=display_hz, exposure_ms=HALF_FRAME / 240.0 * 1e3)
+    result = analysis.analyse(frames, analysis.AnalysisOptions(fps=240.0, display_hz=display_hz, exposure_ms=HALF_FRAME / 240.0 * 1e3))
     _holds_truth(result, truth)
     assert any(warning.startswith("the camera (240 fps") for warning in result.warnings)

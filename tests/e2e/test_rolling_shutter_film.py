@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import analysis
+from analysis.options import AnalysisOptions
 from analysis.tracks import track
 from rig.film_file import FRAME_TIMES_FILE
 from rig.service import SimulationConfig, simulate
@@ -32,7 +33,7 @@ def test_a_rolling_shutter_phone_film_reads_back_and_shifts_the_latency_by_its_r
 
     with open(tmp_path / FRAME_TIMES_FILE, newline="") as file:
         written = np.array([float(row["t_presented"]) for row in csv.DictReader(file)])
-    tracks = track(run.video_path, led_side="left")
+    tracks = track(run.video_path, AnalysisOptions(led_side="left"))
     assert len(tracks.stamps) == len(written) == run.truth.frames
     np.testing.assert_array_equal(tracks.stamps - tracks.stamps[0], written)
     # stamps this close to a constant rate are taken as one (analysis.timing): the times stay within the jitter

@@ -19,6 +19,16 @@ from analysis.board.blink_code import BlinkSchedule
 from analysis.board.recording import load_table
 from rig.board import BoardIdentity, BoardRecorder, LedChange, LinkChange, Microcontroller
 from rig.board.framing import FrameDecoder, encode_frame
+import predictors
+from rig.board.instrument import BoardInstrument, BoardSettings
+from rig.clock import MonotonicClock
+from rig.devices.protocols import Instrument
+from rig.lsl import ExternalRenderer
+from rig.render.protocol import RenderSetup
+from rig.session import MeasuredCost, OneImagePerAppFrame, RunRecord, Session, SessionParts
+from rig.sim.display import DisplayConfig, SimDisplay
+from rig.sim.pendulum import Pendulum, PendulumConfig
+from rig.sim.tracker import SimTracker, TrackerConfig
 from rig.board.protocol import protocol
 from rig.commands.board import add_parser
 from rig.errors import RigError
@@ -176,6 +186,30 @@ def test_record_command_writes_a_recording_after_the_blink_code(board, tmp_path:
     assert np.all(code[played] == (led["level"][np.isfinite(led["bit"])] > 0))
     # After the code the LED is left lit, by a command.
     assert np.isnan(led["bit"][-1]) and led["level"][-1] == 200
+
+
+def test_the_board_records_beside_a_live_session_on_its_clock(board, tmp_path: Path) -> None:
+    """The board as one of a session's instruments, as `rig measure --board` runs it: connected with
+    the other devices, polled at every refresh, finished at the end, on the session's clock."""
+    out = tmp_path
+    pendulum = Pendulum(PendulumConfig(), t_end=60.0)
+    instrument = BoardInstrument(board.url, out / "board", BoardSettings(rise=RISE, fall=FALL))
+    assert isinstance(instrument, Instrument)
+    clock = MonotonicClock()
+    parts = SessionParts(
+        clock, SimTracker(pendulum, TrackerConfig(), 0.0, 60.0, seed=1), predictors.make("hold"), ExternalRenderer(),
+        RenderSetup(64, 48, np.eye(4), 0.1), OneImagePerAppFrame(), MeasuredCost(), SimDisplay(DisplayConfig()),
+        instruments=[instrument],
+    )  # fmt: skip
+    with RunRecord(out) as record:
+        session = Session(parts, 0.0, 1.5, record, live=True)
+        session.run()
+    encoder = load_table(out / "board", "encoder.csv")
+    assert encoder["count"].size > 0
+    # Rig times are the session's clock's, within the run, not the system's monotonic clock.
+    assert np.all((encoder["rig_time_s"] > 0.0) & (encoder["rig_time_s"] <= session.t_end + 5.0))
+    metadata = json.loads((out / "board" / "recording.json").read_text())
+    assert metadata["options"]["rise"] == RISE and metadata["events"]["encoder.csv"] == encoder["count"].size
 
 
 def test_record_refuses_a_duration_shorter_than_its_blink(tmp_path: Path) -> None:

@@ -61,7 +61,7 @@ def test_bad_min_interval_is_an_error(bad):
         ("kalman-cv", {"position_noise": 0.0}, "position_noise must be a positive number of metres"),
         ("kalman-ca", {"jerk_noise": -1.0}, "jerk_noise must be a positive number of m/s"),
         ("kalman-cv", {"max_gap": math.nan}, "max_gap must be a positive number of seconds"),
-        ("desp", {"position_alpha": 1.0}, "position_alpha must be a number between 0 and 1"),
+        ("desp", {"position_alpha": 1.0}, "position_alpha must be a positive number below 1"),
         ("desp", {"sample_interval": 0.0}, "sample_interval must be a positive number of seconds"),
         ("auto", {"margin": "wide"}, "margin must be a positive number"),
     ],

@@ -13,15 +13,14 @@ turned off when one is given). A file's rate and size are its own; it plays at i
 stamped at the start plus i intervals.
 
 A capture thread reads frames as they come, stamps each on the rig clock the moment it is grabbed
-(keeping the backend's timestamp beside it), writes it through a `FrameWriter` (video, frame table,
-dropped frames filled) and queues it for `poll()`. A camera that stops delivering (unplugged, the
-stream closed) ends the capture: `poll()` then raises RigError saying so; everything captured is on
-disk.
+(keeping the backend's timestamp beside it) and queues it for `poll()`, which hands over every frame
+captured since the last call (the run's film writes them, `rig.session.record.FilmRecord`). A
+camera that stops delivering (unplugged, the stream closed) ends the capture and says so in
+`fault()`; a file that has played to its end is `finished`.
 """
 
 from __future__ import annotations
 
-import json
 import threading
 from collections import deque
 from dataclasses import asdict, dataclass, field
@@ -32,13 +31,9 @@ from urllib.parse import parse_qsl
 import cv2
 
 from rig.clock import Clock
-from rig.devices.camera.frames import FrameWriter
-from rig.devices.protocols import CameraFrame
+from rig.devices.protocols import CameraFrame, Fault
 from rig.errors import ConfigError, RigError
 
-SETTINGS_FILE = "camera.json"
-QUEUE_FRAMES = 64
-"""Frames `poll` can return at most (older ones are on disk only)."""
 FPS_TOLERANCE = 0.01
 V4L2_MANUAL_EXPOSURE = 1
 OPEN_TIMEOUT_MS = 10000
@@ -147,32 +142,23 @@ def apply_settings(capture: Any, settings: CameraSettings, kind: str) -> Setting
 class OpenCvCamera:
     """A camera read through OpenCV on its own thread; see the module docstring."""
 
-    def __init__(
-        self, source: CameraSource, settings: CameraSettings, out_dir: Path, *, accept_refused: bool = False,
-        overwrite: bool = False,
-    ) -> None:  # fmt: skip
+    def __init__(self, source: CameraSource, settings: CameraSettings, *, accept_refused: bool = False) -> None:
         self.source = source
         self.settings = settings
-        self.out_dir = Path(out_dir)
         self.spec = f"camera:{source.address}"
         self.fps = settings.fps or 0.0
         self.width, self.height = settings.size or (0, 0)
         self.check: SettingsCheck | None = None
-        self.writer: FrameWriter | None = None
-        self.failure: str | None = None
+        self.captured = 0
         self.finished = False
-        self.partial = False
-        """Set when the filming was stopped before its end (Ctrl-C): camera.json says so."""
+        self._fault: Fault | None = None
         self._accept_refused = accept_refused
-        self._overwrite = overwrite
         self._capture: Any = None
         self._clock: Clock | None = None
-        self._queue: deque[CameraFrame] = deque(maxlen=QUEUE_FRAMES)
-        self._latest: CameraFrame | None = None
+        self._queue: deque[CameraFrame] = deque()
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-        self._closed = False
 
     def connect(self, clock: Clock) -> None:
         """Open the camera, apply and check the settings, start capturing (RigError if it cannot)."""
@@ -205,16 +191,14 @@ class OpenCvCamera:
         self.fps = self.check.reported["fps"] or self.settings.fps or 30.0
         self.width, self.height = self.check.reported["size"]
         self._capture = capture
-        self.out_dir.mkdir(parents=True, exist_ok=True)
-        self.writer = FrameWriter(self.out_dir, self.fps, self.width, self.height, overwrite=self._overwrite)
         self._thread = threading.Thread(target=self._capture_loop, name=f"camera {self.source.address}", daemon=True)
         self._thread.start()
 
     def _capture_loop(self) -> None:
-        capture, clock, writer = self._capture, self._clock, self.writer
+        capture, clock = self._capture, self._clock
         paced_start: float | None = None
-        index = 0
         while not self._stop.is_set():
+            index = self.captured
             if self.source.kind == "file":
                 paced_start = clock.now() if paced_start is None else paced_start
                 clock.wait_until(paced_start + index / self.fps)
@@ -222,55 +206,44 @@ class OpenCvCamera:
                 if self.source.kind == "file":
                     self.finished = True
                 else:
-                    self.failure = f"camera {self.source.address} stopped delivering frames at {clock.now():.3f} s (unplugged, or the stream ended)"
+                    gone = f"camera {self.source.address} stopped delivering frames (unplugged, or the stream ended)"
+                    self._fault = Fault(clock.now(), gone)
                 return
             t_capture = paced_start + index / self.fps if paced_start is not None else clock.now()
             backend_ms = float(capture.get(cv2.CAP_PROP_POS_MSEC))
             ok, image = capture.retrieve()
             if not ok:
-                self.failure = f"camera {self.source.address} delivered a frame it could not decode at {t_capture:.3f} s"
+                self._fault = Fault(t_capture, f"camera {self.source.address} delivered a frame it could not decode")
                 return
             grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
-            writer.write(grey, t_capture, backend_ms if backend_ms > 0 or index == 0 else None)
-            frame = CameraFrame(index, t_capture, 1.0 / self.fps, grey)
+            frame = CameraFrame(index, t_capture, 1.0 / self.fps, grey, t_backend_ms=backend_ms if backend_ms > 0 or index == 0 else None)
             with self._lock:
                 self._queue.append(frame)
-                self._latest = frame
-            index += 1
+            self.captured += 1
 
     def poll(self) -> list[CameraFrame]:
-        """The frames captured since the last call (the latest QUEUE_FRAMES at most); RigError once the
-        camera has stopped delivering."""
+        """Every frame captured since the last call."""
         with self._lock:
             frames = list(self._queue)
             self._queue.clear()
-        if not frames and self.failure is not None:
-            raise RigError(f"{self.failure}; everything captured before is in {self.out_dir}")
         return frames
 
-    def latest(self) -> CameraFrame | None:
-        """The newest frame captured (for a preview)."""
-        with self._lock:
-            return self._latest
+    def fault(self) -> Fault | None:
+        return self._fault
 
     def report(self) -> dict[str, Any]:
-        writer = self.writer
         return {
             "camera": self.spec,
             "source": self.source.kind,
             "requested": self.check.requested if self.check else self.settings.requested(),
             "reported": self.check.reported if self.check else None,
             "refused": self.check.refused if self.check else [],
-            "frames": writer.frames if writer else 0,
-            "dropped": writer.dropped if writer else 0,
-            "stalls": writer.stalls if writer else 0,
-            "measured_fps": writer.measured_fps() if writer else None,
-            "failure": self.failure,
-            "partial": self.partial,
+            "captured": self.captured,
+            "failure": f"{self._fault.reason} at {self._fault.since:.3f} s" if self._fault else None,
         }
 
     def close(self) -> None:
-        """Stop capturing, release the camera, finish the files and write camera.json; safe to repeat."""
+        """Stop capturing and release the camera; safe to repeat."""
         self._stop.set()
         thread, self._thread = self._thread, None
         if thread is not None:
@@ -278,13 +251,9 @@ class OpenCvCamera:
         capture, self._capture = self._capture, None
         if capture is not None:
             capture.release()
-        if self.writer is not None and not self._closed:
-            self._closed = True
-            self.writer.close()
-            (self.out_dir / SETTINGS_FILE).write_text(json.dumps(self.report(), indent=1) + "\n", encoding="utf-8")
 
 
-def opencv_camera(address: str, out_dir: Path, **options: Any) -> OpenCvCamera:
-    """An unconnected camera for `SOURCE[?settings]` writing into `out_dir`."""
+def opencv_camera(address: str, **options: Any) -> OpenCvCamera:
+    """An unconnected camera for `SOURCE[?settings]`."""
     source, settings = parse_camera_address(address)
-    return OpenCvCamera(source, settings, out_dir, **options)
+    return OpenCvCamera(source, settings, **options)

@@ -36,6 +36,7 @@ from typing import Any, Callable, NamedTuple
 
 from predictors import PoseSample
 from rig.clock import Clock
+from rig.devices.protocols import Fault
 from rig.devices.trackers.clock_mapping import ClockMapping
 from rig.devices.trackers.counters import LatencyHistogram, SequenceCheck, TrackerCounters
 from rig.devices.trackers.link import Link, LinkLost, NativeReader
@@ -227,6 +228,11 @@ class TrackerStream:
             thread.join()
             self._chunks.append(_CLOSED)
         self.link.close()
+
+    def fault(self) -> Fault | None:
+        """The link's loss, while it has not been restored."""
+        change = next((event for event in reversed(self.events) if event.what in ("lost", "restored")), None)
+        return Fault(change.t, f"tracker {self.name} was lost ({change.detail})") if change and change.what == "lost" else None
 
     def report(self) -> dict[str, Any]:
         """Counters, latency (where knowable), clock mapping and link events, for the end of a run."""

@@ -17,11 +17,12 @@ import sys
 from pathlib import Path
 from typing import Any, Callable
 
+from analysis import AnalysisOptions
 from rig.clock import MonotonicClock
 from rig.devices.protocols import Display
 from rig.devices.window import WindowSettings
 from rig.errors import RigError
-from rig.live.measure import MeasureReport, VideoOptions, analyse_run, write_report
+from rig.live.measure import MeasureReport, analyse_run, write_report
 from rig.live.run import EXTERNAL, LiveConfig, run_live
 from rig.live.selftest.emulator import EmulatedPendulum
 from rig.live.selftest.frame_clock import FixedRateFrameClock
@@ -95,8 +96,8 @@ def self_test(
             renderer.terminate()
             renderer.wait(timeout=10)
         emulator.close()
-    fps = camera.measured_fps
-    options = VideoOptions(led_roi=layout.led_roi, sphere_roi=layout.sphere_roi)
+    fps = result.summary["film"]["measured_fps"]
+    options = AnalysisOptions(led_roi=layout.led_roi, sphere_roi=layout.sphere_roi)
     report = analyse_run(out_dir, fps, options, None, result.summary)
     report.run["self_test"] = _agreement(report)
     write_report(report)

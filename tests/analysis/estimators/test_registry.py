@@ -4,6 +4,7 @@ import pytest
 
 from analysis import (
     AnalysisError,
+    AnalysisOptions,
     EstimationContext,
     MethodResult,
     analyse,
@@ -46,12 +47,12 @@ def test_an_estimator_registered_from_outside_runs_by_its_name_and_with_all(fit_
     clip = scene(latency_s=0.04, duration_s=4.1, fps=120.0)
     frames = render_video(clip)
     assert methods() == (*BUILT_IN, "fit-centre")
-    alone = analyse(frames, fps=clip.fps, method="fit-centre")
+    alone = analyse(frames, AnalysisOptions(fps=clip.fps, method="fit-centre"))
     assert alone.method == "fit-centre" and list(alone.methods) == ["fit-centre"]
     assert alone.latency_ms == pytest.approx(40.0, abs=0.3)
     assert alone.ci95_ms is None
     assert alone.to_dict()["methods"]["fit-centre"]["periods"] == alone.cycles.how
-    everything = estimate(track(frames, fps=clip.fps), "all")
+    everything = estimate(track(frames, AnalysisOptions(fps=clip.fps)), AnalysisOptions(method="all"))
     assert list(everything.methods) == [*BUILT_IN, "fit-centre"]
     assert everything.method == "sinefit"
     # The fit is computed once and shared: the outside estimator got sinefit's own.
@@ -63,8 +64,8 @@ def test_an_unregistered_estimator_is_gone(scene, render_video):
     register_estimator(FitCentre())
     unregister_estimator("fit-centre")
     assert methods() == BUILT_IN
-    with pytest.raises(AnalysisError, match="unknown method 'fit-centre'; choose one of fft, xcorr, sinefit, bayes or all"):
-        analyse(render_video(scene(duration_s=2.5, fps=120.0)), fps=120.0, method="fit-centre")
+    with pytest.raises(AnalysisError, match="method must be one of fft, xcorr, sinefit, bayes, all, got 'fit-centre'"):
+        analyse(render_video(scene(duration_s=2.5, fps=120.0)), AnalysisOptions(fps=120.0, method="fit-centre"))
 
 
 def test_a_taken_name_or_a_broken_estimator_is_refused(fit_centre):

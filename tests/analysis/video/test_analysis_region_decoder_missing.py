@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from analysis import analyse
+from analysis import AnalysisOptions, analyse
 from analysis.video.decoding import REGION_DECODER_MISSING
 
 WITHOUT_EXTENSION = """
@@ -17,7 +17,7 @@ sys.modules["analysis._jpeg_region"] = None  # import fails, as when the extensi
 import analysis
 from analysis.video.file import VideoFile
 path = sys.argv[1]
-result = analysis.analyse(path, method="fft")
+result = analysis.analyse(path, analysis.AnalysisOptions(method="fft"))
 print(json.dumps({
     "decodes_in_part": VideoFile(path).decodes_in_part,
     "latency_ms": result.latency_ms,
@@ -31,7 +31,7 @@ def test_without_the_region_decoder_a_motion_jpeg_file_gives_the_same_result(tmp
     clip = scene(latency_s=0.03, duration_s=3.2, period_s=0.8)
     path = mjpg_file(tmp_path / "clip.avi", render_video(clip), clip.fps)
     with caplog.at_level(logging.WARNING):
-        expected = analyse(path, method="fft")
+        expected = analyse(path, AnalysisOptions(method="fft"))
     assert REGION_DECODER_MISSING not in caplog.text
     completed = subprocess.run(
         [sys.executable, "-c", WITHOUT_EXTENSION, str(path)], capture_output=True, text=True, check=True, timeout=300

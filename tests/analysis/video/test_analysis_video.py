@@ -7,7 +7,7 @@ import cv2
 import numpy as np
 import pytest
 
-from analysis import AnalysisError, analyse
+from analysis import AnalysisError, AnalysisOptions, analyse
 from analysis.video.array import FrameArray
 from analysis.video.decoding import DECODE_BATCH, READ_AHEAD, decode_threads, ordered_map
 from analysis.video.file import VideoFile
@@ -87,7 +87,7 @@ def test_video_without_frames_raises(tmp_path):
 
 def test_empty_array_raises():
     with pytest.raises(AnalysisError, match="empty"):
-        analyse(np.zeros((0, 32, 48), dtype=np.uint8), fps=240.0)
+        analyse(np.zeros((0, 32, 48), dtype=np.uint8), AnalysisOptions(fps=240.0))
 
 
 @pytest.mark.parametrize("shape", [(32, 48), (4, 32, 48, 2)], ids=["one frame", "two channels"])
@@ -288,7 +288,7 @@ def test_a_file_calibrated_on_a_sample_of_its_frames_is_tracked_as_its_whole_fra
     path = mjpg_file(tmp_path / "clip.avi", render_video(clip), clip.fps)
     assert VideoFile(path).decodes_in_part
     decoded = np.stack([frame for _, frame in VideoFile(path).frames()])
-    from_file, from_array = analyse(path), analyse(decoded, fps=clip.fps)
+    from_file, from_array = analyse(path), analyse(decoded, AnalysisOptions(fps=clip.fps))
     assert from_file.frames == from_array.frames == len(decoded)
     for name in ("led_track", "sphere_track"):
         file_track, array_track = getattr(from_file, name), getattr(from_array, name)

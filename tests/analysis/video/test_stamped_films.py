@@ -9,6 +9,7 @@ import av
 import numpy as np
 import pytest
 
+from analysis.options import AnalysisOptions
 from analysis.tracks import track
 from analysis.video.file import VideoFile
 from rig.film_file import FRAME_TIMES_FILE, TIME_BASE, StampedVideoRecord
@@ -52,7 +53,7 @@ def test_a_still_region_of_an_hevc_film_is_no_repeated_frame(tmp_path: Path, sce
     frames = render_video(clip).copy()
     frames[:, :4, :4] = (20 + np.arange(len(frames)) % 200)[:, None, None]
     path = _write(tmp_path / "film.mp4", frames, np.arange(len(frames)) / FPS, "mp4", "hevc")
-    tracks = track(path, led_side="left")
+    tracks = track(path, AnalysisOptions(led_side="left"))
     still = [np.diff(t.x) == 0 for t in (tracks.led, tracks.sphere)]
     assert np.count_nonzero(still[0] & still[1]) >= 3  # both regions identical to the frame before
     assert tracks.diagnostics["repeated_frames"] == 0
@@ -79,7 +80,7 @@ def test_one_duplicated_frame_is_reported_once(tmp_path: Path, kind: str, scene,
     frames = render_video(clip).copy()
     frames[201] = frames[200]
     path = mjpg_file(tmp_path / "film.avi", frames, FPS) if kind == "mjpeg" else _lossless_h264(tmp_path / "film.mp4", frames)
-    tracks = track(path, led_side="left")
+    tracks = track(path, AnalysisOptions(led_side="left"))
     assert tracks.diagnostics["repeated_frames"] == 1
     assert not tracks.led.valid[201] and not tracks.sphere.valid[201]
     assert tracks.led.valid[200] and tracks.led.valid[202]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
@@ -44,3 +45,20 @@ def test_a_folder_with_a_recording_is_not_overwritten(tmp_path: Path) -> None:
     BoardRecorder(tmp_path).close()
     with pytest.raises(RigError, match="already holds a board recording"):
         BoardRecorder(tmp_path)
+
+
+@pytest.mark.parametrize("kind", list(FILES), ids=lambda kind: kind.__name__)
+def test_each_event_is_written_field_by_field_under_its_columns(kind: type, tmp_path: Path) -> None:
+    names = [field.name for field in fields(kind)]
+    columns = FILES[kind].columns
+    # A field is its column, maybe with its unit (seconds) and, for the sync interval, "offset_".
+    assert len(names) == len(columns)
+    for name, column in zip(names, columns):
+        assert column in (name, f"{name}_s", f"offset_{name}_s")
+    values = {field.name: (True if field.type == "bool" else f"x{i}" if field.type == "str" else i + 0.5 if field.type == "float" else i)
+              for i, field in enumerate(fields(kind))}  # fmt: skip
+    recorder = BoardRecorder(tmp_path)
+    recorder.on_event(kind(**values))
+    recorder.close()
+    row = (tmp_path / FILES[kind].name).read_text().splitlines()[1].split(",")
+    assert row == [str(int(value) if isinstance(value, bool) else value) for value in values.values()]

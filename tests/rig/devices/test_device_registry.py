@@ -8,7 +8,7 @@ import pytest
 
 from rig.clock import VirtualClock
 from rig.devices.protocols import Camera, Display, TrackerSource
-from rig.devices.registry import DeviceContext, device_schemes, make_device
+from rig.devices.registry import TRACKERS, DeviceContext, make_camera, make_display, make_tracker
 from rig.errors import ConfigError, RigError
 from rig.sim.config import SimulationConfig
 from rig.sim.world import SimulatedWorld
@@ -42,37 +42,44 @@ class DummyTracker:
         self.clock.wait_until(min(self.clock.now() + timeout_s, self.sent * 0.01 + 0.002))
         return self.poll()
 
+    def fault(self):
+        return None
+
+    def report(self):
+        return {"tracker": "dummy", "sent": self.sent}
+
     def close(self):
         self.clock = None
 '''
 
 
-def test_a_simulated_run_makes_the_simulated_twin_of_every_kind() -> None:
-    context = DeviceContext(simulation=SimulatedWorld(SimulationConfig(duration_s=1.0)))
-    assert isinstance(make_device("tracker", "sim", context), TrackerSource)
-    display = make_device("display", "sim", context)
-    assert isinstance(display, Display)
-    camera = make_device("camera", "sim", context)
-    assert isinstance(camera, Camera)
+def test_a_simulated_run_passes_the_twin_of_every_kind_it_makes() -> None:
+    world = SimulatedWorld(SimulationConfig(duration_s=1.0))
+    context = DeviceContext(world.twins())
+    assert isinstance(make_tracker("sim", context), TrackerSource)
+    display = make_display("sim", context)
+    assert isinstance(display, Display) and display is world.display()
+    camera = make_camera("sim", context)
+    assert isinstance(camera, Camera) and camera is world.camera()
     assert camera.scene.display is display
 
 
 def test_the_simulated_twins_exist_only_inside_a_simulation() -> None:
     with pytest.raises(ConfigError, match="only in a simulated run"):
-        make_device("tracker", "sim", DeviceContext())
+        make_tracker("sim")
     with pytest.raises(ConfigError, match="takes no address"):
-        make_device("camera", "sim:0", DeviceContext())
+        make_camera("sim:0")
 
 
 def test_an_unknown_scheme_is_a_config_error_listing_the_schemes() -> None:
     with pytest.raises(ConfigError, match=r"unknown tracker 'polhemus'.*available trackers: .*sim"):
-        make_device("tracker", "polhemus:/dev/ttyUSB0", DeviceContext())
+        make_tracker("polhemus:/dev/ttyUSB0")
 
 
 def test_a_third_party_tracker_is_one_module_and_one_entry_point(site) -> None:
     site.install("dummy-tracker", "dummy_tracker", DUMMY_TRACKER, "rig.trackers", "dummy = dummy_tracker:DummyTracker")
-    assert {"dummy", "sim"} <= set(device_schemes("tracker"))
-    tracker = make_device("tracker", "dummy:0.25", DeviceContext())
+    assert {"dummy", "sim"} <= set(TRACKERS.schemes())
+    tracker = make_tracker("dummy:0.25")
     assert isinstance(tracker, TrackerSource)
     clock = VirtualClock()
     tracker.connect(clock)
@@ -82,6 +89,7 @@ def test_a_third_party_tracker_is_one_module_and_one_entry_point(site) -> None:
     later = tracker.poll()
     tracker.close()
     assert [s.t_sensor for s in first + later] == pytest.approx([0.0, 0.01, 0.02, 0.03])
+    assert tracker.report() == {"tracker": "dummy", "sent": 4}
     assert all(s.position[0] == 0.25 for s in first + later)
 
 
@@ -89,9 +97,11 @@ def test_an_entry_point_that_is_not_a_tracker_is_a_rig_error_naming_its_distribu
     site.install("not-a-tracker", "not_a_tracker", "class Thing:\n    def __init__(self, a, c):\n        pass\n",
             "rig.trackers", "thing = not_a_tracker:Thing")  # fmt: skip
     with pytest.raises(RigError, match=r"not-a-tracker 0\.1.*TrackerSource"):
-        make_device("tracker", "thing", DeviceContext())
+        make_tracker("thing")
 
 
-def test_a_kind_that_does_not_exist_is_a_programming_error() -> None:
-    with pytest.raises(ValueError, match="kinds: tracker, display, camera"):
-        make_device("printer", "sim", DeviceContext())
+def test_a_tracker_without_a_report_does_not_satisfy_the_protocol(site) -> None:
+    silent = DUMMY_TRACKER.replace("    def report(self):", "    def _report(self):")
+    site.install("silent-tracker", "silent_tracker", silent, "rig.trackers", "silent = silent_tracker:DummyTracker")
+    with pytest.raises(RigError, match=r"silent-tracker 0\.1.*does not satisfy the TrackerSource protocol"):
+        make_tracker("silent:0.25")

@@ -1,6 +1,7 @@
 """Live camera capture with OpenCV, against a file and a tcp:// Motion-JPEG stream (this OpenCV
-has FFmpeg but no video devices): every frame written as it comes with its time, dropped frames
-found and filled, settings a camera refuses reported, an unplugged camera ending cleanly."""
+has FFmpeg but no video devices), and the film a run writes of it: every frame with its time,
+dropped frames found and filled, settings a camera refuses reported, an unplugged camera ending
+cleanly with its fault."""
 
 from __future__ import annotations
 
@@ -14,10 +15,12 @@ import numpy as np
 import pytest
 
 from rig.clock import MonotonicClock
-from rig.devices.camera import FrameWriter, apply_settings, opencv_camera, parse_camera_address
+from rig.devices.camera import apply_settings, opencv_camera, parse_camera_address
 from rig.devices.camera.opencv_camera import CameraSettings
+from rig.devices.protocols import CameraFrame
 from rig.errors import ConfigError, RigError
 from rig.records import VideoRecord
+from rig.session.record import FilmRecord
 
 FPS = 50.0
 FRAMES = 40
@@ -42,11 +45,15 @@ def test_a_camera_spec_keeps_the_stream_options_and_takes_the_rigs() -> None:
         parse_camera_address("0?size=640")
 
 
+def _black(i: int, t: float, t_slot: float | None = None) -> CameraFrame:
+    return CameraFrame(i, t, 1.0 / FPS, np.zeros((48, 64), dtype=np.uint8), t_slot=t_slot)
+
+
 def test_dropped_frames_are_found_from_the_times_and_filled_to_keep_the_timing(tmp_path: Path) -> None:
-    writer = FrameWriter(tmp_path, FPS, 64, 48)
+    writer = FilmRecord(tmp_path, FPS, 64, 48)
     times = [i / FPS for i in range(10)] + [i / FPS for i in range(13, 20)]
-    for t in times:
-        writer.write(np.zeros((48, 64), dtype=np.uint8), t, None)
+    for i, t in enumerate(times):
+        writer.write(_black(i, t))
     writer.close()
     assert writer.dropped == 3 and writer.frames == 20
     assert writer.measured_fps() == pytest.approx(FPS)
@@ -71,11 +78,11 @@ class RefusingCapture:
 
 
 def test_a_camera_that_knows_its_schedule_finds_drops_from_it_whatever_its_jitter(tmp_path: Path) -> None:
-    writer = FrameWriter(tmp_path, FPS, 64, 48)
+    writer = FilmRecord(tmp_path, FPS, 64, 48)
     slots = [i for i in range(30) if i not in (7, 8, 20)]
     jitter = np.random.default_rng(3).uniform(-0.45, 0.45, len(slots)) / FPS
-    for slot, late in zip(slots, jitter):
-        writer.write(np.zeros((48, 64), dtype=np.uint8), slot / FPS + late, None, slot / FPS)
+    for i, (slot, late) in enumerate(zip(slots, jitter)):
+        writer.write(_black(i, slot / FPS + late, slot / FPS))
     writer.close()
     assert (writer.dropped, writer.frames) == (3, 30)
     assert writer.measured_fps() == pytest.approx(FPS)
@@ -87,19 +94,19 @@ def test_a_setting_the_camera_refuses_is_reported_not_accepted() -> None:
     assert check.reported["size"] == (640, 480) and check.reported["fourcc"] == "MJPG"
 
 
-def test_a_file_camera_writes_every_frame_with_its_time(tmp_path: Path) -> None:
+def test_a_file_camera_hands_over_every_frame_with_its_time(tmp_path: Path) -> None:
     with VideoRecord(tmp_path / "in.avi", FPS, 64, 48) as video:
         for frame in _frames(FRAMES):
             video.write(frame)
-    camera = opencv_camera(str(tmp_path / "in.avi"), tmp_path / "out")
+    camera = opencv_camera(str(tmp_path / "in.avi"))
     camera.connect(MonotonicClock())
     _wait(lambda: camera.finished)
     camera.close()
-    report = camera.report()
-    assert (report["frames"], report["dropped"], report["failure"]) == (FRAMES, 0, None)
-    written = cv2.VideoCapture(str(tmp_path / "out" / "video.avi"))
-    assert int(written.get(cv2.CAP_PROP_FRAME_COUNT)) == FRAMES
-    assert (tmp_path / "out" / "camera.json").is_file()
+    frames = camera.poll()
+    assert [frame.index for frame in frames] == list(range(FRAMES))
+    np.testing.assert_allclose(np.diff([frame.t_start for frame in frames]), 1.0 / FPS)
+    np.testing.assert_allclose([frame.image.mean() for frame in frames], [5 * i % 250 for i in range(FRAMES)], atol=2.0)
+    assert (camera.report()["captured"], camera.fault()) == (FRAMES, None)
 
 
 def test_settings_asked_of_a_file_are_refused(tmp_path: Path) -> None:
@@ -122,23 +129,31 @@ def test_a_tcp_mjpeg_stream_is_captured_and_its_end_ends_the_capture_cleanly(tmp
     sent = 3 * FRAMES
     server = threading.Thread(target=_serve_mjpeg, args=(_frames(sent), listener, sent))
     server.start()
-    camera = opencv_camera(f"tcp://127.0.0.1:{port}", tmp_path)
+    camera = opencv_camera(f"tcp://127.0.0.1:{port}")
+    film = None
     try:
         camera.connect(MonotonicClock())
-        _wait(lambda: camera.failure is not None, 30.0)
-        with pytest.raises(RigError, match="stopped delivering frames"):
-            while True:
-                camera.poll()
+        film = FilmRecord(tmp_path, camera.fps, camera.width, camera.height)
+        deadline = time.monotonic() + 30.0
+        while camera.fault() is None and time.monotonic() < deadline:
+            for frame in camera.poll():
+                film.write(frame)
+            time.sleep(0.02)
+        assert "stopped delivering frames" in camera.fault().reason
+        for frame in camera.poll():
+            film.write(frame)
     finally:
         camera.close()
+        if film is not None:
+            film.close()
         server.join()
         listener.close()
-    report = camera.report()
+    report = film.report()
     # FFmpeg keeps what it read while probing the stream: every frame sent reaches the video.
-    assert report["frames"] - report["dropped"] == sent
+    assert report["frames"] - report["dropped"] == sent == camera.report()["captured"]
     assert int(cv2.VideoCapture(str(tmp_path / "video.avi")).get(cv2.CAP_PROP_FRAME_COUNT)) == report["frames"]
 
 
 def test_a_missing_camera_is_one_clear_error(tmp_path: Path) -> None:
     with pytest.raises(RigError, match="no video file"):
-        opencv_camera(str(tmp_path / "absent.avi"), tmp_path / "out").connect(MonotonicClock())
+        opencv_camera(str(tmp_path / "absent.avi")).connect(MonotonicClock())

@@ -51,7 +51,8 @@ def _self_test(out: Path, *extra: str) -> dict:
 def _nothing_lost(out: Path, report: dict) -> None:
     run = report["run"]
     assert len(_rows(out / "tracker.csv")) == run["tracker_report"]["counters"]["received"] > 0
-    assert run["camera"]["frames"] > 0.5 * SELF_TEST_S * run["camera"]["fps"]
+    assert run["film"]["frames"] > 0.5 * SELF_TEST_S * run["film"]["fps"]
+    assert run["film"]["frames"] == len(_rows(out / "camera_frames.csv"))
     assert run["ended"] == "completed"
 
 

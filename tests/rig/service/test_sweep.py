@@ -92,7 +92,8 @@ camera = { fps = 120.0, impairments = { dim_led = 0.35 } }
         ("[grid]\n", "no \\[grid\\]"),
         ("[grid]\nseed = 3\n", "non-empty list"),
         ("[gird]\nseed = [1]\n", "unknown table"),
-        ("[grid]\nseed = [1]\n[analysis]\nfps = 3\n", "\\[analysis\\] takes"),
+        ("[grid]\nseed = [1]\n[analysis]\nspeed = 3\n", "\\[analysis\\]: unknown key speed; AnalysisOptions takes fps, "),
+        ("[grid]\nseed = [1]\n[analysis]\nmethod = \"guess\"\n", "\\[analysis\\]: method must be one of fft, "),
         ("[grid\n", "not valid TOML"),
         ("points = [1]\n", "list of tables"),
         ("[[points]]\nlabels = 3\n", "labels must be a table"),
@@ -148,5 +149,5 @@ def test_a_sweep_with_simulated_rois_analyses_each_video_within_its_simulations_
     spec.write_text(SPEC.replace('method = "sinefit"', 'method = "sinefit"\nsimulated_rois = true').replace("[0.7, 1.1]", "[0.7]"))
     rows, _ = run_sweep(read_sweep(spec), tmp_path / "out")
     truth = json.loads((tmp_path / "out" / "point000" / "truth.json").read_text())
-    assert [(r.led_roi, r.sphere_roi) for r in requests] == [(tuple(truth["led_roi"]), tuple(truth["sphere_roi"]))]
+    assert [(r.options.led_roi, r.options.sphere_roi) for r in requests] == [(tuple(truth["led_roi"]), tuple(truth["sphere_roi"]))]
     assert abs(rows[0]["error_ms"]) < 1.0

@@ -96,7 +96,7 @@ def run(tmp_path: Path, renderer: FlatRenderer, timing, app_cost, target: Photon
     parts = SessionParts(
         VirtualClock(0.0), ScriptedTracker(), predictors.make("hold"), renderer, SETUP, timing, app_cost, display, target=target
     )
-    with RunRecord(tmp_path, None) as record:
+    with RunRecord(tmp_path) as record:
         session = Session(parts, 0.0, 0.2, record)
         session.run()
     return session, tmp_path
@@ -153,7 +153,7 @@ def test_a_tracker_that_never_sends_is_reported(tmp_path) -> None:
     display = SimDisplay(DisplayConfig(refresh_hz=REFRESH_HZ))
     parts = SessionParts(VirtualClock(0.0), Silent(), predictors.make("hold"), FlatRenderer(False), SETUP,
                          OneImagePerAppFrame(), ModelledCost(3.0), display)  # fmt: skip
-    with RunRecord(tmp_path, None) as record, pytest.raises(RigError, match="no tracker sample arrived"):
+    with RunRecord(tmp_path) as record, pytest.raises(RigError, match="no tracker sample arrived"):
         Session(parts, 0.0, 0.2, record).run()
 
 
@@ -225,7 +225,7 @@ def test_a_server_that_plans_for_more_than_a_refresh_and_takes_less_keeps_compos
     display = SimDisplay(DisplayConfig(refresh_hz=REFRESH_HZ, t0=0.0))
     parts = SessionParts(VirtualClock(0.0), ScriptedTracker(), predictors.make("hold"), renderer, SETUP,
                          CompositeEveryRefresh(MeasuredCost()), MeasuredCost(), display)  # fmt: skip
-    with RunRecord(tmp_path, None) as record:
+    with RunRecord(tmp_path) as record:
         Session(parts, 0.0, 0.6, record).run()
     shown = rows(tmp_path / "display_frames.csv")
     assert_missed_refreshes_repeat_the_last_image(shown)

@@ -1,0 +1,122 @@
+"""Command-line options made from declared settings (`declared`): every setting of a config with a
+`Flag` becomes an option, typed, checked against its range or choices when the command line is read
+(one line naming the option, exit status 2), its help with the unit and the default; and the values
+given become the config again (`config_from_args`), converted back to the setting's unit."""
+
+from __future__ import annotations
+
+import argparse
+import typing
+from typing import Any, Callable, TypeVar
+
+from declared import Entry, from_table, walk
+from declared.settings import whole_numbers
+
+Config = TypeVar("Config")
+
+
+def add_declared_options(parser: argparse.ArgumentParser, kind: type, groups: dict[str, str] | None = None) -> None:
+    """An option for each setting of `kind` with a flag (nested configs' included), in declaration
+    order; a flag's group is a section titled as `groups` says (a group not named there is left out:
+    its options are not this command's)."""
+    groups = {"": "", **(groups or {})}
+    sections: dict[str, Any] = {}
+    for entry in walk(kind):
+        flag = entry.setting.flag
+        if flag is None or flag.group not in groups:
+            continue
+        title = groups[flag.group]
+        if title not in sections:
+            sections[title] = parser.add_argument_group(title) if title else parser
+        sections[title].add_argument(flag.name, dest=_dest(entry), **_argument(entry))
+
+
+def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception]) -> Config:
+    """The `kind` the options given make (every setting without an option at its default), each
+    value in its setting's unit; `error` is what `kind` raises for a value it does not allow."""
+    table: dict[str, Any] = {}
+    per: list[tuple[Entry, Any]] = []
+    for entry in walk(kind):
+        flag = entry.setting.flag
+        if flag is None or not hasattr(args, _dest(entry)):
+            continue
+        value = getattr(args, _dest(entry))
+        if flag.per is not None and value is not None:
+            per.append((entry, value))
+            continue
+        _put(table, entry.path, value / flag.factor if flag.factor != 1.0 and value is not None else value)
+    for entry, value in per:
+        parent = entry.path.rpartition(".")[0]
+        sibling = _get(table, f"{parent}.{entry.setting.flag.per}" if parent else entry.setting.flag.per)
+        _put(table, entry.path, value / sibling)
+    return from_table(kind, table, error)
+
+
+def _dest(entry: Entry) -> str:
+    return entry.setting.flag.name.removeprefix("--").replace("-", "_")
+
+
+def _put(table: dict[str, Any], path: str, value: Any) -> None:
+    *parents, name = path.split(".")
+    for parent in parents:
+        table = table.setdefault(parent, {})
+    table[name] = value
+
+
+def _get(table: dict[str, Any], path: str) -> Any:
+    for name in path.split("."):
+        table = table[name]
+    return table
+
+
+def _argument(entry: Entry) -> dict[str, Any]:
+    """argparse's keywords for the entry's option."""
+    setting, flag = entry.setting, entry.setting.flag
+    default = flag.default if flag.default is not None else _converted(entry.default, flag.factor)
+    unit = flag.unit if flag.unit is not None else setting.unit
+    shown = setting.unset if default is None else ",".join(f"{v:g}" for v in default) if isinstance(default, tuple) else str(default)
+    about = "; ".join(part for part in (unit, f"default: {shown}" if shown and entry.hint is not bool else "") if part)
+    keywords: dict[str, Any] = {"help": f"{setting.help} ({about})".replace("%", "%%") if about else setting.help}
+    if entry.hint is bool:
+        return keywords | {"action": "store_true"}
+    keywords |= {"default": default, "metavar": flag.metavar}
+    if setting.allowed() is not None:
+        return keywords | {"choices": setting.allowed(), "metavar": flag.metavar}
+    return keywords | {"type": _parser(entry)}
+
+
+def _converted(value: Any, factor: float) -> Any:
+    return value * factor if factor != 1.0 and value is not None else value
+
+
+def _parser(entry: Entry) -> Callable[[str], Any]:
+    """Text to the option's value, checked against the setting's range in the option's unit."""
+    setting, flag = entry.setting, entry.setting.flag
+    hint = typing.get_args(entry.hint) if typing.get_origin(entry.hint) is tuple else (entry.hint,)
+    whole = whole_numbers(entry.hint)
+    allowed = flag.range or (setting.range.scaled(flag.factor) if setting.range is not None else None)
+    unit = flag.unit if flag.unit is not None else setting.unit
+
+    def parse(text: str) -> Any:
+        if setting.none and text == setting.none:
+            return None
+        parts = text.split(",") if len(hint) > 1 else [text]
+        try:
+            if len(parts) != len(hint):
+                raise ValueError
+            values = tuple(kind(part) for kind, part in zip(hint, parts))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {_expected(hint, flag.metavar, setting.none)}, got {text!r}") from None
+        value = values if len(hint) > 1 else values[0]
+        problem = setting.problem(value, whole, allowed, unit)
+        if problem is not None:
+            raise argparse.ArgumentTypeError(f"{problem}, got {text}")
+        return value
+
+    return parse
+
+
+def _expected(hint: tuple[Any, ...], metavar: str | None, none: str) -> str:
+    kind = "whole number" if hint[0] is int else "number" if hint[0] is float else "value"
+    what = f"a {kind}" if len(hint) == 1 else f"{metavar or 'values'}, {len(hint)} {kind}s"
+    return f"{what} or '{none}'" if none else what
