@@ -2,9 +2,10 @@
 
 The bands are fitted (``analysis.shutter.fit``); then what the fit found is read as a camera:
 
-- A display flashing full-field scans its rows out too, so the bands move at the difference of
-  the camera's and the display's row rates: the display's time per camera row (its scan-out time
-  over the panel's height in the film, signed by its direction) is added back. The scan-out time
+- A display flashing full-field (``ShutterOptions.source``) scans its rows out too, so the bands
+  move at the difference of the camera's and the display's row rates: the display's time per
+  camera row (its scan-out time over the panel's height in the film, signed by its direction) is
+  added back. The scan-out time
   is the refresh period's share the lab gives, or 88 to 100 % of it (the range of common video
   timings' vertical blanking), in the interval either way.
 - The readout's interval is the jackknife's 95 % (Student's t) with the display's terms beside;
@@ -21,7 +22,6 @@ Every refusal is an AnalysisError in one line naming what to change.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -31,6 +31,7 @@ from analysis.errors import AnalysisError
 from analysis.shutter.film import Rect, RowFilm, read_film
 from analysis.shutter.fit import T95, BandFit, fit_bands, largest_gap
 from analysis.shutter.model import LONGER_THAN_BOTH, Reading, other_readings
+from analysis.shutter.options import ShutterOptions
 from analysis.shutter.result import ShutterResult
 
 MIN_FRAMES = 40
@@ -60,7 +61,6 @@ PANEL_EDGE_ROWS = 0.5
 # share of the exposure; the exposure's interval then reaches down by this many times that spread.
 TIMING_SHARE = 0.1
 TIMING_WIDENING = 2.0
-SCANOUTS = ("top-down", "bottom-up")
 # No interval is narrower than these shares, nor than SWITCHING_S either way: what the model
 # leaves out (rows not read at exactly equal intervals, a light that does not switch instantly,
 # pixels not exactly linear), which the jackknife over frames cannot see.
@@ -69,72 +69,44 @@ EXPOSURE_FLOOR = 0.01
 SWITCHING_S = 2e-6
 
 
-@dataclass(frozen=True)
-class DisplayScan:
-    """A display flashing full-field, as the film sees it: its refresh rate, which way its scan-out
-    moves in the film, and the share of each refresh its scan-out takes (None: not known)."""
-
-    refresh_hz: float
-    direction: str = "top-down"
-    scanout_share: float | None = None
-
-    def __post_init__(self) -> None:
-        if self.direction not in SCANOUTS:
-            raise AnalysisError(f"the display's scan-out must be one of {', '.join(SCANOUTS)}, not {self.direction!r}")
-        if not (math.isfinite(self.refresh_hz) and self.refresh_hz > 0):
-            raise AnalysisError(f"the display's refresh rate must be a positive number of Hz, not {self.refresh_hz}")
-        if self.scanout_share is not None and not 0.0 < self.scanout_share <= 1.0:
-            raise AnalysisError(f"the scan-out's share of a refresh must be in (0, 1], not {self.scanout_share}")
-
-    def line_s(self, film: RowFilm) -> tuple[float, float]:
-        """The display's time per camera row, signed as the camera's line time (positive for a
-        scan-out that moves down the film), and its 95 % half-width."""
-        first, last = film.edges
-        x, y, w, h = film.region
-        if first < y + 0.5 or last > y + h - 0.5:
-            raise AnalysisError(
-                "the flashing display reaches the edge of the frame (or of --roi): film the panel's whole height, "
-                "its top and bottom edges in view, so that its scan-out can be accounted for"
-            )
-        rows = last - first
-        low, high = (self.scanout_share, self.scanout_share) if self.scanout_share is not None else SCANOUT_SHARES
-        scan = (low + high) / 2 / self.refresh_hz
-        sign = 1.0 if self.direction == "top-down" else -1.0
-        spread = math.hypot((high - low) / (low + high), PANEL_EDGE_ROWS / rows)
-        return sign * scan / rows, scan / rows * spread
+def display_line_s(film: RowFilm, options: ShutterOptions) -> tuple[float, float]:
+    """A flashing display's time per camera row, signed as the camera's line time (positive for a
+    scan-out that moves down the film), and its 95 % half-width; (0, 0) for a light."""
+    if options.source != "display" or options.display_hz is None:
+        return 0.0, 0.0
+    first, last = film.edges
+    x, y, w, h = film.region
+    if first < y + 0.5 or last > y + h - 0.5:
+        raise AnalysisError(
+            "the flashing display reaches the edge of the frame (or of --roi): film the panel's whole height, "
+            "its top and bottom edges in view, so that its scan-out can be accounted for"
+        )
+    rows = last - first
+    share = options.scanout_share
+    low, high = (share, share) if share is not None else SCANOUT_SHARES
+    scan = (low + high) / 2 / options.display_hz
+    sign = 1.0 if options.scanout == "top-down" else -1.0
+    spread = math.hypot((high - low) / (low + high), PANEL_EDGE_ROWS / rows)
+    return sign * scan / rows, scan / rows * spread
 
 
 def measure_shutter(
     video: str | Path | np.ndarray,
     flash_hz: float,
-    *,
-    fps: float | None = None,
-    roi: Rect | None = None,
-    duty: float | None = 0.5,
-    display: DisplayScan | None = None,
-    max_exposure_s: float | None = None,
+    options: ShutterOptions = ShutterOptions(),
     progress: Callable[[int, int], object] | None = None,
 ) -> ShutterResult:
     """The readout and exposure of the camera that filmed ``video`` (a file, a folder of images or
-    an (N, H, W) array at ``fps``): a light flashing at ``flash_hz``, on for ``duty`` of each
-    period (None: not known), or a display (``display``) flashing full-field; within ``roi``
-    (x, y, w, h) when given. ``max_exposure_s`` is the longest the camera's exposure can be (None:
-    the frame interval); ``progress(done, total)`` as frames are read."""
-    return estimate_shutter(read_film(video, fps, roi, progress), flash_hz, duty=duty, display=display, max_exposure_s=max_exposure_s)
+    an (N, H, W) array at ``options.fps``): a light, or a display, flashing at ``flash_hz``, read as
+    ``options`` say; ``progress(done, total)`` as frames are read."""
+    return estimate_shutter(read_film(video, options.fps, options.roi, progress), flash_hz, options)
 
 
-def estimate_shutter(
-    film: RowFilm,
-    flash_hz: float,
-    *,
-    duty: float | None = 0.5,
-    display: DisplayScan | None = None,
-    max_exposure_s: float | None = None,
-) -> ShutterResult:
+def estimate_shutter(film: RowFilm, flash_hz: float, options: ShutterOptions = ShutterOptions()) -> ShutterResult:
     """``measure_shutter`` on a film already reduced to rows (``analysis.shutter.film``)."""
-    _check_inputs(film, flash_hz, duty, max_exposure_s)
+    _check_inputs(film, flash_hz)
     interval = film.frame_interval_s
-    display_line, display_spread = display.line_s(film) if display is not None else (0.0, 0.0)
+    display_line, display_spread = display_line_s(film, options)
     line_max = 1.1 * interval / film.height + abs(display_line)
     fit = fit_bands(film, flash_hz, line_max)
     bands = fit.bands
@@ -144,7 +116,7 @@ def estimate_shutter(
             f"{fit.misfit:.0%} of their swing): check --flash-hz, the source, and that nothing else in view changes"
         )
     exposure_s = bands.exposure / fit.flash_hz
-    _check_readings(fit, duty, max_exposure_s if max_exposure_s is not None else interval)
+    _check_readings(fit, options.duty, options.max_exposure_s if options.max_exposure_s is not None else interval)
     _check_coverage(fit)
     line = bands.line_s + display_line
     line_half = math.hypot(T95 * fit.sd["line_s"], display_spread)
@@ -169,7 +141,7 @@ def estimate_shutter(
         line_time_s=0.0 if global_shutter else abs(line),
         global_shutter=global_shutter,
         readout_direction=None if global_shutter else ("top-down" if line > 0 else "bottom-up"),
-        source="light" if display is None else "display",
+        source=options.source,
         flash_hz=flash_hz,
         flash_hz_seen=fit.flash_hz,
         duty=bands.duty,
@@ -200,13 +172,9 @@ def _undecided_readout(readout: float, half: float, display_dominates: bool, exp
     return f"{known}: flash faster (up to {_fastest_flash(exposure_s, duty):.0f} Hz keeps the ramps apart) or let the light fill more rows"
 
 
-def _check_inputs(film: RowFilm, flash_hz: float, duty: float | None, max_exposure_s: float | None) -> None:
+def _check_inputs(film: RowFilm, flash_hz: float) -> None:
     if not (math.isfinite(flash_hz) and flash_hz > 0):
         raise AnalysisError(f"the flash frequency must be a positive number of Hz, not {flash_hz}")
-    if duty is not None and not 0.0 < duty < 1.0:
-        raise AnalysisError(f"the duty cycle is the share of each period the light is on, in (0, 1), not {duty}")
-    if max_exposure_s is not None and not max_exposure_s > 0:
-        raise AnalysisError(f"the longest exposure must be a positive time, not {max_exposure_s}")
     if len(film.times) < MIN_FRAMES:
         raise AnalysisError(f"the film has only {len(film.times)} frames: film the flashing light for at least {MIN_FRAMES} frames")
     gap = largest_gap(flash_hz * film.times)

@@ -23,7 +23,7 @@ from typing import Any, Callable
 import numpy as np
 
 from analysis import AnalysisError
-from analysis.shutter import DisplayScan, measure_shutter, suggest_flash_hz
+from analysis.shutter import ShutterOptions, measure_shutter, suggest_flash_hz
 from analysis.shutter.fit import largest_gap
 from rig.service import SimulationConfig, simulate
 from rig.sim.camera import CameraConfig
@@ -96,7 +96,8 @@ def case_row(grid: CalibrationGrid, fps: float, readout_s: float, exposure_s: fl
         row["simulate_s"] = time.perf_counter() - started
         started = time.perf_counter()
         try:
-            result = measure_shutter(video, flash_hz, duty=duty, display=DisplayScan(DISPLAY_HZ, "top-down", 1.0) if source == "display" else None)
+            display = {"source": "display", "display_hz": DISPLAY_HZ, "scanout_share": 1.0} if source == "display" else {}
+            result = measure_shutter(video, flash_hz, ShutterOptions(duty=duty, **display))
         except AnalysisError as error:
             return row | {"refused": str(error), "estimate_s": time.perf_counter() - started}
         row["estimate_s"] = time.perf_counter() - started

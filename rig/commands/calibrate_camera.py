@@ -10,29 +10,19 @@ import argparse
 import json
 from pathlib import Path
 
-from analysis.shutter import ShutterResult
-from analysis.shutter.estimate import SCANOUTS
+from analysis import AnalysisError
+from analysis.shutter import ShutterOptions, ShutterResult
+from analysis.shutter.options import DISPLAY_GROUP
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options
+from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.progress import ProgressBar
 from rig.service import CalibrationRequest, calibrate_camera
-from rig.service.calibrate import SOURCES
 
 
 def _run(args: argparse.Namespace) -> int:
-    request = CalibrationRequest(
-        film=args.film,
-        flash_hz=args.flash_hz,
-        source=args.source,
-        duty=args.duty,
-        display_hz=args.display_hz,
-        scanout=args.scanout,
-        scanout_share=args.scanout_share,
-        roi=args.roi,
-        fps=args.fps,
-        max_exposure_s=args.max_exposure_ms / 1e3 if args.max_exposure_ms is not None else None,
-    )
-    result = calibrate_camera(request, ProgressBar("reading the film"))
+    options = config_from_args(ShutterOptions, args, AnalysisError)
+    result = calibrate_camera(CalibrationRequest(args.film, args.flash_hz, options), ProgressBar("reading the film"))
     if args.json:
         print(json.dumps(result.to_dict()))
     else:
@@ -68,23 +58,6 @@ def result_lines(result: ShutterResult) -> list[str]:
     ]
 
 
-def _duty(text: str) -> float | None:
-    """A share of each period in (0, 1), or 'fit'."""
-    if text == "fit":
-        return None
-    value = options.positive_float(text)
-    if value >= 1.0:
-        raise argparse.ArgumentTypeError(f"a duty cycle is a share of each period below 1, or 'fit', got {text}")
-    return value
-
-
-def _share(text: str) -> float:
-    value = options.positive_float(text)
-    if value > 1.0:
-        raise argparse.ArgumentTypeError(f"a share of the refresh is at most 1, got {text}")
-    return value
-
-
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "calibrate-camera",
@@ -100,19 +73,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("film", type=Path, metavar="FILM", help="video file (mp4, avi, mov, mkv) or folder of numbered images")
     parser.add_argument("--flash-hz", type=options.positive_float, required=True, metavar="F", help="the light's flash frequency (Hz)")
-    parser.add_argument("--source", choices=SOURCES, default="light", help="what flashes: a light, or a display whose rows scan out (default: %(default)s)")
-    parser.add_argument("--duty", type=_duty, default=0.5, metavar="D",
-                        help="the share of each period the light is on, or 'fit' when not known; it tells the "
-                        "exposure from the light's on time (default: %(default)s)")  # fmt: skip
-    display = parser.add_argument_group("a flashing display", "Its own scan-out sweeps the rows, and is accounted for.")
-    display.add_argument("--display-hz", type=options.positive_float, metavar="HZ", help="the display's refresh rate")
-    display.add_argument("--scanout", choices=SCANOUTS, default="top-down", help="which way its scan-out moves in the film (default: %(default)s)")
-    display.add_argument("--scanout-share", type=_share, metavar="S",
-                         help="the share of each refresh its scan-out takes (active lines over total lines; default: "
-                         "not known, 0.88 to 1 allowed for)")  # fmt: skip
-    parser.add_argument("--roi", type=options.roi, metavar="X,Y,W,H", help="look for the flashing light only here (pixels; a display: its whole height)")
-    parser.add_argument("--fps", type=options.positive_float, help="the camera's frame rate, overriding the file's (needed for image folders)")
-    parser.add_argument("--max-exposure-ms", type=options.positive_float, metavar="MS",
-                        help="the longest the camera's exposure can be (default: a frame interval)")  # fmt: skip
+    add_declared_options(parser, ShutterOptions, {"display": DISPLAY_GROUP})
     parser.add_argument("--json", action="store_true", help="print one JSON object, times in seconds")
     parser.set_defaults(func=_run)

@@ -10,11 +10,12 @@ import re
 import pytest
 
 from analysis import AnalysisError, AnalysisOptions
+from analysis.shutter import ShutterOptions
 from declared import walk
 from rig.cli import main
 from rig.commands.declared_options import add_declared_options, config_from_args
 
-DECLARED = {"analyse": AnalysisOptions}
+DECLARED = {"analyse": AnalysisOptions, "calibrate-camera": ShutterOptions}
 
 
 def _help(capsys: pytest.CaptureFixture[str], command: str) -> str:

@@ -3,12 +3,12 @@ the exact model at 30 to 240 fps, with the flash each film's camera is told to u
 
 import pytest
 
-from analysis.shutter import estimate_shutter, film_of_frames, suggest_flash_hz
+from analysis.shutter import ShutterOptions, estimate_shutter, film_of_frames, suggest_flash_hz
 
 
 def measure(film, duty):
     frames, times = film.frames()
-    return estimate_shutter(film_of_frames(frames, times), film.flash_hz, duty=duty)
+    return estimate_shutter(film_of_frames(frames, times), film.flash_hz, ShutterOptions(duty=duty))
 
 
 def assert_within(result, film):

@@ -6,13 +6,13 @@ display whose own scan-out sweeps the rows."""
 import numpy as np
 import pytest
 
-from analysis.shutter import DisplayScan, estimate_shutter, film_of_frames, measure_shutter
+from analysis.shutter import ShutterOptions, estimate_shutter, film_of_frames, measure_shutter
 
 
-def measure(film, duty=0.25, times=None, **options):
+def measure(film, duty=0.25, times=None, flash_hz=None, **options):
     frames, true_times = film.frames()
-    return estimate_shutter(film_of_frames(frames, true_times if times is None else times, options.pop("roi", None)),
-                            options.pop("flash_hz", film.flash_hz), duty=duty, **options)  # fmt: skip
+    read = ShutterOptions(duty=duty, **options)
+    return estimate_shutter(film_of_frames(frames, true_times if times is None else times, read.roi), flash_hz or film.flash_hz, read)
 
 
 def assert_covered(result, film, readout_tolerance=0.05, exposure_tolerance=0.10):
@@ -111,7 +111,7 @@ def test_a_camera_read_from_the_bottom(flash_film):
 def test_a_display_flashing_full_field_has_its_scan_out_removed(flash_film, panel, direction):
     film = flash_film(fps=119.88, readout_s=7e-3, exposure_s=2e-3, flash_hz=30.0, duty=0.5, height=200, duration_s=2,
                       panel=panel(60.0, 30, 150, direction))  # fmt: skip
-    result = measure(film, duty=0.5, display=DisplayScan(60.0, direction, 1.0))
+    result = measure(film, duty=0.5, source="display", display_hz=60.0, scanout=direction, scanout_share=1.0)
     assert_covered(result, film)
     assert result.source == "display" and result.readout_direction == "top-down"
 
@@ -119,7 +119,7 @@ def test_a_display_flashing_full_field_has_its_scan_out_removed(flash_film, pane
 def test_a_global_shutter_filming_a_display_sees_only_the_display_scan(flash_film, panel):
     film = flash_film(fps=240, readout_s=0.0, exposure_s=1e-3, flash_hz=30.0, duty=0.5, height=200, duration_s=2,
                       panel=panel(60.0, 30, 150))  # fmt: skip
-    result = measure(film, duty=0.5, display=DisplayScan(60.0, "top-down", 1.0))
+    result = measure(film, duty=0.5, source="display", display_hz=60.0, scanout_share=1.0)
     assert result.global_shutter and result.readout_s == 0.0
     assert result.band_periods == pytest.approx(0.5 * 150 / 150, rel=0.05)
 
@@ -127,6 +127,6 @@ def test_a_global_shutter_filming_a_display_sees_only_the_display_scan(flash_fil
 def test_a_video_file_is_read_with_its_frame_times(flash_film, mjpg_file, tmp_path):
     film = flash_film(fps=120, readout_s=7e-3, exposure_s=1e-3, flash_hz=81.3, width=32)
     frames, _ = film.frames()
-    result = measure_shutter(mjpg_file(tmp_path / "flash.avi", frames, 120.0), 81.3, duty=0.25)
+    result = measure_shutter(mjpg_file(tmp_path / "flash.avi", frames, 120.0), 81.3, ShutterOptions(duty=0.25))
     assert_covered(result, film)
     assert result.frames == len(frames) and "container" in result.timing_source

@@ -5,14 +5,14 @@ import numpy as np
 import pytest
 
 from analysis import AnalysisError
-from analysis.shutter import DisplayScan, estimate_shutter, film_of_frames
+from analysis.shutter import ShutterOptions, estimate_shutter, film_of_frames
 
 
-def refusal(film, duty=0.25, frames=None, **options):
+def refusal(film, duty=0.25, frames=None, flash_hz=None, **options):
     made, times = film.frames()
     made = made if frames is None else frames
     with pytest.raises(AnalysisError) as error:
-        estimate_shutter(film_of_frames(made, times), options.pop("flash_hz", film.flash_hz), duty=duty, **options)
+        estimate_shutter(film_of_frames(made, times), flash_hz or film.flash_hz, ShutterOptions(duty=duty, **options))
     message = str(error.value)
     assert "\n" not in message
     return message
@@ -40,7 +40,7 @@ def test_a_square_wave_too_fast_for_the_frame_interval_is_refused_until_the_long
     film = flash_film(fps=240, readout_s=3.5e-3, exposure_s=0.5e-3, flash_hz=505, duty=0.5, duration_s=1)
     assert "cannot tell an exposure" in refusal(film, duty=0.5)
     frames, times = film.frames()
-    result = estimate_shutter(film_of_frames(frames, times), 505, duty=0.5, max_exposure_s=1e-3)
+    result = estimate_shutter(film_of_frames(frames, times), 505, ShutterOptions(duty=0.5, max_exposure_s=1e-3))
     assert result.exposure_s == pytest.approx(0.5e-3, rel=0.02)
 
 
@@ -85,28 +85,30 @@ def test_a_wrong_flash_frequency_is_refused(flash_film):
 def test_a_display_without_its_scan_out_share_cannot_decide_a_short_readout(flash_film, panel):
     film = flash_film(fps=240, readout_s=3.5e-3, exposure_s=4e-3, flash_hz=30.0, duty=0.5, height=200, duration_s=2,
                       panel=panel(60.0, 30, 150))  # fmt: skip
-    message = refusal(film, duty=0.5, display=DisplayScan(60.0, "top-down"))
+    message = refusal(film, duty=0.5, source="display", display_hz=60.0)
     assert "display's scan-out" in message
 
 
 def test_a_display_reaching_the_frame_s_edge_is_refused(flash_film, panel):
     film = flash_film(fps=120, readout_s=7e-3, exposure_s=2e-3, flash_hz=30.0, duty=0.5, duration_s=2, panel=panel(60.0, 0, 160))
-    assert "panel's whole height" in refusal(film, duty=0.5, display=DisplayScan(60.0, "top-down", 1.0))
+    assert "panel's whole height" in refusal(film, duty=0.5, source="display", display_hz=60.0, scanout_share=1.0)
+
+
+def test_a_flash_frequency_that_is_not_one_is_refused(flash_film):
+    assert "flash frequency must be a positive number of Hz" in refusal(flash_film(readout_s=7e-3, flash_hz=81.3), flash_hz=-5.0)
 
 
 @pytest.mark.parametrize(
     "options, words",
     [
-        ({"flash_hz": -5.0}, "flash frequency"),
-        ({"duty": 1.2}, "duty cycle"),
-        ({"max_exposure_s": 0.0}, "longest exposure"),
+        ({"duty": 1.2}, "duty must be a positive number below 1"),
+        ({"max_exposure_s": 0.0}, "max_exposure_s must be a positive number of seconds"),
+        ({"scanout": "left-right"}, "scanout must be one of top-down, bottom-up"),
+        ({"source": "display"}, "give its refresh rate (--display-hz)"),
+        ({"display_hz": 60.0}, "give --source display with it"),
     ],
 )
-def test_inputs_out_of_range_are_refused(flash_film, options, words):
-    duty = options.pop("duty", 0.25)
-    assert words in refusal(flash_film(readout_s=7e-3, flash_hz=81.3), duty=duty, **options)
-
-
-def test_a_display_described_wrongly_is_refused():
-    with pytest.raises(AnalysisError, match="scan-out must be one of"):
-        DisplayScan(60.0, "left-right")
+def test_options_out_of_range_are_refused(options, words):
+    with pytest.raises(AnalysisError) as error:
+        ShutterOptions(**options)
+    assert words in str(error.value)

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from analysis.shutter import DisplayScan, measure_shutter, suggest_flash_hz
+from analysis.shutter import ShutterOptions, measure_shutter, suggest_flash_hz
 from rig.cli import main
 from rig.errors import ConfigError
 from rig.service import SimulationConfig, simulate
@@ -65,7 +65,7 @@ def test_a_light_filmed_by_the_simulated_camera_gives_its_readout_and_exposure(t
 def test_a_display_flashing_full_field_gives_the_readout_once_its_scan_out_is_removed(tmp_path, fps, readout_share, exposure_share):
     readout, exposure = readout_share / fps, exposure_share / fps
     video = film(tmp_path, fps, readout, exposure, FlashTarget("display", refreshes=2), layout=TALL_PANEL)
-    result = measure_shutter(video, 30.0, display=DisplayScan(60.0, "top-down", 1.0))
+    result = measure_shutter(video, 30.0, ShutterOptions(source="display", display_hz=60.0, scanout_share=1.0))
     assert_measured(result, readout, exposure)
     assert result.source == "display"
 
