@@ -49,9 +49,9 @@ RAMPS_MEET = 0.85
 DUTY_TOLERANCE = 0.03
 # An exposure this much over the longest the camera can take is still possible (timing rounding).
 EXPOSURE_SLACK = 1.02
-# A rolling shutter's readout known no better than this share (95 %), or a global shutter's bound
-# above this share of the frame interval, is not an answer.
-MAX_READOUT_SPREAD = 0.25
+# A rolling shutter's readout or an exposure known no better than this share (95 %), or a global
+# shutter's bound above this share of the frame interval, is not an answer.
+MAX_SPREAD = 0.25
 # Without the display's scan-out share, it is taken to lie in this range.
 SCANOUT_SHARES = (0.88, 1.0)
 # A display panel's height in the film is known to this many rows (95 %): its edges are placed to
@@ -119,15 +119,24 @@ def estimate_shutter(film: RowFilm, flash_hz: float, options: ShutterOptions = S
     _check_readings(fit, options.duty, options.max_exposure_s if options.max_exposure_s is not None else interval)
     _check_coverage(fit)
     line = bands.line_s + display_line
-    line_half = math.hypot(T95 * fit.sd["line_s"], display_spread)
+    causes = {"bands": T95 * fit.sd["line_s"], "display": display_spread, "drift": fit.spread["line_s"]}
+    line_half = math.hypot(causes["bands"], causes["display"]) + causes["drift"]
     readout = abs(line) * film.height
     readout_half = max(line_half * film.height, READOUT_FLOOR * readout, SWITCHING_S)
     global_shutter = bool(readout <= readout_half)
-    if global_shutter and readout + readout_half > MAX_READOUT_SPREAD * interval:
-        raise AnalysisError(_undecided_readout(0.0, readout + readout_half, display_spread > T95 * fit.sd["line_s"], exposure_s, bands.duty))
-    if not global_shutter and readout_half > MAX_READOUT_SPREAD * readout:
-        raise AnalysisError(_undecided_readout(readout, readout_half, display_spread > T95 * fit.sd["line_s"], exposure_s, bands.duty))
-    exposure_half = max(T95 * fit.sd["exposure_s"], EXPOSURE_FLOOR * exposure_s, SWITCHING_S)
+    cause = max(causes, key=lambda name: causes[name])
+    advice = _advice(cause, flash_hz, interval, exposure_s, bands.duty)
+    if global_shutter and readout + readout_half > MAX_SPREAD * interval:
+        raise AnalysisError(f"the readout is only known to be below {(readout + readout_half) * 1e3:.2f} ms{advice}")
+    if not global_shutter and readout_half > MAX_SPREAD * readout:
+        raise AnalysisError(f"the readout is only known to be {readout * 1e3:.2f} +- {readout_half * 1e3:.2f} ms{advice}")
+    exposure_half = max(T95 * fit.sd["exposure_s"], EXPOSURE_FLOOR * exposure_s, SWITCHING_S) + fit.spread["exposure_s"]
+    if exposure_half > MAX_SPREAD * exposure_s:
+        drifting = fit.spread["exposure_s"] > T95 * fit.sd["exposure_s"]
+        raise AnalysisError(
+            f"the exposure is only known to be {exposure_s * 1e3:.2f} +- {exposure_half * 1e3:.2f} ms"
+            f"{_advice('drift' if drifting else 'bands', flash_hz, interval, exposure_s, bands.duty)}"
+        )
     # Frames whose times are off blur the ramps, so the exposure may be shorter by about that spread.
     timing_off = fit.timing_rms_s > TIMING_SHARE * exposure_s
     exposure_low = exposure_s - exposure_half - (TIMING_WIDENING * fit.timing_rms_s if timing_off else 0.0)
@@ -160,16 +169,20 @@ def estimate_shutter(film: RowFilm, flash_hz: float, options: ShutterOptions = S
     )
 
 
-def _undecided_readout(readout: float, half: float, display_dominates: bool, exposure_s: float, duty: float) -> str:
-    """Why the readout is not decided (known to ``readout`` +- ``half``; below ``half`` where
-    ``readout`` is 0), and what to change."""
-    known = f"the readout is only known to be {readout * 1e3:.2f} +- {half * 1e3:.2f} ms" if readout > 0 else f"the readout is only known to be below {half * 1e3:.2f} ms"
-    if display_dominates:
+def _advice(cause: str, flash_hz: float, interval: float, exposure_s: float, duty: float) -> str:
+    """What to change where ``cause`` ("bands", "display" or "drift") leaves a figure undecided."""
+    if cause == "display":
         return (
-            f"{known}, most of that from the display's scan-out: give the share of each refresh its scan-out takes, "
+            ", most of that from the display's scan-out: give the share of each refresh its scan-out takes, "
             "film the panel taller in the frame, or film a flashing light instead"
         )
-    return f"{known}: flash faster (up to {_fastest_flash(exposure_s, duty):.0f} Hz keeps the ramps apart) or let the light fill more rows"
+    if cause == "drift":
+        return (
+            f": {flash_hz:g} Hz drifts so slowly against a multiple of {0.5 / interval:g} Hz (half the frame rate) "
+            "that its exact frequency and the bands' slope cannot be told apart; film longer, or choose a flash "
+            f"frequency further from it (such as {_unlocked_flash(flash_hz, interval):.1f} Hz)"
+        )
+    return f": flash faster (up to {_fastest_flash(exposure_s, duty):.0f} Hz keeps the ramps apart) or let the light fill more rows"
 
 
 def _check_inputs(film: RowFilm, flash_hz: float) -> None:

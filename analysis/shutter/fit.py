@@ -19,6 +19,7 @@ jackknife over blocks of frames: the spread of the fit when each block is left o
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -44,6 +45,10 @@ MIN_RAMP_ROWS = 3
 DUTY_BOUNDS = (0.01, 0.99)
 EXPOSURE_BOUNDS = (1e-4, 0.999)
 MAX_ITERATIONS = 100
+# The flash frequency's profile: held at these shares of its range, a fit whose cost is within this
+# many residual variances of the best explains the film as well.
+PROFILE_POINTS = (-1.0, -0.5, 0.5, 1.0)
+PROFILE_CHI2 = 10.0
 # Exposures a fit may start from, as shares of the shorter of the light's on and off times, and
 # row frequencies, in steps of the Fourier grid's about each peak's.
 EXPOSURE_STARTS = np.array([0.03, 0.1, 0.2, 0.35, 0.5, 0.7])
@@ -69,11 +74,14 @@ class BandFit:
     rows (``misfit``: the residual's RMS over the rows' swing), the largest gap between the phases
     the frames caught the flash at (cycles, at the middle row), how many frames caught the light switching in at least
     MIN_RAMP_ROWS rows, and the frames' times against the bands' (``timing_rms_s``: the robust RMS
-    of the shift that best fits each such frame alone)."""
+    of the shift that best fits each such frame alone). ``spread`` is how far the line time and the
+    exposure can move (each way, s) while the flash frequency seen moves within its range and the
+    fit stays as good (see ``_frequency_profile``): 0 where the film pins the frequency."""
 
     bands: Bands
     flash_hz: float
     sd: dict[str, float]
+    spread: dict[str, float]
     misfit: float
     phase_gap: float
     ramp_frames: int
@@ -96,6 +104,13 @@ class _Data:
         reach = self.nu_max * self.span_s
         self.lower = np.array([-np.inf, -reach, -np.inf, DUTY_BOUNDS[0], EXPOSURE_BOUNDS[0]])
         self.upper = np.array([np.inf, reach, np.inf, DUTY_BOUNDS[1], EXPOSURE_BOUNDS[1]])
+
+    def holding_nu(self, nu_hz: float) -> _Data:
+        """The same samples, the flash frequency seen held at the given one plus ``nu_hz``."""
+        held = copy.copy(self)
+        held.lower, held.upper = self.lower.copy(), self.upper.copy()
+        held.lower[1] = held.upper[1] = nu_hz * self.span_s
+        return held
 
     def to_x(self, bands: Bands) -> np.ndarray:
         """Parameters of order one: band cycles across the rows, cycles gained over the film, psi,
@@ -154,6 +169,7 @@ def fit_bands(film: RowFilm, flash_hz: float, line_max_s: float) -> BandFit:
     fits = [_refine(data, start) for start in _starts(data, line_max_s)]
     best = min(fits, key=lambda pair: pair[1])[0]
     best = _positive_gain(data, best)
+    spread = _frequency_profile(data, best)
     replicates = [_refine(_Data(film, keep, flash_hz), best)[0] for keep in _leave_one_block_out(len(film.times))]
     g = data.model(best)
     dark, gain = data.rows_fit(g)
@@ -164,6 +180,7 @@ def fit_bands(film: RowFilm, flash_hz: float, line_max_s: float) -> BandFit:
         bands=best,
         flash_hz=flash_hz + best.nu_hz,
         sd=_jackknife_sd(best, replicates, flash_hz),
+        spread=spread,
         misfit=misfit,
         phase_gap=largest_gap((flash_hz + best.nu_hz) * data.t - best.phase),
         ramp_frames=int(informative.sum()),
@@ -214,18 +231,21 @@ def _symmetric_grid(largest: float, step: float) -> np.ndarray:
 
 
 def _refine(data: _Data, start: Bands) -> tuple[Bands, float]:
-    """Levenberg-Marquardt from ``start`` within the parameters' bounds; the bands and the cost."""
+    """Levenberg-Marquardt from ``start`` within the parameters' bounds (a parameter whose bounds
+    meet is held); the bands and the cost."""
     x = np.clip(data.to_x(start), data.lower, data.upper)
     residuals, jacobian = data.residuals(x, jacobian=True)
     cost = float(np.sum(residuals**2))
     damping = 1e-3
+    free = data.upper > data.lower
     for _ in range(MAX_ITERATIONS):
         assert jacobian is not None
-        flat = jacobian.reshape(len(x), -1)
+        flat = jacobian.reshape(len(x), -1)[free]
         normal = flat @ flat.T
         gradient = flat @ residuals.ravel()
         while damping < 1e10:
-            step = np.linalg.solve(normal + damping * np.diag(np.diag(normal) + 1e-12), -gradient)
+            step = np.zeros_like(x)
+            step[free] = np.linalg.solve(normal + damping * np.diag(np.diag(normal) + 1e-12), -gradient)
             trial = np.clip(x + step, data.lower, data.upper)
             trial_residuals, _ = data.residuals(trial)
             trial_cost = float(np.sum(trial_residuals**2))
@@ -249,6 +269,26 @@ def _positive_gain(data: _Data, bands: Bands) -> Bands:
     if np.median(gain) >= 0:
         return bands
     return _refine(data, replace(bands, phase=bands.phase + bands.duty, duty=1.0 - bands.duty))[0]
+
+
+def _frequency_profile(data: _Data, best: Bands) -> dict[str, float]:
+    """How far the line time and the exposure move (the largest change either way, s) among fits
+    with the flash frequency held at PROFILE_POINTS across its range that explain the film as well
+    as the best (cost within PROFILE_CHI2 residual variances). A flash that only drifts slowly
+    against a multiple of half the frame rate shows the same film for a range of frequencies, each
+    with its own line time and exposure; a film that pins the frequency leaves 0."""
+    x = data.to_x(best)
+    residuals, _ = data.residuals(x)
+    cost = float(np.sum(residuals**2))
+    variance = cost / max(residuals.size - len(x), 1)
+    spread = {"line_s": 0.0, "exposure_s": 0.0}
+    for share in PROFILE_POINTS:
+        nu = share * data.nu_max
+        bands, trial = _refine(data.holding_nu(nu), replace(best, nu_hz=nu))
+        if trial - cost <= PROFILE_CHI2 * variance:
+            spread["line_s"] = max(spread["line_s"], abs(bands.line_s - best.line_s))
+            spread["exposure_s"] = max(spread["exposure_s"], abs(bands.exposure / (data.flash_hz + bands.nu_hz) - best.exposure / (data.flash_hz + best.nu_hz)))
+    return spread
 
 
 def _leave_one_block_out(count: int) -> list[np.ndarray]:

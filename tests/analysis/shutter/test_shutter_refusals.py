@@ -77,6 +77,15 @@ def test_bands_that_only_alternate_are_refused(flash_film):
     assert "too few phases" in message and "such as 165.8 Hz" in message
 
 
+def test_a_flash_drifting_slowly_against_half_the_frame_rate_is_refused(flash_film, panel):
+    # 14.925 Hz at 30 fps: odd frames see the complement of even ones, and the pattern only drifts by
+    # 0.9 of a period over 6 s; flash frequencies 0.06 % apart fit as well, with readouts 27 to 33 ms.
+    film = flash_film(fps=30, readout_s=31.67e-3, exposure_s=4.17e-3, flash_hz=59.7 / 4, duty=0.5, duration_s=6, height=240,
+                      width=16, panel=panel(59.7, 29, 182))  # fmt: skip
+    message = refusal(film, duty=0.5, source="display", display_hz=59.7, scanout_share=1.0)
+    assert "only known to be" in message and "film longer" in message
+
+
 def test_a_wrong_flash_frequency_is_refused(flash_film):
     message = refusal(flash_film(readout_s=7e-3, flash_hz=81.3), flash_hz=95.0)
     assert "do not follow a light flashing at 95 Hz" in message
