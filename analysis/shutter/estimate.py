@@ -5,12 +5,12 @@ The bands are fitted (``analysis.shutter.fit``); then what the fit found is read
 - A display flashing full-field (``ShutterOptions.source``) scans its rows out too, so the bands
   move at the difference of the camera's and the display's row rates: the display's time per
   camera row (its scan-out time over the panel's height in the film, signed by its direction) is
-  added back. The scan-out time
-  is the refresh period's share the lab gives, or 88 to 100 % of it (the range of common video
-  timings' vertical blanking), in the interval either way.
-- The readout's interval is the jackknife's 95 % (Student's t) with the display's terms beside;
-  where it holds 0 the camera has a global shutter, and the answer is readout 0 with the interval's
-  top as its bound.
+  added back. The scan-out time is the refresh period's share the lab gives, or 88 to 100 % of it
+  (the range of common video timings' vertical blanking), in the interval either way.
+- The readout's interval is the jackknife's 95 % (Student's t) with the display's terms beside,
+  plus the line times of the equally good fits at other flash frequencies the film allows; where
+  it holds 0 the camera has a global shutter, and the answer is readout 0 with the interval's top
+  as its bound.
 - The exposure is the ramps' length, but a film cannot tell it from three other readings of the
   same trapezoid (``analysis.shutter.model.other_readings``). Each is ruled out by the light's duty
   cycle, when given, or by the longest exposure the camera can have (the frame interval, or the
@@ -28,7 +28,7 @@ from typing import Callable
 import numpy as np
 
 from analysis.errors import AnalysisError
-from analysis.shutter.film import Rect, RowFilm, read_film
+from analysis.shutter.film import RowFilm, read_film
 from analysis.shutter.fit import T95, BandFit, fit_bands, largest_gap
 from analysis.shutter.model import LONGER_THAN_BOTH, Reading, other_readings
 from analysis.shutter.options import ShutterOptions
@@ -178,9 +178,9 @@ def _advice(cause: str, flash_hz: float, interval: float, exposure_s: float, dut
         )
     if cause == "drift":
         return (
-            f": {flash_hz:g} Hz drifts so slowly against a multiple of {0.5 / interval:g} Hz (half the frame rate) "
-            "that its exact frequency and the bands' slope cannot be told apart; film longer, or choose a flash "
-            f"frequency further from it (such as {_unlocked_flash(flash_hz, interval):.1f} Hz)"
+            f": {flash_hz:g} Hz is so near a simple fraction of the frame rate that the bands only drift, and its "
+            "exact frequency and the bands' slope cannot be told apart; film longer, or choose a flash frequency "
+            f"whose phase moves on by about a third of a period each frame (such as {_unlocked_flash(flash_hz, interval):.1f} Hz)"
         )
     return f": flash faster (up to {_fastest_flash(exposure_s, duty):.0f} Hz keeps the ramps apart) or let the light fill more rows"
 

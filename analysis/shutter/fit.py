@@ -45,9 +45,9 @@ MIN_RAMP_ROWS = 3
 DUTY_BOUNDS = (0.01, 0.99)
 EXPOSURE_BOUNDS = (1e-4, 0.999)
 MAX_ITERATIONS = 100
-# The flash frequency's profile: held at these shares of its range, a fit whose cost is within this
-# many residual variances of the best explains the film as well.
-PROFILE_POINTS = (-1.0, -0.5, 0.5, 1.0)
+# The flash frequency's profile: held this many steps across its whole range, a fit whose cost is
+# within this many residual variances of the best explains the film as well.
+PROFILE_STEPS = 16
 PROFILE_CHI2 = 10.0
 # Exposures a fit may start from, as shares of the shorter of the light's on and off times, and
 # row frequencies, in steps of the Fourier grid's about each peak's.
@@ -272,22 +272,29 @@ def _positive_gain(data: _Data, bands: Bands) -> Bands:
 
 
 def _frequency_profile(data: _Data, best: Bands) -> dict[str, float]:
-    """How far the line time and the exposure move (the largest change either way, s) among fits
-    with the flash frequency held at PROFILE_POINTS across its range that explain the film as well
-    as the best (cost within PROFILE_CHI2 residual variances). A flash that only drifts slowly
-    against a multiple of half the frame rate shows the same film for a range of frequencies, each
-    with its own line time and exposure; a film that pins the frequency leaves 0."""
+    """How far the line time and the exposure move (the largest change either way, s) along fits
+    that explain the film as well as the best (cost within PROFILE_CHI2 residual variances) with the
+    flash frequency held further and further from the best's, PROFILE_STEPS steps across its range
+    each way, each fit starting from the last. A flash that only drifts slowly against a simple
+    fraction of the frame rate shows the same film for a range of frequencies, each with its own
+    line time and exposure; a film that pins the frequency leaves 0."""
     x = data.to_x(best)
     residuals, _ = data.residuals(x)
     cost = float(np.sum(residuals**2))
-    variance = cost / max(residuals.size - len(x), 1)
+    limit = cost + PROFILE_CHI2 * cost / max(residuals.size - len(x), 1)
+    exposure = best.exposure / (data.flash_hz + best.nu_hz)
     spread = {"line_s": 0.0, "exposure_s": 0.0}
-    for share in PROFILE_POINTS:
-        nu = share * data.nu_max
-        bands, trial = _refine(data.holding_nu(nu), replace(best, nu_hz=nu))
-        if trial - cost <= PROFILE_CHI2 * variance:
+    for direction in (-1.0, 1.0):
+        bands = best
+        for step in range(1, PROFILE_STEPS + 1):
+            nu = best.nu_hz + direction * step * data.nu_max / PROFILE_STEPS * 2.0
+            if abs(nu) > data.nu_max:
+                break
+            bands, trial = _refine(data.holding_nu(nu), replace(bands, nu_hz=nu))
+            if trial > limit:
+                break
             spread["line_s"] = max(spread["line_s"], abs(bands.line_s - best.line_s))
-            spread["exposure_s"] = max(spread["exposure_s"], abs(bands.exposure / (data.flash_hz + bands.nu_hz) - best.exposure / (data.flash_hz + best.nu_hz)))
+            spread["exposure_s"] = max(spread["exposure_s"], abs(bands.exposure / (data.flash_hz + nu) - exposure))
     return spread
 
 
