@@ -34,11 +34,11 @@ def add_camera_calibration(benchmarks: argparse._SubParsersAction) -> None:
     parser = benchmarks.add_parser(
         "camera-calibration",
         help="rig calibrate-camera's readout and exposure error on simulated films, 30 to 240 fps",
-        description="Film a flashing light (50 %% and 25 %% duty) and a display flashing full-field with the simulated "
-        "camera at 30, 60, 120 and 240 fps, readouts of 0 (a global shutter) to 95 %% of the frame interval and "
+        description="Film a flashing light (50 % and 25 % duty) and a display flashing full-field with the simulated "
+        "camera at 30, 60, 120 and 240 fps, readouts of 0 (a global shutter) to 95 % of the frame interval and "
         "exposures of an eighth to a whole frame interval, measure each film as `rig calibrate-camera` does, and "
-        "report per source the readout's and the exposure's error, the refusals, how many are within 5 %% and 10 %% "
-        "and how many 95 %% intervals hold the truth, and the seconds per film. About 15 minutes on two cores; "
+        "report per source the readout's and the exposure's error, the refusals, how many are within 5 % and 10 % "
+        "and how many 95 % intervals hold the truth, and the seconds per film. About 15 minutes on two cores; "
         "--quick films four small cases.",
     )
     parser.add_argument("--json", type=outputs.json_file, metavar="OUT.json", help="write the summaries and every film's row as JSON")

@@ -65,8 +65,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description="Film a light flashing at a known frequency (an LED lighting a white card, or out of focus so "
         "that it fills the view), or a display flashing full-field, for a few seconds; this measures the "
         "camera's rolling-shutter readout (0 for a global shutter) and its exposure from the bands the flash "
-        "draws, each with its 95 %% interval. Choose the flash frequency so that the exposure is shorter than "
-        "half the time the light is on and off; with a 50 %% duty cycle, also so that a period less the "
+        "draws, each with its 95 % interval. Choose the flash frequency so that the exposure is shorter than "
+        "half the time the light is on and off; with a 50 % duty cycle, also so that a period less the "
         "exposure is longer than the frame interval (or give --max-exposure-ms); and so that it is no simple "
         "fraction of the frame rate. Exit status: 0 clean, 3 with warnings, 2 when the film cannot decide "
         "(the message says what to change).",
