@@ -24,6 +24,7 @@ def _methods() -> tuple[str, ...]:
 
 
 def _increasing(pair: tuple[float, float]) -> str | None:
+    """LOW below HIGH."""
     return None if pair[0] < pair[1] else "LOW must be below HIGH"
 
 

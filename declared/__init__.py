@@ -6,14 +6,16 @@ import another's declarations, so the primitive lives here, importing nothing of
 
 * `Range` (`declared.ranges`): the numbers allowed, and how they read in a message;
 * `setting(default, unit, help, range, flag=...)` declares a dataclass field (`declared.settings`);
-  the dataclass's `__post_init__` calls `check(self, ErrorType)`, and `walk(kind)` lists a config's
-  settings, nested configs included, for the command line and the docs tables;
+  the dataclass's `__post_init__` calls `check(self, ErrorType)`, `like(kind, name)` holds the same
+  setting in a second dataclass, and `walk(kind)` lists a config's settings, nested configs
+  included, for the command line and the docs tables;
 * `from_table(kind, table, ErrorType)` (`declared.tables`) reads a spec's table into the dataclass,
-  every key and type checked.
+  every key and type checked;
+* `declared.docs.markdown_table(kind)` is the docs' table of a config's settings.
 """
 
 from declared.ranges import ANY, FRACTION, NON_NEGATIVE, OPEN_UNIT, POSITIVE, Range
-from declared.settings import Entry, Flag, Setting, check, setting, setting_of, walk
+from declared.settings import Entry, Flag, Setting, check, like, setting, setting_of, walk
 from declared.tables import from_table, words
 
 __all__ = [
@@ -28,6 +30,7 @@ __all__ = [
     "Setting",
     "check",
     "from_table",
+    "like",
     "setting",
     "setting_of",
     "walk",

@@ -25,7 +25,8 @@ class Flag:
     a setting in seconds given in ms). per: the option is the setting x this sibling setting (an
     exposure in seconds given as a fraction of the frame interval: exposure x fps). range, default:
     the option's, where they are not the setting's own converted (None: they are; needed with
-    `per`). group: the title of the --help section it is listed in ("" for the command's main one).
+    `per`). help: the option's, where it is not the setting's. group: the title of the --help
+    section it is listed in ("" for the command's main one).
     """
 
     name: str
@@ -35,6 +36,7 @@ class Flag:
     range: Range | None = None
     default: Any = None
     metavar: str | None = None
+    help: str = ""
     group: str = ""
 
 
@@ -43,7 +45,7 @@ class Setting:
     """What a setting means to a user.
 
     unit: as a message reads it ("seconds", "Hz"); "" for a pure number or a name.
-    help: one line for --help and the docs tables; where the default is None it says what None does.
+    help: one line for --help and the docs tables.
     range: the numbers allowed (for a list, each item's). choices: the names allowed, or a function
     that lists them when asked (a registry that grows). rule: a check of the whole value, giving a
     sentence saying what is wrong or None ("LOW must be below HIGH").
@@ -83,12 +85,21 @@ class Setting:
 def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
+
 def setting(default: Any, unit: str, help: str, range: Range | None = None, *, flag: str | Flag | None = None,
             **declared: Any) -> Any:  # fmt: skip
     """A dataclass field with its `Setting` (`declared`: choices, rule, none, unset); `flag` the option's
     name, or a `Flag` where the option differs from the setting."""
     flag = Flag(flag) if isinstance(flag, str) else flag
     return dataclasses.field(default=default, metadata={_KEY: Setting(unit, help, range, flag=flag, **declared)})
+
+
+def like(kind: type, name: str, **changes: Any) -> Any:
+    """A field declared as the field `name` of the dataclass `kind` is, with its default: the same
+    setting held in a second place (`changes` to its `Setting`, such as a flag of its own)."""
+    field = next(field for field in dataclasses.fields(kind) if field.name == name)
+    declared = dataclasses.replace(setting_of(field), **changes)
+    return dataclasses.field(default=field.default, metadata={_KEY: declared})
 
 
 def setting_of(field: dataclasses.Field) -> Setting | None:

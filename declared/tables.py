@@ -2,7 +2,7 @@
 checked against the fields, so that a typo or a wrong type is one line naming the key.
 
 Numbers, strings and booleans are themselves; a tuple field is an array (a tuple of tuples, an
-array of arrays); a nested dataclass is a table; a dict field is a table taken as it is; a field
+array of arrays); a nested dataclass is a table (or, from Python, the dataclass); a dict field is a table taken as it is; a field
 that may be None is None by leaving its key out (TOML has no null), or by its setting's `none` word
 where the default is not None ("measured"); None itself, from Python, where the field may hold
 it. The values are then checked by the dataclass itself
@@ -47,6 +47,8 @@ def _value(hint: Any, declared: Setting | None, value: Any, key: str, at: str, e
         return None
     origin, args = typing.get_origin(hint), typing.get_args(hint)
     if dataclasses.is_dataclass(hint):
+        if isinstance(value, hint):
+            return value
         if not isinstance(value, Mapping):
             raise error(f"{at}{key} must be {words(hint, declared)}, not {value!r}")
         return from_table(hint, value, error, at.removesuffix(": "), f"{key}.")

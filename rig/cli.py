@@ -21,6 +21,7 @@ import importlib
 import os
 import re
 import sys
+import textwrap
 import traceback
 from typing import NoReturn, Sequence
 
@@ -61,7 +62,11 @@ EXIT_TERMINATED = 143
 
 class ListingFormatter(argparse.HelpFormatter):
     """Wraps help text as argparse does, except a paragraph that lists choices (lines indented by
-    two spaces after its title), which keeps a line per choice."""
+    two spaces after its title), which keeps a line per choice, and never inside a hyphenated word
+    (an option's or a layout's name reads whole)."""
+
+    def _split_lines(self, text: str, width: int) -> list[str]:
+        return textwrap.wrap(" ".join(text.split()), width, break_on_hyphens=False)
 
     def _fill_text(self, text: str, width: int, indent: str) -> str:
         return "\n\n".join(

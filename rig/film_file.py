@@ -1,4 +1,4 @@
-"""The files a camera's film may be written to: an MJPEG AVI (`rig.records.VideoRecord`, frame i at
+"""The files a camera's film may be written to: an MJPEG AVI (`rig.writers.VideoRecord`, frame i at
 i / fps), or H.264 or HEVC in an MP4 or a MOV, as phones record, written through PyAV
 (`StampedVideoRecord`), where every frame carries its own presentation time.
 
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from rig.errors import ConfigError, RigError
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 
 CONTAINERS = ("avi", "mp4", "mov")
 CODECS = ("mjpeg", "h264", "hevc")
@@ -70,7 +70,7 @@ class StampedVideoRecord:
     def __init__(self, path: str | os.PathLike[str], container: str, codec: str, fps: float, width: int, height: int) -> None:
         check_film_format(container, codec, stamped=False)
         if container not in STAMPED_CONTAINERS:
-            raise ConfigError(f"an {container} film is written by rig.records.VideoRecord, not with timestamps")
+            raise ConfigError(f"an {container} film is written by rig.writers.VideoRecord, not with timestamps")
         import av  # here: only a run writing such a film loads FFmpeg
 
         self.path = Path(path)

@@ -15,7 +15,7 @@ CSV file per kind of event, and `load_table` to read them back.
 
 board_tick counts the board's clock, TICK_HZ ticks a second, from its reset; board_time_s is the
 same instant in seconds. rig_time_s is the rig clock through the clock sync known at that moment
-(sync.csv holds every interval, to convert again later). The writer (rig.board.recording) flushes
+(sync.csv holds every interval, to convert again later). The writer (rig.board.recorder) flushes
 the files after each batch of events, so a recording cut short is still readable.
 """
 

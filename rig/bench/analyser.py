@@ -1,21 +1,26 @@
-"""The analyser bench (`rig bench analyser`): each estimator's error, interval coverage, confidently
-wrong answers and speed on videos of known latency.
+"""`rig bench analyser`: simulate videos of known latency over two grids, analyse each with every
+method, and report per method the median and worst error, the coverage of the 95 % intervals, the
+confidently wrong answers (truth outside the interval by more than max(0.5 ms, its half-width)),
+the refusals and the speed against decoding alone. The mixed grid spans periods, frame rates,
+refresh rates, swings, damping and impairments; the hard grid, what goes wrong in a lab: camera
+rates that lock to the display's, short exposures, a dim LED or sphere, swapped sides, a second
+bright object, a partly hidden blob, decimated films. Both take about forty minutes on two cores;
+--quick runs three tiny cases. The cases are a sweep: `rig sweep` on its spec gives the same
+summary rows.
 
 The bench is a sweep (`rig.service.sweep`) with a fixed spec, `specs/analyser.toml` (three tiny
-cases in `specs/analyser-quick.toml`): the mixed grid of pendulums, rates, swings and impairments,
-and the hard grid of what goes wrong in a lab (camera and display rates that lock, short
-exposures, a dim LED, swapped sides, a bar across a blob's path, decimated films), written out
-point by point; the impairments are the simulated camera's (`rig.sim.impairments`). Each point is
-simulated and analysed as `rig sweep` does it, giving the sweep's summary row; the bench then
-analyses the same film with every method and adds its record of the case to the row ("bench").
-Errors are against the simulation's true latency, in ms and in the film's frame intervals;
-coverage is the fraction of cases whose 95 % interval holds the truth (methods without intervals
-have none); a *confidently wrong* answer is one whose interval misses the truth by more than
-max(WRONG_MS, its half-width), or, for a method without an interval, whose number is off by more
-than WRONG_MS. Cases the analyser refuses (the sweep's row failed: it cannot tell the LED from the
-sphere) give no number and are counted apart, as are cases flagged ambiguous (left out of the
-error statistics). Accuracy is also summarised over the cases whose camera is not phase-locked to
-the display (the refreshes walk through the frames), where the target is today's.
+cases in `specs/analyser-quick.toml`), its points written out one by one; the impairments are the
+simulated camera's (`rig.sim.impairments`). Each point is simulated and analysed as `rig sweep` does
+it, giving the sweep's summary row; the bench then analyses the same film with every method and adds
+its record of the case to the row ("bench"). Errors are against the simulation's true latency, in ms
+and in the film's frame intervals; coverage is the fraction of cases whose 95 % interval holds the
+truth (methods without intervals have none); a *confidently wrong* answer is one whose interval
+misses the truth by more than max(WRONG_MS, its half-width), or, for a method without an interval,
+whose number is off by more than WRONG_MS. Cases the analyser refuses (the sweep's row failed: it
+cannot tell the LED from the sphere) give no number and are counted apart, as are cases flagged
+ambiguous (left out of the error statistics). Accuracy is also summarised over the cases whose
+camera is not phase-locked to the display (the refreshes walk through the frames), where the target
+is today's.
 
 Speed: the sweep's analysis (sinefit) runs first and is the warm-up; the film is then decoded
 alone (the fastest the analyser's own reader can go, nothing else done), analysed with every method
@@ -27,18 +32,20 @@ machine touches the ratio less.
 
 from __future__ import annotations
 
+import argparse
 import time
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 import analysis
 from analysis.sampling.model import commensurate
 from analysis.video.sources import open_frames
-from rig.service.sweep import Sweep, SweepPoint, run_point, run_sweep
+from rig.bench.contract import Bench, Context, Log, SpecFile, cell
+from rig.service.sweep import Sweep, SweepPoint, read_sweep, run_point, run_sweep
 from rig.sim.config import SimulationConfig
 
 SPECS = Path(__file__).parent / "specs"
@@ -55,8 +62,6 @@ TARGETS = {
 }
 WRONG_MS = 0.5
 GROUPS = {"all": ("mixed", "named", "hard"), "mixed": ("mixed", "named"), "hard": ("hard",)}
-
-Log = Callable[[str], None]
 
 
 def decode_seconds(video: Path) -> tuple[float, int]:
@@ -235,9 +240,6 @@ def targets_met(summaries: dict[str, dict[str, dict[str, Any]]]) -> dict[str, bo
 def table(summary: dict[str, dict[str, Any]]) -> str:
     """A summary as a Markdown table (the README's)."""
 
-    def cell(value: Any, digits: int) -> str:
-        return "-" if value is None else f"{value:.{digits}f}"
-
     lines = [
         "| method | median abs error (ms / frames) | worst abs error (ms / frames) | 95% coverage | confidently wrong | "
         "refused | analysis fps | speed vs decoding |",
@@ -246,10 +248,10 @@ def table(summary: dict[str, dict[str, Any]]) -> str:
     for name, s in summary.items():
         coverage = "-" if s["coverage"] is None else f"{s['coverage']:.0%} of {s['intervals']}"
         lines.append(
-            f"| {name} | {cell(s['median_abs_error_ms'], 3)} / {cell(s['median_abs_error_frames'], 3)} | "
-            f"{cell(s['worst_abs_error_ms'], 3)} / {cell(s['worst_abs_error_frames'], 3)} | {coverage} | "
-            f"{s['confidently_wrong']} of {s['unambiguous']} | {s['refused']} | {cell(s['analysis_fps'], 0)} | "
-            f"x{cell(s['speed_ratio'], 2)} |"
+            f"| {name} | {cell(s['median_abs_error_ms'], '.3f')} / {cell(s['median_abs_error_frames'], '.3f')} | "
+            f"{cell(s['worst_abs_error_ms'], '.3f')} / {cell(s['worst_abs_error_frames'], '.3f')} | {coverage} | "
+            f"{s['confidently_wrong']} of {s['unambiguous']} | {s['refused']} | {cell(s['analysis_fps'], '.0f')} | "
+            f"x{cell(s['speed_ratio'], '.2f')} |"
         )
     return "\n".join(lines)
 
@@ -289,29 +291,56 @@ def plot(summary: dict[str, dict[str, Any]], rows: list[dict[str, Any]], path: P
     figure.savefig(path, dpi=110)
 
 
-def run_bench(
-    sweep: Sweep,
-    folder: Path,
-    log: Log,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    groups: tuple[str, ...] = GROUPS["all"],
-) -> dict[str, Any]:
-    """The sweep's points of `groups` (a point's "group" label; none is "mixed") run as a sweep into
-    `folder` (serially or on Dask, `rig.executor`), each measured by `measure_point`: the sweep's
-    rows ("sweep", and folder/summary.csv), the bench's record of every case in their order
-    ("cases"), the summaries per group of cases (GROUPS) and the targets. On Dask, speed ratios are
-    taken with the workers sharing the cores."""
-    chosen = sweep if groups == GROUPS["all"] else sweep.only(lambda labels: labels.get("group", "mixed") in groups)
+def of_groups(sweep: Sweep, grid: str) -> Sweep:
+    """The sweep's points of one of GROUPS (by a point's "group" label; none is "mixed")."""
+    return sweep if grid == "all" else sweep.only(lambda labels: labels.get("group", "mixed") in GROUPS[grid])
+
+
+def run(sweep: Sweep, context: Context) -> dict[str, Any]:
+    """The sweep's points run as a sweep into the context's folder (serially or on Dask,
+    `rig.executor`), each measured by `measure_point`: the sweep's rows ("sweep", and
+    folder/summary.csv), the bench's record of every case in their order ("cases"), the summaries
+    per group of cases (GROUPS), the targets and the time taken. On Dask, speed ratios are taken
+    with the workers sharing the cores."""
+    started = time.perf_counter()
 
     def progress(done: float, total: float) -> None:
-        log(f"[{done}/{total} cases]")
+        context.log(f"[{done}/{total} cases]")
 
-    rows, _ = run_sweep(chosen, folder, workers, scheduler, progress, overwrite=True, job=partial(measure_point, log=log))
+    job = partial(measure_point, log=context.log)
+    rows, _ = run_sweep(sweep, context.folder, context.workers, context.scheduler, progress, overwrite=True, job=job)
     cases = [row.pop("bench") for row in rows]
     summaries = {
         group: summarise(members)
         for group, member_groups in GROUPS.items()
         if (members := [case for case in cases if group == "all" or case["group"] in member_groups])
     }
-    return {"summary": summaries["all"], "summaries": summaries, "targets_met": targets_met(summaries), "cases": cases, "sweep": rows}
+    return {"summary": summaries["all"], "summaries": summaries, "targets_met": targets_met(summaries), "cases": cases,
+            "sweep": rows, "seconds": time.perf_counter() - started}  # fmt: skip
+
+
+def tables(report: dict[str, Any]) -> str:
+    """Each group's summary as a table under its name and count."""
+    return "\n".join(f"{group} ({summary['sinefit']['cases']} cases):\n{table(summary)}" for group, summary in report["summaries"].items())
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--grid", choices=tuple(GROUPS), default="all", help="which grid to run, by the points' group (default: %(default)s)")
+
+
+BENCH = Bench(
+    name="analyser",
+    help="error, interval coverage, confidently wrong answers and speed of each latency estimator on simulated videos",
+    spec=lambda args: of_groups(args.spec, args.grid),
+    run=run, table=tables,
+    targets=lambda report: report["targets_met"],
+    notes=lambda report: f"{len(report['cases'])} cases in {report['seconds'] / 60:.1f} minutes",
+    plot=lambda report, path: plot(report["summary"], report["cases"], path),
+    options=_options,
+    outputs={"json": "write the summaries, every case and the sweep's rows as JSON", "plot": "plot speed against error per method"},
+    spec_file=SpecFile(read_sweep, SPEC, QUICK_SPEC,
+                       help="the cases, as a sweep whose points are labelled case, group (mixed, named or hard) and impairment "
+                       "(default: the bench's own)", quick_help=f"three short cases (a smoke test; {QUICK_SPEC.name})"),
+    runs="keep the simulated videos and the sweep's summary.csv here (default: a temporary folder)",
+    executor="the grid",
+)  # fmt: skip

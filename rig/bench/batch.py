@@ -18,6 +18,7 @@ one run.
 
 from __future__ import annotations
 
+import argparse
 import os
 import statistics
 import subprocess
@@ -26,14 +27,15 @@ import tempfile
 import time
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
+from rig.bench.contract import Bench, Context, Log
+from rig.commands import options
 from rig.executor import worker_environment
 from rig.service.simulate import simulate
 from rig.sim.config import SimulationConfig
 from rig.sim.pendulum import PendulumConfig
 
-Log = Callable[[str], None]
 PERIODS_S = (0.7, 0.9, 1.1, 1.3)
 DECODE_ONLY = "import sys; from analysis.video.sources import open_frames; sum(1 for _ in open_frames(sys.argv[1]).frames())"
 
@@ -120,10 +122,11 @@ def fixed_cost(clip: Path, log: Log) -> dict[str, Any]:
     }
 
 
-def run_bench(folder: Path, count: int, duration_s: float, clip_s: float, workers: int, rounds: int, log: Log) -> dict[str, Any]:
-    paths = videos(folder / "batch", count, duration_s, log)
-    clip = simulate(replace(SimulationConfig(duration_s=clip_s), seed=99), folder / "clip", overwrite=True).video_path
-    return {"scale_out": scale_out(paths, workers, rounds, log), "fixed_cost": fixed_cost(clip, log)}
+def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
+    """The batch's scale-out and a clip's fixed cost (see the module docstring)."""
+    paths = videos(context.folder / "batch", args.videos, args.duration, context.log)
+    clip = simulate(replace(SimulationConfig(duration_s=args.clip_duration), seed=99), context.folder / "clip", overwrite=True).video_path
+    return {"scale_out": scale_out(paths, args.workers, args.rounds, context.log), "fixed_cost": fixed_cost(clip, context.log)}
 
 
 def table(report: dict[str, Any]) -> str:
@@ -160,3 +163,20 @@ def plot(report: dict[str, Any], path: Path) -> None:
     clip.set_xlabel("one clip")
     clip.set_title(f"fixed cost: {f['ratio_warm']:.2f} x decoding (filled cache)")
     figure.savefig(path, dpi=100)
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--videos", type=options.positive_int, default=24, help="videos in the batch (default: %(default)s)")
+    parser.add_argument("--duration", type=options.positive_float, default=6.0, help="seconds per batch video (default: %(default)s)")
+    parser.add_argument("--clip-duration", type=options.positive_float, default=20.0, help="seconds of the fixed-cost clip (default: %(default)s)")
+    parser.add_argument("--workers", type=options.positive_int, default=2, help="Dask worker processes (default: %(default)s)")
+    parser.add_argument("--rounds", type=options.positive_int, default=3,
+                        help="times the batch runs serially and on Dask, alternately (default: %(default)s)")  # fmt: skip
+
+
+BENCH = Bench(
+    name="batch",
+    help="what many measurements cost: a batch serially and on Dask, and the fixed cost per video",
+    run=run, table=table, plot=plot, options=_options,
+    outputs={"json": "write the figures as JSON", "plot": "draw the wall times"},
+)

@@ -1,4 +1,7 @@
-"""`rig bench live`: what the live loop itself adds, measured in one run.
+"""`rig bench live`: what the live loop itself adds, measured in one run: the rig runs live on an
+emulated LSL tracker with a window paced at 60 Hz (under xvfb-run or a desktop), and the bench
+reports the time from a sample's arrival to the pose the renderer gets, and from each buffer swap
+to its logged row.
 
 1. **Sample arrival to pose**: the rig runs live (`rig.live.run`) for a while on an emulated LSL
    tracker at 1 kHz (`rig.live.selftest.emulator`) with the direct renderer in a window paced by a
@@ -16,22 +19,25 @@ them within one run.
 
 from __future__ import annotations
 
+import argparse
 import csv
 import os
 import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
+from rig.bench.contract import Bench, Context
 from rig.clock import MonotonicClock
+from rig.commands import options
 from rig.devices.window import SWAP_COLUMNS, SwapRecord, WindowDisplay, WindowSettings
 from rig.live.run import LiveConfig, run_live
 from rig.live.selftest.emulator import EmulatedPendulum
 from rig.live.selftest.frame_clock import FixedRateFrameClock
 from rig.live.view import View
-from rig.records import CsvRecord
-from rig.sim.bench import make_layout
+from rig.writers import CsvRecord
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -86,13 +92,15 @@ def swap_to_log(out_dir: Path, swaps: int = SWAPS) -> dict[str, Any]:
     return {"swap_to_log": _figures(np.array(delays))}
 
 
-def run_bench(duration_s: float, out_dir: Path, log: Callable[[str], None]) -> dict[str, Any]:
-    """Both measurements (see the module docstring) with their files in `out_dir`."""
+def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
+    """Both measurements (see the module docstring) after a live run of `args.duration` seconds, their
+    files in the context's folder."""
+    out_dir, duration_s = context.folder, args.duration
     clock = MonotonicClock()
     pendulum = Pendulum(PendulumConfig(), t_end=duration_s + 30.0)
     layout = make_layout(pendulum, CameraConfig(), DisplayConfig(width=SIZE[0], height=SIZE[1]))
     name = f"RigBenchLive{os.getpid()}"
-    log(f"live run: {duration_s:g} s, LSL tracker at {TRACKER_HZ:g} Hz, direct renderer, window at {REFRESH_HZ:g} Hz")
+    context.log(f"live run: {duration_s:g} s, LSL tracker at {TRACKER_HZ:g} Hz, direct renderer, window at {REFRESH_HZ:g} Hz")
     emulator = EmulatedPendulum(name, duration_s + 30.0, clock, TRACKER_HZ)
     try:
         config = LiveConfig(tracker=f"lsl:{name}", renderer="direct", duration_s=duration_s, window=WindowSettings(size=SIZE),
@@ -101,7 +109,7 @@ def run_bench(duration_s: float, out_dir: Path, log: Callable[[str], None]) -> d
                  frame_clock=FixedRateFrameClock(REFRESH_HZ), clock=clock, overwrite=True)  # fmt: skip
     finally:
         emulator.close()
-    log(f"swap to log: {SWAPS} swaps")
+    context.log(f"swap to log: {SWAPS} swaps")
     load = os.getloadavg()[0]
     started = time.monotonic()
     report = {**arrival_to_pose(out_dir / "run"), **swap_to_log(out_dir), "cpus": os.cpu_count(), "load_average_1min": load}
@@ -118,14 +126,13 @@ def table(report: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def plot(report: dict[str, Any], path: Path) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def plot(report: dict[str, Any], path: Path) -> None:
+    """Each figure's median, with a bar to its 95th percentile."""
+    from matplotlib.figure import Figure
 
     keys = ("arrival_to_pose", "frame_start_to_pose", "swap_to_log")
-    figure, axes = plt.subplots(figsize=(6.0, 3.0))
+    figure = Figure(figsize=(6.0, 3.0))
+    axes = figure.subplots()
     for i, key in enumerate(keys):
         f = report[key]
         axes.errorbar([f["median_us"]], [i], xerr=[[0.0], [f["p95_us"] - f["median_us"]]], fmt="o", capsize=4)
@@ -134,5 +141,18 @@ def plot(report: dict[str, Any], path: Path) -> Path:
     axes.set_xlabel("microseconds (median, bar to the 95th percentile)")
     figure.tight_layout()
     figure.savefig(path, dpi=120)
-    plt.close(figure)
-    return path
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--duration", type=options.positive_float, default=10.0, help="seconds of live run (default: %(default)s)")
+
+
+BENCH = Bench(
+    name="live",
+    help="the live loop's overhead: sample arrival to the pose the renderer gets, swap to log (needs an X display)",
+    run=run, table=table,
+    notes=lambda report: f"machine noise: {report['cpus']} CPUs, 1-minute load average {report['load_average_1min']:.2f}",
+    plot=plot, options=_options,
+    outputs={"json": "write the figures as JSON", "plot": "plot the figures"},
+    runs="keep the run's files here (default: a temporary folder)",
+)

@@ -11,39 +11,44 @@ whose photon-target latency lies nearest zero.
 
 from __future__ import annotations
 
+import argparse
 import time
-from pathlib import Path
-from typing import Any, Callable
+from dataclasses import dataclass, replace
+from typing import Any
 
-from rig.bench.renderer_latency import LatencyRun, film_latency
-from rig.bench.renderers import BenchGrid, machine_name
+from rig.bench.contract import Bench, Context, cell
+from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_setup import machine_name
+from rig.bench.renderers import BenchGrid, plain, with_options
 from rig.session import DEFAULT_SERVER_MS, PHOTON_TARGETS
 
 RESIDUAL_PREDICTORS = ("adaptive", "kalman-ca", "kalman-cv", "desp", "slerp", "hold")
 RESIDUAL_TRIANGLES = 10_000
 
-Log = Callable[[str], None]
+
+@dataclass(frozen=True)
+class ResidualSpec:
+    """The grid (its first resolution, refresh, films' camera and length, and `server_ms`) and the predictors filmed."""
+
+    grid: BenchGrid
+    predictors: tuple[str, ...]
 
 
-def run_photon_residual(grid: BenchGrid, predictors: tuple[str, ...], runs_dir: Path, log: Log) -> list[dict[str, Any]]:
+def run(spec: ResidualSpec, context: Context) -> list[dict[str, Any]]:
     """A row per predictor and photon target, the server's cost modelled at DEFAULT_SERVER_MS (or
     the grid's `server_ms`)."""
+    grid = replace(spec.grid, server_ms=spec.grid.server_ms if spec.grid.server_ms is not None else DEFAULT_SERVER_MS)
     machine = machine_name()
-    server_ms = grid.server_ms if grid.server_ms is not None else DEFAULT_SERVER_MS
     rows = []
-    for predictor in predictors:
+    for predictor in spec.predictors:
         for target in PHOTON_TARGETS:
             started = time.perf_counter()
-            run = LatencyRun(
-                "warp", RESIDUAL_TRIANGLES, grid.resolutions[0], predictor, server_ms=server_ms, photon_target=target,
-                refresh_hz=grid.refresh_hz, camera=grid.latency_camera, min_duration_s=grid.latency_duration_s,
-                max_period_s=grid.max_period_s,
-            )  # fmt: skip
-            figures = film_latency(run, 0.05, server_ms / 1e3, runs_dir / f"residual-{predictor}-{target}")
+            run = grid.latency_run("warp", RESIDUAL_TRIANGLES, predictor, target)
+            figures = film_latency(run, 0.05, grid.server_ms / 1e3, context.folder / f"residual-{predictor}-{target}")
             rows.append({**figures, "machine": machine})
             measured = figures["latency_measured_ms"]
-            log(f"{predictor:10} {target:8}: latency {measured if measured is not None else float('nan'):+.2f} ms measured, "
-                f"{figures['latency_true_ms'] or float('nan'):+.2f} ms true ({time.perf_counter() - started:.0f} s)")  # fmt: skip
+            context.log(f"{predictor:10} {target:8}: latency {measured if measured is not None else float('nan'):+.2f} ms measured, "
+                        f"{figures['latency_true_ms'] or float('nan'):+.2f} ms true ({time.perf_counter() - started:.0f} s)")  # fmt: skip
     return rows
 
 
@@ -58,11 +63,8 @@ def residual_text(rows: list[dict[str, Any]]) -> str:
     by = {(r["predictor"], r["photon_target"]): r for r in rows}
     lines = [f"{'predictor':10} {'photons: measured':>18} {'true':>8} {'scanout: measured':>18} {'true':>8}"]
     for predictor in dict.fromkeys(r["predictor"] for r in rows):
-        cells = []
-        for target in PHOTON_TARGETS:
-            r = by.get((predictor, target), {})
-            cells += [f"{r.get('latency_measured_ms'):+.2f}" if r.get("latency_measured_ms") is not None else "-",
-                      f"{r.get('latency_true_ms'):+.2f}" if r.get("latency_true_ms") is not None else "-"]  # fmt: skip
+        cells = [cell(by.get((predictor, target), {}).get(name), "+.2f") for target in PHOTON_TARGETS
+                 for name in ("latency_measured_ms", "latency_true_ms")]  # fmt: skip
         lines.append(f"{predictor:10} {cells[0]:>15} ms {cells[1]:>8} {cells[2]:>15} ms {cells[3]:>8}")
     best = best_predictor(rows)
     if best is not None:
@@ -71,3 +73,16 @@ def residual_text(rows: list[dict[str, Any]]) -> str:
                      f"{scanout.get('latency_measured_ms') or float('nan'):+.2f} ms aimed at scan-out")  # fmt: skip
     lines += [f"run: {note}" for note in sorted({r["latency_note"] for r in rows if r.get("latency_note")})]
     return "\n".join(lines)
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--residual-predictor", action="append", metavar="NAME",
+                        help="a predictor for --photon-residual; repeat for several (default: adaptive, kalman-ca, kalman-cv, desp, slerp, hold)")  # fmt: skip
+
+
+BENCH = Bench(
+    name="photon-residual",
+    help="latency left by each predictor aimed at the photons and at scan-out",
+    spec=lambda args: ResidualSpec(with_options(args.spec, args), tuple(args.residual_predictor or RESIDUAL_PREDICTORS)),
+    run=run, table=residual_text, record=plain, options=_options,
+)

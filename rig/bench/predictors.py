@@ -1,5 +1,6 @@
 """The predictor bench (`rig bench predictors`): every predictor on every trace, its error against
-constant velocity and against its cost.
+constant velocity and against its cost. With no --trace or --stress, it runs the simulated
+pendulum, the synthetic head and the two recordings in data/traces.
 
 Default traces:
 
@@ -25,6 +26,7 @@ not tuned on. Writes JSON and a PNG of speed against error if asked.
 
 from __future__ import annotations
 
+import argparse
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,16 +34,20 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+import predictors
 from predictors import Evaluation, Trace, evaluate, read_trace
 from predictors.stress import stress_streams
 from predictors.synthetic import head_motion
+from rig.bench.contract import Bench, Context
+from rig.bench.predictor_scores import BASELINE, HeldOut, Ratios, cost_ratios, label, leave_one_out, ratios
+from rig.commands import choices, options
+from rig.errors import ConfigError
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import TrackerConfig, simulate_tracker
 
 TRACES = Path(__file__).resolve().parents[2] / "data" / "traces"
 RECORDINGS = (TRACES / "hmd_orientation_user1.csv", TRACES / "quest_pro_robot_traj2.csv")
 DEFAULT_HORIZONS_MS = (0.0, 10.0, 20.0, 50.0, 100.0)
-BASELINE = "slerp"
 _TRUTH_RATE_HZ = 1000.0
 
 
@@ -65,17 +71,7 @@ def default_traces(duration_s: float, seed: int) -> list[Trace]:
     return [pendulum_trace(duration_s, seed), head, *(read_trace(path) for path in RECORDINGS)]
 
 
-def stress_traces(duration_s: float, seed: int) -> list[Trace]:
-    """The stress streams (`predictors.stress.stress_streams`)."""
-    return stress_streams(duration_s, seed)
-
-
-def label(name: str, params: dict[str, Any]) -> str:
-    """A predictor spec as one word: its name, and its parameters where any were given."""
-    return name if not params else f"{name}:" + ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
-
-
-def run_bench(
+def evaluate_all(
     traces: Sequence[Trace],
     specs: Sequence[tuple[str, dict[str, Any]]],
     horizons: Sequence[float],
@@ -91,68 +87,6 @@ def run_bench(
             if progress is not None:
                 progress(i * len(specs) + j + 1, total)
     return results
-
-
-@dataclass(frozen=True)
-class Ratios:
-    """One predictor's RMS errors over constant velocity's on each trace, per horizon (ms): angular,
-    and positional (NaN where constant velocity's position error is zero: no position to predict)."""
-
-    predictor: str
-    angular: dict[str, dict[float, float]]
-    position: dict[str, dict[float, float]]
-    us_per_update: dict[str, float]
-
-    def geometric_mean(self, part: str, horizon_ms: float) -> float:
-        """The geometric mean of one part's ratios across the traces that have it (NaN if none)."""
-        values = [by_horizon[horizon_ms] for by_horizon in getattr(self, part).values()]
-        values = [v for v in values if math.isfinite(v) and v > 0.0]
-        return math.exp(sum(math.log(v) for v in values) / len(values)) if values else math.nan
-
-    def worst(self, part: str, horizon_ms: float) -> float:
-        """The largest ratio of one part across the traces (NaN if none)."""
-        values = [by_horizon[horizon_ms] for by_horizon in getattr(self, part).values()]
-        values = [v for v in values if math.isfinite(v)]
-        return max(values) if values else math.nan
-
-    def to_dict(self, horizons: Sequence[float]) -> dict[str, Any]:
-        """Plain JSON-ready values, the geometric means and worst ratios per horizon included."""
-        return {
-            "predictor": self.predictor,
-            "angular": _keyed(self.angular),
-            "position": _keyed(self.position),
-            "us_per_update": self.us_per_update,
-            "geometric_mean": {part: {f"{h:g}": _finite(self.geometric_mean(part, h)) for h in horizons} for part in ("angular", "position")},
-            "worst": {part: {f"{h:g}": _finite(self.worst(part, h)) for h in horizons} for part in ("angular", "position")},
-        }
-
-
-def _finite(value: float) -> float | None:
-    return value if math.isfinite(value) else None
-
-
-def _keyed(ratios: dict[str, dict[float, float]]) -> dict[str, dict[str, float | None]]:
-    return {trace: {f"{h:g}": _finite(v) for h, v in by_horizon.items()} for trace, by_horizon in ratios.items()}
-
-
-def ratios(results: Sequence[Evaluation], horizons: Sequence[float]) -> list[Ratios]:
-    """Every predictor's ratios to the baseline (`BASELINE`, which must be among the results)."""
-    baseline = {r.trace: r for r in results if r.predictor == BASELINE and not r.params}
-    missing = sorted({r.trace for r in results} - set(baseline))
-    if missing:
-        raise ValueError(f"ratios need {BASELINE} with its defaults on every trace; missing on {', '.join(missing)}")
-    by_label: dict[str, Ratios] = {}
-    for result in results:
-        entry = by_label.setdefault(label(result.predictor, result.params), Ratios(label(result.predictor, result.params), {}, {}, {}))
-        base = baseline[result.trace]
-        entry.angular[result.trace] = {h: _ratio(result.at(h).angular_rms_deg, base.at(h).angular_rms_deg) for h in horizons}
-        entry.position[result.trace] = {h: _ratio(result.at(h).position_rms_mm, base.at(h).position_rms_mm) for h in horizons}
-        entry.us_per_update[result.trace] = result.us_per_update
-    return list(by_label.values())
-
-
-def _ratio(error: float, baseline: float) -> float:
-    return error / baseline if baseline > 0.0 else math.nan
 
 
 def table(results: Sequence[Evaluation], horizons: Sequence[float]) -> str:
@@ -177,64 +111,6 @@ def ratio_table(entries: Sequence[Ratios], part: str, horizons: Sequence[float])
         summary = [" / ".join(f"{entry.geometric_mean(part, h):.3f}" for h in horizons), " / ".join(f"{entry.worst(part, h):.3f}" for h in horizons)]
         rows.append(f"| {entry.predictor} | " + " | ".join(cells + summary) + f" | {float(np.median(list(entry.us_per_update.values()))):.1f} |")
     return "\n".join(rows)
-
-
-def cost_ratios(results: Sequence[Evaluation]) -> dict[str, float]:
-    """kalman-cv's us/update over desp's, per trace where both ran."""
-    cost = {(r.trace, r.predictor): r.us_per_update for r in results}
-    return {
-        trace: cost[(trace, "kalman-cv")] / cost[(trace, "desp")]
-        for trace, name in cost
-        if name == "kalman-cv" and (trace, "desp") in cost
-    }
-
-
-@dataclass(frozen=True)
-class HeldOut:
-    """A predictor tuned at `horizon_ms` on every trace but `trace`, scored on `trace`: its angular
-    and position RMS error there over constant velocity's, and its defaults' ratios beside them."""
-
-    predictor: str
-    trace: str
-    horizon_ms: float
-    params: dict[str, Any]
-    angular: float
-    position: float
-    defaults_angular: float
-    defaults_position: float
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain JSON-ready values (None for a ratio on a trace without that part)."""
-        return {k: _finite(v) if isinstance(v, float) else v for k, v in vars(self).items()}
-
-
-def leave_one_out(
-    name: str, traces: Sequence[Trace], horizon_ms: float, max_iterations: int,
-    progress: Callable[[float, float], object] | None = None,
-) -> list[HeldOut]:
-    """Tune `name` on all traces but one and score it on that one, for each trace in turn."""
-    from predictors.tuning import tune  # imports JAX: only when asked
-
-    horizon = horizon_ms / 1e3
-    held = []
-    for k, trace in enumerate(traces):
-        others = [t for i, t in enumerate(traces) if i != k]
-        params = tune(name, others, horizon, max_iterations=max_iterations).params
-        scores = {
-            key: evaluate(predictor, trace, [horizon], given, timing_repeats=0).scores[0]
-            for key, predictor, given in (("tuned", name, params), ("defaults", name, {}), ("baseline", BASELINE, {}))
-        }
-        base = scores["baseline"]
-        held.append(HeldOut(
-            name, trace.name, horizon_ms, params,
-            _ratio(scores["tuned"].angular_rms_deg, base.angular_rms_deg),
-            _ratio(scores["tuned"].position_rms_mm, base.position_rms_mm),
-            _ratio(scores["defaults"].angular_rms_deg, base.angular_rms_deg),
-            _ratio(scores["defaults"].position_rms_mm, base.position_rms_mm),
-        ))
-        if progress is not None:
-            progress(k + 1, len(traces))
-    return held
 
 
 def held_out_table(held: Sequence[HeldOut]) -> str:
@@ -276,3 +152,117 @@ def plot(results: Sequence[Evaluation], horizon_ms: float, path: Path) -> None:
             axis.grid(True, alpha=0.3)
     figure.tight_layout()
     figure.savefig(path, dpi=100)
+
+
+@dataclass(frozen=True)
+class Scores:
+    """What the bench found: the horizons (ms) and the one plotted, every evaluation, the ratios to
+    the baseline, kalman-cv's cost over desp's per trace, and the leave-one-out results."""
+
+    horizons_ms: tuple[float, ...]
+    plot_horizon_ms: float
+    results: list[Evaluation]
+    ratios: list[Ratios]
+    costs: dict[str, float]
+    held: list[HeldOut]
+
+
+def run(args: argparse.Namespace, context: Context) -> Scores:
+    """Every predictor named (all by default; the baseline always) on every trace (the files, the
+    stress streams, or the default four), then each one named tuned with one trace held out in turn."""
+    horizons, plot_horizon = args.horizons_ms, args.plot_horizon_ms
+    if plot_horizon not in horizons:
+        raise ConfigError(f"--plot-horizon-ms {plot_horizon:g} must be one of --horizons-ms {','.join(f'{h:g}' for h in horizons)}")
+    traces = [read_trace(path) for path in args.trace or []] + (stress_streams(args.duration, args.seed) if args.stress else [])
+    traces = traces or default_traces(args.duration, args.seed)
+    if args.leave_one_out and len(traces) < 2:
+        raise ConfigError("--leave-one-out needs at least two traces: it tunes on all but one")
+    specs = args.predictor or [(name, {}) for name in predictors.names()]
+    specs += [] if (BASELINE, {}) in specs else [(BASELINE, {})]
+    results = evaluate_all(traces, specs, horizons, args.timing_repeats, context.progress("benchmarking predictors"))
+    held = [h for name in args.leave_one_out or () for h in leave_one_out(name, traces, plot_horizon, args.tune_iterations,
+                                                                             context.progress(f"tuning {name}, each trace held out in turn"))]  # fmt: skip
+    return Scores(horizons, plot_horizon, results, ratios(results, horizons), cost_ratios(results), held)
+
+
+def text(scores: Scores) -> str:
+    """The scores table, the ratio tables (position where any trace has it), the costs and the held-out table."""
+    horizons = scores.horizons_ms
+    shown = [h for h in horizons if h > 0.0] or list(horizons)
+    at = " / ".join(f"{h:g}" for h in shown)
+    lines = [table(scores.results, horizons), f"\nangular RMS error / constant velocity ({BASELINE}) at {at} ms:",
+             ratio_table(scores.ratios, "angular", shown)]  # fmt: skip
+    if any(math.isfinite(v) for entry in scores.ratios for by_horizon in entry.position.values() for v in by_horizon.values()):
+        lines += [f"\nposition RMS error / constant velocity at {at} ms (traces with position):", ratio_table(scores.ratios, "position", shown)]
+    lines += [f"kalman-cv / desp cost on {trace}: {ratio:.2f}" for trace, ratio in scores.costs.items()]
+    if scores.held:
+        lines += [f"\nleave one trace out: tuned at {scores.plot_horizon_ms:g} ms on the others, RMS error / constant velocity "
+                  "on the one held out:", held_out_table(scores.held)]  # fmt: skip
+    return "\n".join(lines)
+
+
+def record(scores: Scores) -> dict[str, Any]:
+    """Every score, ratio and held-out result, as JSON-ready values."""
+    horizons = scores.horizons_ms
+    return {
+        "horizons_ms": list(horizons),
+        "baseline": BASELINE,
+        "kalman_cv_over_desp_cost": scores.costs,
+        "ratios": [entry.to_dict(horizons) for entry in scores.ratios],
+        "leave_one_out": [h.to_dict() for h in scores.held],
+        "results": [r.to_dict() for r in scores.results],
+    }
+
+
+def _horizons_ms(text: str) -> tuple[float, ...]:
+    """A comma-separated list of horizons in ms, each >= 0."""
+    try:
+        values = tuple(float(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected horizons in ms separated by commas, got {text!r}") from None
+    if not all(math.isfinite(v) and v >= 0.0 for v in values):
+        raise argparse.ArgumentTypeError(f"horizons must be zero or positive milliseconds, got {text!r}")
+    return values
+
+
+def _tunable(name: str) -> str:
+    from predictors.tuning import TUNABLE  # imports JAX: only when the option is given
+
+    if name not in TUNABLE:
+        raise argparse.ArgumentTypeError(f"cannot tune {name!r}; tunable predictors: {', '.join(TUNABLE)}")
+    return name
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.epilog = choices.predictors_listing()
+    parser.add_argument("--trace", type=Path, action="append", metavar="FILE",
+                        help="trace CSV (t_sensor,t_arrival,px,py,pz,qw,qx,qy,qz, or t instead of t_sensor); repeat "
+                        "for several (default: the built-in four)")  # fmt: skip
+    parser.add_argument("--stress", action="store_true",
+                        help="run the synthetic stress streams (30-1000 Hz, noise, jitter, repeats, sudden stops) too")  # fmt: skip
+    parser.add_argument("--predictor", type=options.predictor_spec, action="append", metavar="NAME[:key=value,...]",
+                        help="predictor (listed below) and parameters, or NAME:FILE.json; repeat for several (default: every "
+                        f"predictor); {BASELINE}, the baseline, is always run")  # fmt: skip
+    parser.add_argument("--horizons-ms", type=_horizons_ms, default=DEFAULT_HORIZONS_MS, metavar="H,H,...",
+                        help="prediction horizons after each sample's arrival (default: 0,10,20,50,100)")  # fmt: skip
+    parser.add_argument("--plot-horizon-ms", type=options.non_negative_float, default=50.0,
+                        help="the horizon the plot shows and --leave-one-out tunes for (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--leave-one-out", type=_tunable, action="append", metavar="NAME",
+                        help="tune NAME on all traces but one and score it on that one, for each trace; repeat for several")  # fmt: skip
+    parser.add_argument("--tune-iterations", type=options.non_negative_int, default=40,
+                        help="optimiser iterations per --leave-one-out fit (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--duration", type=options.positive_float, default=30.0,
+                        help="seconds of simulated pendulum, synthetic head and stress streams (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--seed", type=int, default=0, help="seed of the simulated traces (default: %(default)s)")
+    parser.add_argument("--timing-repeats", type=options.non_negative_int, default=3,
+                        help="timed replays per predictor and trace; the best counts (default: %(default)s)")  # fmt: skip
+
+
+BENCH = Bench(
+    name="predictors",
+    help="score every predictor on traces: error against constant velocity at several horizons, and cost per update",
+    run=run, table=text, record=record,
+    plot=lambda scores, path: plot(scores.results, scores.plot_horizon_ms, path),
+    options=_options,
+    outputs={"json": "write every score, ratio and held-out result as JSON", "plot": "draw speed against error"},
+)

@@ -7,25 +7,16 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Callable
 
-from rig.errors import RigError
 
+def _draw(path: Path, draw: Callable[[Any, list[Any]], None]) -> None:
+    """A figure of two panels side by side, drawn by `draw(figure, axes)` and saved to `path`."""
+    from matplotlib.figure import Figure
 
-def _draw(path: Path, columns: int, draw: Callable[[Any, list[Any]], None]) -> None:
-    """A figure of `columns` panels, drawn by `draw(figure, axes)` and saved to `path`."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    figure, axes = plt.subplots(1, columns, figsize=(6 * columns, 4.8))
-    try:
-        draw(figure, list(axes) if columns > 1 else [axes])
-        figure.tight_layout()
-        figure.savefig(path, dpi=110)
-    except OSError as error:
-        raise RigError(f"cannot write the plot {path}: {error}") from error
-    finally:
-        plt.close(figure)
+    figure = Figure(figsize=(12, 4.8))
+    axes = figure.subplots(1, 2)
+    draw(figure, list(axes))
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
 
 
 def _latency_series(axis: Any, rows: list[dict[str, Any]], renderer: str, colour: str, label: str, marker: str = "o", filled: bool = True) -> None:
@@ -62,7 +53,7 @@ def plot_rows(rows: list[dict[str, Any]], path: Path) -> None:
                   title="image error against warp time (one point per N)")  # fmt: skip
         right.legend(fontsize=8)
 
-    _draw(path, 2, draw)
+    _draw(path, draw)
 
 
 def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path: Path, label: str) -> None:
@@ -87,7 +78,7 @@ def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path
         for axis in axes:
             axis.legend(fontsize=8)
 
-    _draw(path, 2, draw)
+    _draw(path, draw)
 
 
 def plot_variants(rows: list[dict[str, Any]], path: Path) -> None:
@@ -108,4 +99,4 @@ def plot_variants(rows: list[dict[str, Any]], path: Path) -> None:
         handles += [axes[0].scatter([], [], marker="s", color=c, label=f"{n} triangles") for n, c in colours.items()]
         axes[1].legend(handles=handles, fontsize=7, loc="best")
 
-    _draw(path, 2, draw)
+    _draw(path, draw)

@@ -1,4 +1,12 @@
-"""The renderer bench (`rig bench renderers`): cost, latency and image error of the direct and the warp renderer against scene size.
+"""`rig bench renderers`: time the direct renderer and the warp renderer's client and server for
+load sizes and display resolutions, measure the image error of warped frames against direct
+renders, and the latency `rig analyse` finds in simulated videos whose clock every frame's measured
+cost drives (--server-ms models the warp server instead, labelled). --seed-table sets this
+machine's latencies beside the seeds' Table 2; --variants plots image error against latency saved
+for each warp variant; --photon-residual films each predictor aimed at the photons and at
+scan-out. The grid is a spec file, the grid's options override it; its latency films are written
+beside the runs as films.toml, which `rig sweep` films again. The default grid takes several
+minutes, --seed-table up to an hour; --quick runs a tiny one of each.
 
 For each display resolution and load of N triangles:
 
@@ -23,39 +31,41 @@ that takes longer than a refresh misses refreshes), or the server's modelled whe
 a sweep (`rig.service.sweep`) of explicit points, written beside the runs as films.toml, so that
 `rig sweep films.toml --out DIR` films exactly those again.
 
-The grid is data: `specs/renderers.toml` (the default) and `specs/renderers-quick.toml` (`--quick`),
-read by `read_grid`. `rig.bench.seed_table` and `rig.bench.warp_variants` build on these parts.
+The grid is `BenchGrid`, each setting declared once with its default; a spec (`--spec`, and
+`specs/renderers-quick.toml` for `--quick`) sets any of them, read by `read_grid`, the grid's
+options over it. The subject's modes
+(`rig.bench.seed_table`, `rig.bench.warp_variants`, `rig.bench.photon_residual`) build on these
+parts and share its options and outputs.
 """
 
 from __future__ import annotations
 
-import os
-import platform
+import argparse
+import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
+from declared import NON_NEGATIVE, POSITIVE, Range, check, like, setting
 from predictors import Pose
+from rig.bench import renderer_plots
+from rig.bench.contract import Bench, Context, SpecFile, cell, given
 from rig.bench.renderer_latency import LatencyRun, film_latencies
+from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup
 from rig.bench.spec_reader import read_spec
+from rig.commands import options
 from rig.errors import ConfigError
-from rig.render import gl, make_renderer
 from rig.render.direct import DirectRenderer
+from rig.render.gl import LOAD_SHAPES
 from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, RenderSetup
-from rig.render.warp import WarpRenderer
-from rig.sim.bench import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
-from rig.sim.pendulum import Pendulum, PendulumConfig
 
-IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
-SPECS = Path(__file__).parent / "specs"
-SPEC = SPECS / "renderers.toml"
-QUICK_SPEC = SPECS / "renderers-quick.toml"
+QUICK_SPEC = Path(__file__).parent / "specs" / "renderers-quick.toml"
 
 ROW_FIELDS = (
     "renderer", "spec", "reconstruction", "views", "triangles", "width", "height", "rate_ratio",
@@ -73,39 +83,50 @@ LATENCY_FIELDS = (
 
 @dataclass(frozen=True)
 class BenchGrid:
-    """What `rig bench renderers` measures, and how much of it."""
+    """What `rig bench renderers` measures, and how much of it: each setting declared on its field
+    (the defaults are the bench's grid); a spec file (`--spec FILE.toml`, `specs/renderers-quick.toml`)
+    sets any of them, every key and value checked (`read_grid`)."""
 
-    triangles: tuple[int, ...] = (10_000, 100_000, 1_000_000, 5_000_000)
-    resolutions: tuple[tuple[int, int], ...] = ((320, 240), (640, 480), (1280, 720))
-    """the first is the latency runs' display too"""
-    ratios: tuple[int, ...] = (1, 5, 10)
-    warp: str = "warp"
-    """the warp renderer's spec, options included"""
-    phases: int = 4
-    """client poses per (N, resolution) for the image error, spread over a swing"""
-    warp_rounds: int = 16
-    direct_frames: int = 4
-    direct_budget_s: float = 6.0
-    """stop timing direct frames (after the first) once this much time is spent"""
-    latency_triangles: tuple[int, ...] | None = None
-    """the load sizes whose latency is filmed (None: all)"""
+    triangles: tuple[int, ...] = setting(
+        (10_000, 100_000, 1_000_000, 5_000_000), "triangles",
+        "load sizes (a soup of small random triangles), each timed at every resolution", NON_NEGATIVE,
+    )  # fmt: skip
+    resolutions: tuple[tuple[int, int], ...] = setting(
+        ((320, 240), (640, 480), (1280, 720)), "pixels", "display sizes, [width, height]; the first is the latency films' display too"
+    )
+    ratios: tuple[int, ...] = setting(
+        (1, 5, 10), "", "client:display rate ratios 1:r whose image error is measured (display frames per client frame)",
+        Range(1.0, includes_low=True),
+    )  # fmt: skip
+    warp: str = setting("warp", "", "the warp renderer and its options, a renderer spec such as warp:recon=grid,views=2")
+    phases: int = setting(4, "", "client poses per load and resolution for the image error, spread over a swing", Range(1.0, includes_low=True))
+    warp_rounds: int = setting(
+        16, "", "rounds of warp timing; each round times one display frame of every load in turn", Range(1.0, includes_low=True)
+    )
+    direct_frames: int = setting(4, "", "direct frames timed at most (the first is always timed)", Range(1.0, includes_low=True))
+    direct_budget_s: float = setting(6.0, "seconds", "no more direct frames are timed after this long", POSITIVE)
+    latency_triangles: tuple[int, ...] | None = setting(
+        None, "triangles", "the load sizes whose latency is filmed", NON_NEGATIVE, unset="all of them"
+    )
     latency_camera: CameraConfig = CameraConfig()
-    """the latency runs' camera; its frame rate follows the pendulum period"""
-    latency_duration_s: float = 6.0
-    max_period_s: float = 8.0
-    refresh_hz: float = 60.0
-    server_ms: float | None = None
-    """the warp server's modelled cost in the latency runs (ms), None: measured"""
-    predictor: str = "hold"
-    """the latency runs' predictor, both renderers alike (as the seeds' Table 2)"""
-    direct_predictor: str | None = None
-    """the direct renderer's predictor in the latency runs, where it differs"""
+    """the latency films' camera; its frame rate follows the pendulum's period"""
+    latency_duration_s: float = setting(6.0, "seconds", "the latency films' shortest length", POSITIVE)
+    max_period_s: float = setting(
+        8.0, "seconds", "the longest pendulum period filmed: a latency that would need a longer one is beyond range", POSITIVE
+    )
+    refresh_hz: float = like(DisplayConfig, "refresh_hz", flag=None)
+    server_ms: float | None = setting(
+        None, "ms", "the warp server's modelled cost in the latency films", POSITIVE, unset="measured here, as every other cost"
+    )
+    predictor: str = setting("hold", "", "the latency films' predictor, both renderers alike (as the seeds' Table 2)")
+    direct_predictor: str | None = setting(
+        None, "", "the direct renderer's predictor in the latency films, where it differs", unset="the same"
+    )
 
     def __post_init__(self) -> None:
+        check(self, ConfigError)
         if not (self.triangles and self.resolutions and self.ratios):
             raise ConfigError("a renderer bench grid needs at least one load size, resolution and rate ratio")
-        if min(self.ratios) < 1 or min(self.triangles) < 0:
-            raise ConfigError("rate ratios are display frames per client frame, at least 1; load sizes are at least 0")
         if min(min(size) for size in self.resolutions) < 16:
             raise ConfigError(f"a display is at least 16x16 pixels, got {self.resolutions}")
 
@@ -121,48 +142,15 @@ class BenchGrid:
         )  # fmt: skip
 
 
-def read_grid(path: Path) -> BenchGrid:
-    """A grid from its TOML spec (`rig.bench.spec_reader`: every key and type checked)."""
-    return read_spec(BenchGrid, path)
+def read_grid(path: Path | None) -> BenchGrid:
+    """The grid a TOML spec sets (`rig.bench.spec_reader`: every key and value checked), the
+    defaults where it is silent; with no spec, the defaults."""
+    return read_spec(BenchGrid, path) if path is not None else BenchGrid()
 
-
-Log = Callable[[str], None]
 
 
 def _percentile_ms(values: list[float], q: float) -> float | None:
     return float(np.percentile(values, q) * 1e3) if values else None
-
-
-def machine_name() -> str:
-    """CPU, core count and OpenGL renderer of this machine, for the record."""
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    ctx = gl.create_context()
-    try:
-        gl_name = f"{ctx.info['GL_RENDERER']}, OpenGL {ctx.version_code // 100}.{ctx.version_code % 100 // 10}"
-    finally:
-        ctx.release()
-    return f"{cpu}, {os.cpu_count()} cores, {gl_name}"
-
-
-def scene_setup(width: int, height: int, triangles: int, refresh_hz: float, load: str = "soup") -> tuple[RenderSetup, Pendulum]:
-    """The session's view of the default pendulum at this display size, costs measured, with a
-    load of `triangles` shaped as `load` says (`rig.render.gl.LOAD_SHAPES`)."""
-    pendulum = Pendulum(PendulumConfig(), t_end=3.0)
-    layout = make_layout(pendulum, CameraConfig(), DisplayConfig(refresh_hz=refresh_hz, width=width, height=height))
-    setup = RenderSetup(width, height, layout.world_to_clip, layout.sphere_radius_m, scene_triangles=triangles, scene_load=load)
-    return setup, pendulum
-
-
-def pose_of(pendulum: Pendulum) -> Callable[[float], Pose]:
-    """The pendulum's exact pose at any time: prediction error stays out of the image error."""
-    return lambda t: Pose(t, pendulum.led_position(t), IDENTITY)
 
 
 def time_direct(setup: RenderSetup, grid: BenchGrid) -> tuple[list[float], list[float]]:
@@ -182,43 +170,6 @@ def time_direct(setup: RenderSetup, grid: BenchGrid) -> tuple[list[float], list[
     finally:
         renderer.close()
     return (costs[1:], cpu[1:]) if len(costs) >= 3 else (costs, cpu)
-
-
-QUALITY_FIGURES = ("lab_error_pct", "ssim", "dssim", "psnr_db", "hole_pct", "primitives")
-
-
-@dataclass
-class WarpMeasurement:
-    """One open warp renderer on a pendulum scene, and what was measured of it: client seconds,
-    per rate ratio the image figures (QUALITY_FIGURES) of every warped frame, and per timed display
-    frame its wall, GL-query and CPU seconds."""
-
-    renderer: WarpRenderer
-    pendulum: Pendulum
-    client_s: list[float] = field(default_factory=list)
-    errors: dict[int, list[tuple[float, ...]]] = field(default_factory=dict)
-    wall_s: list[float] = field(default_factory=list)
-    gpu_s: list[float] = field(default_factory=list)
-    cpu_s: list[float] = field(default_factory=list)
-    next_frame: int = 0
-
-    def quality(self, ratio: int) -> dict[str, float | None]:
-        """The mean of each image figure at client:display rate ratio 1:`ratio` (PSNR over finite values)."""
-        values = np.array(self.errors[ratio], dtype=np.float64)
-        means: dict[str, float | None] = {}
-        for name, column in zip(QUALITY_FIGURES, values.T):
-            finite = column[np.isfinite(column)]
-            means[name] = float(finite.mean()) if len(finite) else None
-        return means
-
-
-def open_warp(spec: str, setup: RenderSetup, pendulum: Pendulum, ratios: tuple[int, ...]) -> WarpMeasurement:
-    """The warp renderer of `spec`, open on `setup`."""
-    renderer = make_renderer(spec)
-    if not isinstance(renderer, WarpRenderer):
-        raise ConfigError(f"the renderer bench's warp spec must be a warp renderer, got {spec!r}")
-    renderer.open(setup)
-    return WarpMeasurement(renderer, pendulum, errors={r: [] for r in ratios})
 
 
 def measure_warp_quality(measurement: WarpMeasurement, grid: BenchGrid) -> None:
@@ -277,10 +228,10 @@ def warp_row(base: dict[str, Any], m: WarpMeasurement, triangles: int, size: tup
     }  # fmt: skip
 
 
-def run_bench(grid: BenchGrid, runs_dir: Path, log: Log, workers: int | None = None, scheduler: str | None = None) -> list[dict[str, Any]]:
+def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
     """Every row of the benchmark (see the module docstring). The timings run here, one at a time;
-    the latency films (simulate, then analyse: a sweep into `runs_dir`) on `rig.executor`'s workers
-    when asked."""
+    the latency films (simulate, then analyse: a sweep into the context's folder) on its executor."""
+    log = context.log
     machine = machine_name()
     log(f"machine: {machine}")
     rows: list[dict[str, Any]] = []
@@ -332,7 +283,7 @@ def run_bench(grid: BenchGrid, runs_dir: Path, log: Log, workers: int | None = N
     def progress(done: float, total: float) -> None:
         log(f"[{done}/{total} latency films]")
 
-    for (labels, *_), figures in zip(films, film_latencies(films, runs_dir, comment, workers, scheduler, progress)):
+    for (labels, *_), figures in zip(films, film_latencies(films, context.folder, comment, context.workers, context.scheduler, progress)):
         measured = figures["latency_measured_ms"]
         shown = f"{measured:.1f} ms measured, {figures['latency_true_ms']:.1f} ms true" if measured is not None else figures["latency_note"]
         log(f"latency {labels['renderer']:6} {labels['triangles']:>9} triangles: {shown}")
@@ -340,3 +291,88 @@ def run_bench(grid: BenchGrid, runs_dir: Path, log: Log, workers: int | None = N
             if (row["renderer"], row["triangles"], (row["width"], row["height"])) == (labels["renderer"], labels["triangles"], grid.resolutions[0]):
                 row.update({name: figures[name] for name in LATENCY_FIELDS})
     return rows
+
+
+def table(rows: list[dict[str, Any]]) -> str:
+    """The grid's rows as a fixed-width table, with the latency notes and the machine below."""
+    lines = [
+        f"{'renderer':8} {'N':>9} {'size':>9} {'ratio':>5} {'frame ms':>9} {'p95':>8} {'gpu ms':>7} {'cpu ms':>8} {'client ms':>9} "
+        f"{'lat meas':>8} {'lat true':>8} {'sd':>5} {'missed':>6} {'Lab>10 %':>8} {'SSIM':>6} {'PSNR':>5} {'holes %':>7}"
+    ]  # fmt: skip
+    for r in rows:
+        ratio = f"1:{r['rate_ratio']}" if r["rate_ratio"] else "-"
+        missed = f"{r['missed_pct']:.0f}%" if r["missed_pct"] is not None else "-"
+        lines.append(
+            f"{r['renderer']:8} {r['triangles']:>9} {r['width']}x{r['height']:<4} {ratio:>5} {cell(r['frame_ms_median']):>9} "
+            f"{cell(r['frame_ms_p95']):>8} {cell(r['frame_gpu_ms_median']):>7} {cell(r['frame_cpu_ms_median']):>8} "
+            f"{cell(r['client_ms_median']):>9} "
+            f"{cell(r['latency_measured_ms']):>8} {cell(r['latency_true_ms']):>8} {cell(r['latency_sd_ms']):>5} {missed:>6} "
+            f"{cell(r['lab_error_pct'], '.2f'):>8} {cell(r['ssim'], '.3f'):>6} {cell(r['psnr_db']):>5} {cell(r['hole_pct'], '.2f'):>7}"
+        )
+    specs = sorted({r["spec"] for r in rows if r["renderer"] == "warp"})
+    lines.append(f"warp: {', '.join(specs)}; sd: the latency's spread swing by swing, from the video" if specs else "")
+    lines += [f"latency: {note}" for note in sorted({r["latency_note"] for r in rows if r["latency_note"]})]
+    lines.append(f"machine: {rows[0]['machine']}" if rows else "no rows")
+    return "\n".join(lines)
+
+
+def plain(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows as JSON holds them: an infinity or NaN (which JSON has not) as null."""
+    return [{k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in row.items()} for row in rows]
+
+
+GRID_OPTIONS = ("triangles", "resolutions", "ratios", "warp", "server_ms", "predictor", "direct_predictor")
+
+
+def with_options(grid: BenchGrid, args: argparse.Namespace) -> BenchGrid:
+    """`grid` with the grid's options given (GRID_OPTIONS) over it: the grid's, and each mode's."""
+    return replace(grid, **given(args, *GRID_OPTIONS))
+
+
+def _int_list(text: str) -> tuple[int, ...]:
+    return tuple(options.non_negative_int(part) for part in text.split(","))
+
+
+def _ratio_list(text: str) -> tuple[int, ...]:
+    values = _int_list(text)
+    if min(values) < 1:
+        raise argparse.ArgumentTypeError(f"rate ratios are display frames per client frame, at least 1, got {text!r}")
+    return values
+
+
+def _resolution(text: str) -> tuple[int, int]:
+    w, sep, h = text.lower().partition("x")
+    try:
+        size = (int(w), int(h))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, got {text!r}") from None
+    if not sep or min(size) < 16:
+        raise argparse.ArgumentTypeError(f"a resolution is WIDTHxHEIGHT, each at least 16, got {text!r}")
+    return size
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--triangles", type=_int_list, metavar="N,N,...", help="load sizes (default 10000,100000,1000000,5000000; --variants 10000,200000)")
+    parser.add_argument("--resolutions", type=lambda text: tuple(map(_resolution, text.split(","))), metavar="WxH,...",
+                        help="display sizes; the first is the latency runs' (default 320x240,640x480,1280x720)")  # fmt: skip
+    parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
+    parser.add_argument("--warp", metavar="SPEC", help="the warp renderer and its options, e.g. warp:recon=grid,views=2 (default: warp)")
+    parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants, --seed-table: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
+    parser.add_argument("--predictor", help="the predictor of every latency run, both renderers alike (default: the spec's, hold, as the seeds' Table 2)")
+    parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")
+    parser.add_argument("--server-ms", type=options.positive_float, metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
+
+
+BENCH = Bench(
+    name="renderers",
+    help="frame cost, latency and image error of the direct and warp renderers against scene size",
+    spec=lambda args: with_options(args.spec, args),
+    run=run, table=table, record=plain, plot=renderer_plots.plot_rows, options=_options,
+    outputs={"json": "write the rows as a JSON list", "csv": "write the rows as CSV",
+             "plot": "plot the run (latency against N, error against latency saved, ...)"},
+    spec_file=SpecFile(read_grid, None, QUICK_SPEC,
+                       help="the grid, as a TOML file of rig.bench.renderers.BenchGrid's settings (default: BenchGrid's defaults)",
+                       quick_help=f"a tiny run (a smoke test, seconds not minutes; {QUICK_SPEC.name})"),
+    runs="keep the latency runs' videos here, and the grid's films.toml and summary (default: a temporary folder)",
+    executor="the latency films",
+)  # fmt: skip

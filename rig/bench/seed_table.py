@@ -5,8 +5,8 @@ the video, with the same predictor on both.
 
 Scene sizes grow fourfold from `first` while the direct renderer's frame, measured before its run,
 takes at most `max_frame_s` and the load at most `max_triangles` (memory: 36 bytes a triangle, and
-the GL driver's copy). Every cost on the clock is measured (the server's modelled where `server_ms`
-says, labelled). The pendulum's period may stretch to `max_period_s`: the analyser calibrates on the
+the GL driver's copy). Every cost on the clock is measured (the server's modelled where the grid's
+`server_ms` says, labelled). The pendulum's period may stretch to the grid's `max_period_s`: the analyser calibrates on the
 first 1.5 s of video and needs the blobs to move there, so a direct renderer showing a new frame
 less often than about once a second (a period over 8 s) is beyond what filming measures, as the
 seed's 64M-face reference was (its latency exceeded half the pendulum's period); such a row keeps
@@ -22,22 +22,26 @@ warp renderer's spec.
 
 from __future__ import annotations
 
+import argparse
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from rig.bench.renderer_latency import LatencyRun, film_latency
-from rig.bench.renderers import BenchGrid, machine_name, open_warp, pose_of, scene_setup, time_direct
+from rig.bench import renderer_plots
+from rig.bench.contract import Bench, Context, cell, given
+from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_setup import machine_name, open_warp, pose_of, scene_setup
+from rig.bench.renderers import BenchGrid, plain, time_direct, with_options
+from rig.commands import options
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest
 from rig.sim.camera import CameraConfig
 
 SEED_SOURCE = "Smit, van Liere, Beck, Froehlich 2010, Table 2"
 SEED_REFRESH_MS = 1e3 / 60.0
-SEED_COLUMNS = ("faces", "reference_ms", "reference_sd_ms", "reference_frame_ms", "warp_ms", "warp_sd_ms", "warp_frame_ms")
 SEED_TABLE_2 = (
     (64e6, None, None, 577.0, 58.9, 2.6, 14.1),
     (32e6, 780.0, 14.2, 289.0, 61.1, 2.5, 14.3),
@@ -50,28 +54,20 @@ SEED_TABLE_2 = (
 """The seed's multi-GPU rows (faces; reference latency, sd, draw time; warp latency, sd, warp
 time; ms). 64M faces: the reference's latency exceeded half the pendulum's period."""
 
-Log = Callable[[str], None]
-
 
 @dataclass(frozen=True)
 class SeedTableSpec:
-    """What `--seed-table` measures."""
+    """What `--seed-table` measures: load sizes from `first` up to the limits, what the load makes,
+    and the grid whose first resolution, direct-frame timing, films (camera, length, longest period,
+    refresh), predictor, warp spec and server cost the table takes."""
 
     first: int = 4_000
     max_triangles: int = 20_000_000
     max_frame_s: float = 60.0
-    size: tuple[int, int] = (320, 240)
-    predictor: str = "hold"
-    warp: str = "warp"
     load: str = "soup"
     """what the load's triangles make (`rig.render.gl.LOAD_SHAPES`): the soup is the stress case,
     meshes a few tessellated solid objects, as the seed's scenes were"""
-    server_ms: float | None = None
-    refresh_hz: float = 60.0
-    max_period_s: float = 8.0
-    probe: BenchGrid = BenchGrid(direct_frames=3, direct_budget_s=2.0)
-    camera: CameraConfig = CameraConfig()
-    min_duration_s: float = 6.0
+    grid: BenchGrid = BenchGrid(resolutions=((320, 240),), direct_frames=3, direct_budget_s=2.0)
 
     def sizes(self) -> list[int]:
         """The fourfold series of load sizes up to `max_triangles` (the frame limit stops it earlier)."""
@@ -81,10 +77,10 @@ class SeedTableSpec:
         return sizes
 
 
-QUICK_SPEC = SeedTableSpec(
-    first=1_000, max_triangles=4_000, size=(160, 120), probe=BenchGrid(direct_frames=3, direct_budget_s=0.5),
-    camera=CameraConfig(width=320, height=240, subsamples=4), min_duration_s=2.5,
-)  # fmt: skip
+QUICK_SPEC = SeedTableSpec(first=1_000, max_triangles=4_000, grid=BenchGrid(
+    resolutions=((160, 120),), direct_frames=3, direct_budget_s=0.5, latency_camera=CameraConfig(width=320, height=240, subsamples=4),
+    latency_duration_s=2.5,
+))  # fmt: skip
 
 
 def seed_rows() -> list[dict[str, Any]]:
@@ -116,14 +112,14 @@ def crossover(rows: list[dict[str, Any]]) -> dict[str, Any] | None:
     return None
 
 
-def _probe_warp(spec: SeedTableSpec, setup, pendulum) -> tuple[float, float]:
+def _probe_warp(grid: BenchGrid, setup, pendulum) -> tuple[float, float]:
     """(client s, server s) of one client frame and a few display frames, for the run's period."""
-    m = open_warp(spec.warp, setup, pendulum, (1,))
+    m = open_warp(grid.warp, setup, pendulum, (1,))
     try:
         predict = pose_of(pendulum)
         client = m.renderer.render_app_frame(AppFrameRequest(0, 0.0, 0.0, predict)).cost_s
         for k in range(4):
-            t = (k + 1) / spec.refresh_hz
+            t = (k + 1) / grid.refresh_hz
             m.renderer.render_display_frame(DisplayFrameRequest(k, t, t, predict, 0))
             m.wall_s.append(m.renderer.last_warp_seconds[0])
     finally:
@@ -131,23 +127,23 @@ def _probe_warp(spec: SeedTableSpec, setup, pendulum) -> tuple[float, float]:
     return client, float(np.median(m.wall_s[1:]))
 
 
-def run_seed_table(spec: SeedTableSpec, runs_dir: Path, log: Log) -> list[dict[str, Any]]:
+def run(spec: SeedTableSpec, context: Context) -> list[dict[str, Any]]:
     """Our rows (see the module docstring), one per renderer and load size."""
+    log, runs_dir, grid = context.log, context.folder, spec.grid
     machine = machine_name()
-    log(f"machine: {machine}; load: {spec.load}; warp: {spec.warp}")
+    log(f"machine: {machine}; load: {spec.load}; warp: {grid.warp}")
     rows: list[dict[str, Any]] = []
-    refresh_ms = 1e3 / spec.refresh_hz
+    refresh_ms = 1e3 / grid.refresh_hz
     for triangles in spec.sizes():
-        setup, pendulum = scene_setup(*spec.size, triangles, spec.refresh_hz, spec.load)
-        direct_s = float(np.median(time_direct(setup, spec.probe)[0]))
+        setup, pendulum = scene_setup(*grid.resolutions[0], triangles, grid.refresh_hz, spec.load)
+        direct_s = float(np.median(time_direct(setup, grid)[0]))
         if direct_s > spec.max_frame_s:
             log(f"{triangles} triangles: a direct frame takes {direct_s:.1f} s, over {spec.max_frame_s:g} s; the table stops here")
             break
-        client_s, server_s = _probe_warp(spec, setup, pendulum)
-        for renderer, app_s, comp_s in (("direct", direct_s, 0.0), (spec.warp, client_s, server_s)):
+        client_s, server_s = _probe_warp(grid, setup, pendulum)
+        for renderer, app_s, comp_s in (("direct", direct_s, 0.0), (grid.warp, client_s, server_s)):
             started = time.perf_counter()
-            run = LatencyRun(renderer, triangles, spec.size, spec.predictor, server_ms=spec.server_ms, refresh_hz=spec.refresh_hz,
-                             camera=spec.camera, min_duration_s=spec.min_duration_s, max_period_s=spec.max_period_s, load=spec.load)  # fmt: skip
+            run = grid.latency_run(renderer, triangles, grid.predictor, load=spec.load)
             figures = film_latency(run, app_s, comp_s, runs_dir / f"seed-{spec.load}-{renderer.replace(':', '_')}-{triangles}")
             latency = figures["latency_measured_ms"]
             if figures["frame_ms_median"] is None:
@@ -170,10 +166,6 @@ def run_label(rows: list[dict[str, Any]]) -> str:
     loads = "/".join(sorted({r["load"] for r in rows}))
     warps = "/".join(sorted({r["spec"] for r in rows if r["renderer"] == "warp"}))
     return f"load {loads}, warp {warps}"
-
-
-def _cell(value: float | None, digits: int = 1) -> str:
-    return "-" if value is None else f"{value:.{digits}f}"
 
 
 def _no_crossover(rows: list[dict[str, Any]]) -> str:
@@ -200,14 +192,14 @@ def seed_table_text(rows: list[dict[str, Any]]) -> str:
     for n in sorted({r["triangles"] for r in rows}):
         d, w = by.get(("direct", n), {}), by.get(("warp", n), {})
         lines.append(
-            f"{n:>10} | {_cell(d.get('frame_ms_median')):>9} ms {_cell(d.get('latency_measured_ms')):>8} ({_cell(d.get('latency_sd_ms'))}) "
-            f"{_cell(d.get('latency_refreshes'), 2):>8} | {_cell(w.get('frame_ms_median')):>7} ms {_cell(w.get('latency_measured_ms')):>8} "
-            f"({_cell(w.get('latency_sd_ms'))}) {_cell(w.get('latency_refreshes'), 2):>8} {_cell(w.get('missed_pct'), 0):>6}%"
+            f"{n:>10} | {cell(d.get('frame_ms_median')):>9} ms {cell(d.get('latency_measured_ms')):>8} ({cell(d.get('latency_sd_ms'))}) "
+            f"{cell(d.get('latency_refreshes'), '.2f'):>8} | {cell(w.get('frame_ms_median')):>7} ms {cell(w.get('latency_measured_ms')):>8} "
+            f"({cell(w.get('latency_sd_ms'))}) {cell(w.get('latency_refreshes'), '.2f'):>8} {cell(w.get('missed_pct'), '.0f'):>6}%"
         )
     lines.append(f"{SEED_SOURCE} (2 GPUs, stereo, 60 Hz per eye; latency / {SEED_REFRESH_MS:.1f} ms):")
     for faces, ref, ref_sd, ref_ms, warp, warp_sd, warp_ms in SEED_TABLE_2:
         lines.append(
-            f"{int(faces):>10} | {ref_ms:>9.1f} ms {_cell(ref):>8} ({_cell(ref_sd)}) {_cell(ref / SEED_REFRESH_MS if ref else None, 2):>8} | "
+            f"{int(faces):>10} | {ref_ms:>9.1f} ms {cell(ref):>8} ({cell(ref_sd)}) {cell(ref / SEED_REFRESH_MS if ref else None, '.2f'):>8} | "
             f"{warp_ms:>7.1f} ms {warp:>8.1f} ({warp_sd}) {warp / SEED_REFRESH_MS:>8.2f}"
         )
     for name, table in (("this machine", rows), ("seed", seed_rows())):
@@ -218,3 +210,29 @@ def seed_table_text(rows: list[dict[str, Any]]) -> str:
         )  # fmt: skip
     notes = sorted({r["latency_note"] for r in rows if r.get("latency_note")})
     return "\n".join(lines + [f"run: {note}" for note in notes])
+
+
+def spec(args: argparse.Namespace) -> SeedTableSpec:
+    """The seed table's spec (the quick one with --quick), the options given over it and its grid."""
+    chosen = QUICK_SPEC if args.quick else SeedTableSpec()
+    return replace(chosen, grid=with_options(chosen.grid, args), **given(args, "max_frame_s", "max_triangles", "load"))
+
+
+def _plot(rows: list[dict[str, Any]], path: Path) -> None:
+    renderer_plots.plot_seed_table(rows, seed_rows(), path, run_label(rows))
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--max-frame-s", type=options.positive_float, default=SeedTableSpec().max_frame_s,
+                        help="--seed-table: the largest direct frame, in seconds, a scene may take (default: %(default)s)")  # fmt: skip
+    parser.add_argument("--max-triangles", type=options.positive_int, metavar="N",
+                        help="--seed-table: the largest load (default: 20000000, 720 MB and the GL driver's copy)")  # fmt: skip
+
+
+BENCH = Bench(
+    name="seed-table",
+    help="the seeds' Table 2 beside this machine's (see rig.bench.seed_table)",
+    spec=spec, run=run, table=seed_table_text,
+    record=lambda rows: plain(rows + seed_rows()),
+    plot=_plot, options=_options,
+)

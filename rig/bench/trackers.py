@@ -1,9 +1,12 @@
-"""The tracker bench (`rig bench trackers`): the real tracker sources fed by the emulators, clean and
-with faults, measured for loss, fabrication, order, reading cost and added latency.
+"""`rig bench trackers`: stream the simulated pendulum from `rig emulate-tracker` (a pseudo-terminal,
+TCP, LSL), clean and with faults (1% of bytes corrupted and a 0.5 s disconnect; a disconnect for
+LSL), record each with the rig's tracker source as `rig record-tracker` does, and report per case
+what was sent, recorded, missing, fabricated and counted corrupt, the CPU per sample, and the
+latency from the emulator's write to the sample's queueing for a predictor.
 
 Each case starts `rig emulate-tracker` in a process of its own (a pseudo-terminal, a TCP socket or
 an LSL outlet, with the emulator's log of every record's fate) and records it in this process with
-`rig.service.record.record_tracker`, as `rig record-tracker` does. Then:
+`rig.service.tracker_recording.record_tracker`, as `rig record-tracker` does. Then:
 
 * sent, recorded: records the emulator wrote (intact or damaged) and rows in tracker.csv;
 * missing: intact records sent that are not in tracker.csv; fabricated: rows that match no intact
@@ -30,6 +33,7 @@ interpreter's part; on a shared virtual machine it varies from run to run.
 
 from __future__ import annotations
 
+import argparse
 import csv
 import os
 import resource
@@ -40,16 +44,18 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Iterator
 
 import numpy as np
 
+from rig.bench.contract import Bench, Context, Log
 from rig.clock import MonotonicClock
+from rig.commands import options
 from rig.devices.trackers.decoders import BinaryDecoder
 from rig.devices.trackers.profile import load_profile
 from rig.devices.trackers.stream import TrackerRecord
 from rig.errors import RigError
-from rig.service.record import record_tracker
+from rig.service.tracker_recording import record_tracker
 
 TARGET_US_PER_SAMPLE = 50.0
 TARGET_LATENCY_MEDIAN_MS = 1.0
@@ -125,7 +131,7 @@ def _sent(log: Path) -> tuple[dict[int, float], int, int]:
     return intact, damaged, lost
 
 
-def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: Callable[[str], None]) -> dict[str, Any]:
+def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: Log) -> dict[str, Any]:
     folder.mkdir(parents=True, exist_ok=True)
     sent_log = folder / "sent.csv"
     address = str(folder / "tracker") if case.transport == "pty" else "0" if case.transport == "tcp" else f"rig-bench-{os.getpid()}-{folder.name}"
@@ -242,19 +248,27 @@ def stolen_pct(before: tuple[int, int] | None, after: tuple[int, int] | None) ->
     return 100.0 * (after[0] - before[0]) / (after[1] - before[1])
 
 
-def run_bench(rate_hz: float, duration_s: float, folder: Path, log: Callable[[str], None]) -> dict[str, Any]:
-    """Every case in turn; each row also holds the noise its figures carry: the machine's 1-minute
+def run(args: argparse.Namespace, context: Context) -> list[dict[str, Any]]:
+    """Every case in turn, `args.rate` records a second for `args.duration` seconds; each row also holds the noise its figures carry: the machine's 1-minute
     load average when it started, the wake floor measured just before it, and the share of the CPU
     the host of a virtual machine took during it (a stolen stretch delays records by milliseconds,
     which shows in the latency's 95th percentile first)."""
     rows = []
-    for index, case in enumerate(cases(fault_at_s=duration_s / 2.0)):
+    for index, case in enumerate(cases(fault_at_s=args.duration / 2.0)):
         load = os.getloadavg()[0]
-        floor = wake_floor(rate_hz, WAKE_FLOOR_S, folder / f"floor{index}")
+        floor = wake_floor(args.rate, WAKE_FLOOR_S, context.folder / f"floor{index}")
         before = cpu_ticks()
-        row = run_case(case, rate_hz, duration_s, folder / f"case{index}", log)
+        row = run_case(case, args.rate, args.duration, context.folder / f"case{index}", context.log)
         rows.append({**row, "load_average_1min": load, "wake_floor_us": floor, "stolen_cpu_pct": stolen_pct(before, cpu_ticks())})
-    return {"rows": rows, "targets_met": targets(rows)}
+    return rows
+
+
+def machine_noise(rows: list[dict[str, Any]]) -> str:
+    """The machine's load and the CPU its host took, over the cases."""
+    loads = [row["load_average_1min"] for row in rows]
+    stolen = [row["stolen_cpu_pct"] for row in rows if row["stolen_cpu_pct"] is not None]
+    return (f"machine noise: {os.cpu_count()} CPUs, 1-minute load average {min(loads):.2f} to {max(loads):.2f} over the cases"
+            + (f", CPU stolen by the virtual machine's host {min(stolen):.1f} to {max(stolen):.1f} %" if stolen else ""))  # fmt: skip
 
 
 def table(rows: list[dict[str, Any]]) -> str:
@@ -297,3 +311,18 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
     latency.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=100)
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--rate", type=options.positive_float, default=1000.0, help="records a second (default: %(default)s)")
+    parser.add_argument("--duration", type=options.positive_float, default=10.0, help="seconds per case (default: %(default)s)")
+    parser.add_argument("--quick", dest="duration", action="store_const", const=2.0, help="2 s per case (a smoke test)")
+
+
+BENCH = Bench(
+    name="trackers",
+    help="the serial and LSL tracker sources fed by the emulators: loss, fabrication, CPU per sample, added latency",
+    run=run, table=table, targets=targets, notes=machine_noise, plot=plot, options=_options,
+    outputs={"json": "write the rows as a JSON list", "plot": "plot CPU per sample and latency per case"},
+    runs="keep the recordings and emulator logs here (default: a temporary folder)",
+)

@@ -12,78 +12,71 @@ what each variant costs in image quality for the latency it saves.
 
 from __future__ import annotations
 
+import argparse
 import time
 from dataclasses import dataclass, replace
-from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
+from rig.bench import renderer_plots
+from rig.bench.contract import Bench, Context, cell, given
 from rig.bench.renderer_latency import film_latency
-from rig.bench.renderers import (
-    QUALITY_FIGURES,
-    QUICK_SPEC,
-    BenchGrid,
-    machine_name,
-    measure_warp_quality,
-    open_warp,
-    read_grid,
-    scene_setup,
-    time_direct,
-    time_warp_rounds,
-)
+from rig.bench.renderer_setup import QUALITY_FIGURES, machine_name, open_warp, scene_setup
+from rig.bench.renderers import BenchGrid, measure_warp_quality, plain, time_direct, time_warp_rounds, with_options
 
 DEFAULT_VARIANTS = (
     "warp", "warp:recon=quad", "warp:recon=mesh", "warp:recon=grid", "warp:views=2", "warp:holes=1", "warp:holes=2",
     "warp:fill=lowpass", "warp:views=2,recon=grid,holes=2,fill=lowpass", "warp:spin=30", "warp:spin=30,untracked=hold",
 )  # fmt: skip
-
-Log = Callable[[str], None]
+QUICK_VARIANTS = ("warp", "warp:views=2,recon=grid,holes=1")
 
 
 @dataclass(frozen=True)
 class VariantSpec:
-    """What `--variants` measures: load sizes and shape, variants, the display, the rate ratio of
-    the image error, the latency runs' predictor and costs."""
+    """What `--variants` measures: the variants, what the load makes, and the grid whose load sizes,
+    first resolution, first rate ratio (of the image error), timing and films (predictor, costs) it takes."""
 
-    triangles: tuple[int, ...] = (10_000, 200_000)
-    """a cheap scene and one whose direct frames take several refreshes, still within what filming measures"""
+    variants: tuple[str, ...] = DEFAULT_VARIANTS
     load: str = "soup"
     """what the load's triangles make (`rig.render.gl.LOAD_SHAPES`): the soup is the stress case of
     the warp's reconstructions (visible fragments a few pixels wide), meshes what real scenes are"""
-    variants: tuple[str, ...] = DEFAULT_VARIANTS
-    grid: BenchGrid = BenchGrid(resolutions=((320, 240),), ratios=(5,), phases=2, warp_rounds=8, direct_frames=3, direct_budget_s=2.0)
-    predictor: str = "hold"
+    grid: BenchGrid = BenchGrid(triangles=(10_000, 200_000), resolutions=((320, 240),), ratios=(5,), phases=2, warp_rounds=8,
+                                direct_frames=3, direct_budget_s=2.0)  # fmt: skip
+    """a cheap scene and one whose direct frames take several refreshes, still within what filming measures"""
 
 
-def quick_spec() -> VariantSpec:
-    """A tiny run: one load, two variants, the quick grid's display and films at one rate ratio."""
-    return VariantSpec(triangles=(1_000,), variants=("warp", "warp:views=2,recon=grid,holes=1"), grid=replace(read_grid(QUICK_SPEC), ratios=(3,)))
+def spec(args: argparse.Namespace) -> VariantSpec:
+    """The variants' spec, the options given over it and its grid; with --quick a tiny run: one load,
+    two variants, the quick grid (`args.spec`, read) at one rate ratio."""
+    chosen = VariantSpec(QUICK_VARIANTS, grid=replace(args.spec, triangles=(1_000,), ratios=(3,))) if args.quick else VariantSpec()
+    return replace(chosen, grid=with_options(chosen.grid, args), **given(args, "load"), **({"variants": tuple(args.variant)} if args.variant else {}))
 
 
-def run_variants(spec: VariantSpec, runs_dir: Path, log: Log) -> list[dict[str, Any]]:
+def run(spec: VariantSpec, context: Context) -> list[dict[str, Any]]:
     """A row per variant and load size (see the module docstring)."""
+    log, runs_dir = context.log, context.folder
     machine = machine_name()
     log(f"machine: {machine}; load: {spec.load}")
     grid = spec.grid
     size, ratio = grid.resolutions[0], grid.ratios[0]
     rows: list[dict[str, Any]] = []
-    for triangles in spec.triangles:
+    for triangles in grid.triangles:
         setup, pendulum = scene_setup(*size, triangles, grid.refresh_hz, spec.load)
         direct_s = float(np.median(time_direct(setup, grid)[0]))
-        direct_run = grid.latency_run("direct", triangles, spec.predictor, load=spec.load)
+        direct_run = grid.latency_run("direct", triangles, grid.predictor, load=spec.load)
         direct = film_latency(direct_run, direct_s, 0.0, runs_dir / f"variants-direct-{triangles}")
         log(f"{triangles:>9} triangles: direct latency {direct['latency_measured_ms'] or float('nan'):.1f} ms")
         for variant in spec.variants:
             started = time.perf_counter()
-            m = open_warp(variant, setup, pendulum, (ratio,))
+            m = open_warp(variant, setup, pendulum, grid.ratios)
             try:
                 measure_warp_quality(m, grid)
                 time_warp_rounds([m], grid)
             finally:
                 m.renderer.close()
             client_s, server_s = float(np.median(m.client_s)), float(np.median(m.wall_s))
-            run = grid.latency_run(variant, triangles, spec.predictor, load=spec.load)
+            run = grid.latency_run(variant, triangles, grid.predictor, load=spec.load)
             figures = film_latency(run, client_s, server_s, runs_dir / f"variants-{variant.replace(':', '_').replace(',', '_')}-{triangles}")
             warp_ms, direct_ms = figures["latency_measured_ms"], direct["latency_measured_ms"]
             rows.append({
@@ -106,9 +99,8 @@ def variants_text(rows: list[dict[str, Any]]) -> str:
               f"{'ms/frame':>8} {'missed':>6} {'latency':>8} {'saved':>7}")  # fmt: skip
     lines = [header]
     for r in rows:
-        figures = [f"{r[name]:.3f}" if r[name] is not None else "-" for name in ("lab_error_pct", "ssim", "dssim", "hole_pct")]
-        latency = "-" if r["latency_measured_ms"] is None else f"{r['latency_measured_ms']:.1f}"
-        saved = "-" if r["latency_saved_ms"] is None else f"{r['latency_saved_ms']:.1f}"
+        figures = [cell(r[name], ".3f") for name in ("lab_error_pct", "ssim", "dssim", "hole_pct")]
+        latency, saved = cell(r["latency_measured_ms"]), cell(r["latency_saved_ms"])
         lines.append(
             f"{r['triangles']:>9} {r['spec']:45} {figures[0]:>8} {figures[1]:>7} {figures[2]:>7} {figures[3]:>7} {r['primitives']:>10.0f} "
             f"{r['server_ms_median']:>8.1f} {r['missed_pct'] or 0:>5.0f}% {latency:>8} {saved:>7}"
@@ -116,3 +108,15 @@ def variants_text(rows: list[dict[str, Any]]) -> str:
     lines.append(f"image figures: means over the warped frames (client:display 1:{rows[0]['rate_ratio']}); "
                  f"{', '.join(QUALITY_FIGURES)}" if rows else "no rows")  # fmt: skip
     return "\n".join(lines)
+
+
+def _options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--variant", action="append", metavar="SPEC",
+                        help="a warp variant for --variants; repeat for several (default: the seeds' features one by one)")  # fmt: skip
+
+
+BENCH = Bench(
+    name="variants",
+    help="image error against latency saved for each warp variant and scene",
+    spec=spec, run=run, table=variants_text, record=plain, plot=renderer_plots.plot_variants, options=_options,
+)

@@ -16,7 +16,7 @@ from rig.board.events import (
     PhotodiodeSample,
 )
 from rig.board.microcontroller import Microcontroller
-from rig.board.recording import BoardRecorder
+from rig.board.recorder import BoardRecorder
 
 __all__ = [
     "BoardIdentity",

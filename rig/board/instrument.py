@@ -19,7 +19,7 @@ from typing import Any, Callable
 
 from rig.board.link import SerialPort, open_serial_url
 from rig.board.microcontroller import Microcontroller
-from rig.board.recording import BoardRecorder
+from rig.board.recorder import BoardRecorder
 from rig.clock import Clock
 from rig.errors import RigError
 

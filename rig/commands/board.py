@@ -28,7 +28,7 @@ from analysis.board.photodiode_latency import estimate_from_recording, plot_boar
 from rig.board.clock_sync import OffsetInterval
 from rig.board.instrument import DEFAULT_FALL, DEFAULT_RISE, BoardInstrument, BoardSettings
 from rig.board.microcontroller import Microcontroller
-from rig.board.recording import BoardRecorder
+from rig.board.recorder import BoardRecorder
 from rig.clock import MonotonicClock
 from rig.commands import outputs
 from rig.commands.options import non_negative_float, non_negative_int, positive_float

@@ -15,26 +15,24 @@ from declared.settings import whole_numbers
 Config = TypeVar("Config")
 
 
-def add_declared_options(parser: argparse.ArgumentParser, kind: type, groups: dict[str, str] | None = None) -> None:
+def add_declared_options(parser: argparse.ArgumentParser, kind: type, groups: dict[str, str] | None = None) -> dict[str, Any]:
     """An option for each setting of `kind` with a flag (nested configs' included), in declaration
     order; a flag's group is a section titled as `groups` says (a group not named there is left out:
-    its options are not this command's)."""
+    its options are not this command's). The sections by title, for options of the command's own."""
     groups = {"": "", **(groups or {})}
-    sections: dict[str, Any] = {}
+    sections = {title: parser.add_argument_group(title) if title else parser for title in groups.values()}
     for entry in walk(kind):
         flag = entry.setting.flag
-        if flag is None or flag.group not in groups:
-            continue
-        title = groups[flag.group]
-        if title not in sections:
-            sections[title] = parser.add_argument_group(title) if title else parser
-        sections[title].add_argument(flag.name, dest=_dest(entry), **_argument(entry))
+        if flag is not None and flag.group in groups:
+            sections[groups[flag.group]].add_argument(flag.name, dest=_dest(entry), **_argument(entry))
+    return sections
 
 
-def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception]) -> Config:
-    """The `kind` the options given make (every setting without an option at its default), each
-    value in its setting's unit; `error` is what `kind` raises for a value it does not allow."""
-    table: dict[str, Any] = {}
+def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception], **given: Any) -> Config:
+    """The `kind` the options given make (every setting without an option at its default, and the
+    fields in `given` as given), each value in its setting's unit; `error` is what `kind` raises
+    for a value it does not allow."""
+    table: dict[str, Any] = dict(given)
     per: list[tuple[Entry, Any]] = []
     for entry in walk(kind):
         flag = entry.setting.flag
@@ -70,19 +68,19 @@ def _get(table: dict[str, Any], path: str) -> Any:
 
 
 def _argument(entry: Entry) -> dict[str, Any]:
-    """argparse's keywords for the entry's option."""
+    """argparse's keywords for the entry's option: its help ends with its unit and default."""
     setting, flag = entry.setting, entry.setting.flag
     default = flag.default if flag.default is not None else _converted(entry.default, flag.factor)
     unit = flag.unit if flag.unit is not None else setting.unit
     shown = setting.unset if default is None else ",".join(f"{v:g}" for v in default) if isinstance(default, tuple) else str(default)
     about = "; ".join(part for part in (unit, f"default: {shown}" if shown and entry.hint is not bool else "") if part)
-    keywords: dict[str, Any] = {"help": f"{setting.help} ({about})".replace("%", "%%") if about else setting.help}
+    text = flag.help or setting.help
+    keywords: dict[str, Any] = {"help": (f"{text} ({about})" if about else text).replace("%", "%%")}
     if entry.hint is bool:
         return keywords | {"action": "store_true"}
     keywords |= {"default": default, "metavar": flag.metavar}
-    if setting.allowed() is not None:
-        return keywords | {"choices": setting.allowed(), "metavar": flag.metavar}
-    return keywords | {"type": _parser(entry)}
+    choices = setting.allowed()
+    return keywords | ({"choices": choices} if choices is not None else {"type": _parser(entry)})
 
 
 def _converted(value: Any, factor: float) -> Any:
@@ -90,25 +88,28 @@ def _converted(value: Any, factor: float) -> Any:
 
 
 def _parser(entry: Entry) -> Callable[[str], Any]:
-    """Text to the option's value, checked against the setting's range in the option's unit."""
+    """Text to the option's value (a list is comma-separated), checked against the setting's range
+    in the option's unit."""
     setting, flag = entry.setting, entry.setting.flag
-    hint = typing.get_args(entry.hint) if typing.get_origin(entry.hint) is tuple else (entry.hint,)
-    whole = whole_numbers(entry.hint)
+    kinds = typing.get_args(entry.hint) if typing.get_origin(entry.hint) is tuple else (entry.hint,)
+    listed = len(kinds) > 1
     allowed = flag.range or (setting.range.scaled(flag.factor) if setting.range is not None else None)
     unit = flag.unit if flag.unit is not None else setting.unit
+    expected = _expected(kinds, flag.metavar, setting.none)
 
     def parse(text: str) -> Any:
         if setting.none and text == setting.none:
             return None
-        parts = text.split(",") if len(hint) > 1 else [text]
+        parts = text.split(",") if listed else [text]
+        items = [kinds[0]] * len(parts) if kinds[-1] is Ellipsis else kinds
         try:
-            if len(parts) != len(hint):
+            if len(parts) != len(items):
                 raise ValueError
-            values = tuple(kind(part) for kind, part in zip(hint, parts))
+            values = tuple(kind(part) for kind, part in zip(items, parts))
         except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {_expected(hint, flag.metavar, setting.none)}, got {text!r}") from None
-        value = values if len(hint) > 1 else values[0]
-        problem = setting.problem(value, whole, allowed, unit)
+            raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}") from None
+        value = values if listed else values[0]
+        problem = setting.problem(value, whole_numbers(entry.hint), allowed, unit)
         if problem is not None:
             raise argparse.ArgumentTypeError(f"{problem}, got {text}")
         return value
@@ -116,7 +117,8 @@ def _parser(entry: Entry) -> Callable[[str], Any]:
     return parse
 
 
-def _expected(hint: tuple[Any, ...], metavar: str | None, none: str) -> str:
-    kind = "whole number" if hint[0] is int else "number" if hint[0] is float else "value"
-    what = f"a {kind}" if len(hint) == 1 else f"{metavar or 'values'}, {len(hint)} {kind}s"
+def _expected(kinds: tuple[Any, ...], metavar: str | None, none: str) -> str:
+    noun = "whole number" if kinds[0] is int else "number" if kinds[0] is float else "value"
+    count = "" if kinds[-1] is Ellipsis else f"{len(kinds)} "
+    what = f"a {noun}" if len(kinds) == 1 else f"{metavar or 'values'}, {count}{noun}s"
     return f"{what} or '{none}'" if none else what

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from rig.commands import outputs
 from rig.commands.formatting import summary_line
-from rig.commands.simulation_options import add_simulation_options, config_from_args
+from rig.commands.simulation_options import add_simulation_options, simulation_config
 from rig.progress import ProgressBar
 from rig.service import compare_renderers, comparison_config, demo
 from rig.service.demo import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
@@ -22,7 +22,7 @@ EXIT_MISMATCH = 1
 
 
 def _run(args: argparse.Namespace) -> int:
-    config = config_from_args(args)
+    config = simulation_config(args)
     if args.compare:
         return _run_comparison(args, comparison_config(config))
     out: Path = args.out

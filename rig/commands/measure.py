@@ -28,7 +28,7 @@ from rig.commands.record import CAMERA_SPECS, add_camera_options
 from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
 from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, measure
-from rig.live.record import check_first_seconds, record_camera
+from rig.live.camera_recording import check_first_seconds, record_camera
 from rig.live.run import EXTERNAL, LiveConfig
 from rig.lsl import StreamNames
 from rig.progress import ProgressBar

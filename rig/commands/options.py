@@ -96,13 +96,6 @@ def predictor_spec(text: str) -> tuple[str, dict[str, Any]]:
     return name, params
 
 
-def app_frame_cost(text: str) -> float | None:
-    """A modelled cost in ms, or 'measured' for the real GL render time."""
-    if text == "measured":
-        return None
-    return positive_float(text)
-
-
 def add_executor_options(parser: argparse.ArgumentParser, what: str) -> None:
     """--workers and --scheduler: where `what` runs (`rig.executor`; neither: here, serially)."""
     parser.add_argument("--workers", type=positive_int, metavar="N", help=f"run {what} on a local Dask cluster of N processes")

@@ -14,6 +14,7 @@ command then ends with one line saying what was not written (exit status 2).
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import os
 import tempfile
@@ -120,6 +121,17 @@ class LateWrites:
     def json(self, path: Path, record: object) -> None:
         """Write `record` as indented JSON to `path`, as `write` does."""
         self.write(path, lambda: path.write_text(json.dumps(record, indent=1) + "\n", encoding="utf-8"))
+
+    def csv(self, path: Path, rows: list[dict[str, object]]) -> None:
+        """Write `rows` as CSV to `path`, a column per field any row has in the order they first appear, as `write` does."""
+
+        def write() -> None:
+            with path.open("w", newline="", encoding="utf-8") as stream:
+                writer = csv.DictWriter(stream, fieldnames=list(dict.fromkeys(key for row in rows for key in row)))
+                writer.writeheader()
+                writer.writerows(rows)
+
+        self.write(path, write)
 
     def check(self) -> None:
         """RigError if any write failed; the result has been printed by then."""

@@ -13,7 +13,6 @@ import json
 import sys
 
 from rig.commands import options, outputs
-from rig.commands.simulation_options import amplitude_deg
 from rig.service import Plan, PlanRequest, plan
 from rig.sim.pendulum import PendulumConfig
 
@@ -98,7 +97,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--period-s", type=options.positive_float, default=1.0, help="the pendulum's period (default: %(default)s)")
     parser.add_argument(
-        "--amplitude-deg", type=amplitude_deg, default=PendulumConfig().amplitude_deg, help="its swing (default: %(default)s)"
+        "--amplitude-deg", type=options.positive_float, default=PendulumConfig().amplitude_deg, help="its swing (default: %(default)s)"
     )
     parser.add_argument(
         "--accuracy-ms", type=options.positive_float, default=1.0, help="the 95%% half-width wanted, in ms (default: %(default)s)"

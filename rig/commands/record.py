@@ -12,7 +12,7 @@ import argparse
 import json
 
 from rig.commands import options, outputs
-from rig.live.record import record_camera
+from rig.live.camera_recording import record_camera
 from rig.progress import ProgressBar
 
 CAMERA_SPECS = (

@@ -14,7 +14,7 @@ import json
 from rig.commands import choices, options, outputs
 from rig.progress import ProgressBar
 from rig.errors import RigError
-from rig.service.record import record_tracker
+from rig.service.tracker_recording import record_tracker
 
 
 def _summary(sidecar: dict) -> str:

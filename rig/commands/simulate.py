@@ -6,14 +6,7 @@ import argparse
 import json
 
 from rig.commands import outputs
-from rig.commands.simulation_options import (
-    add_flash_options,
-    add_lab_options,
-    add_simulation_options,
-    config_from_args,
-    with_flash_options,
-    with_lab_options,
-)
+from rig.commands.simulation_options import add_flash_options, add_simulation_options, simulation_config
 from rig.progress import ProgressBar
 from rig.service import SimulationConfig, simulate
 from rig.service.run_plot import plot_run
@@ -21,7 +14,7 @@ from rig.sim.board import BOARD_FOLDER
 
 
 def _run(args: argparse.Namespace) -> int:
-    config = with_flash_options(with_lab_options(config_from_args(args), args), args)
+    config = simulation_config(args)
     result = simulate(config, args.out, ProgressBar("simulating"), args.overwrite)
     writes = outputs.LateWrites()
     if args.plot is not None:
@@ -64,8 +57,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="plot the run's truth: the sphere as tracked, predicted and displayed, and each refresh's delay from "
         "the newest sample to its photons beside the true latency",
     )
-    add_simulation_options(parser)
-    add_lab_options(parser)
+    add_simulation_options(parser, lab=True)
     add_flash_options(parser)
     parser.set_defaults(func=_run)
 

@@ -18,8 +18,9 @@ from typing import Any, Sequence
 
 from rig.devices.trackers.lsl_tracker import CHANNELS, pylsl
 from rig.emulate.encode import Emission, RecordEncoder
-from rig.emulate.faults import ByteFaults
+from rig.emulate.streamer import ReaderGone
 from rig.errors import RigError
+from rig.sim.tracker_faults import ByteFaults
 
 # After a reader opens the port it may flush what is waiting (pyserial does): start a little later.
 READER_GRACE_S = 0.1
@@ -62,14 +63,14 @@ class PtySink:
         return True
 
     def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
-        """Writes the records at once; (damaged per record, the monotonic time of the write)."""
+        """Writes the records at once; (damaged per record, the monotonic time of the write). ReaderGone
+        once nobody reads: the write would block for good when the terminal's buffer is full."""
+        if not self._reader_present():
+            raise ReaderGone
         chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
         written = time.monotonic()
         os.write(self._master, b"".join(chunks))
         return list(damaged), written
-
-    def connected(self) -> bool:
-        return self._reader_present()
 
     def disconnect(self) -> None:
         os.close(self._master)
@@ -128,9 +129,6 @@ class TcpSink:
             self._client = None
         return list(damaged), written
 
-    def connected(self) -> bool:
-        return self._client is not None
-
     def disconnect(self) -> None:
         for sock in (self._client, self._listener):
             if sock is not None:
@@ -177,9 +175,6 @@ class LslSink:
         for emission in emissions:
             self._outlet.push_sample([*emission.position, *emission.orientation], emission.device_time)
         return [False] * len(emissions), written
-
-    def connected(self) -> bool:
-        return self._outlet is not None and self._outlet.have_consumers()
 
     def disconnect(self) -> None:
         self._outlet = None

@@ -1,9 +1,12 @@
-"""The emulated tracker's sending loop: a record every 1 / rate seconds, faults on schedule, and a log
-of what became of every record (`SENT_COLUMNS`), written as it goes.
+"""The emulated tracker's sending loop: each record written when the simulated tracker says it reaches
+the host (`rig.sim.tracker.TrackerSamples.t_arrival`, after its delay, jitter, bursts and stalls), a
+disconnect acted out on the sink, and a log of what became of every record (`SENT_COLUMNS`), written
+as it goes.
 
 A record's fate is `intact` (sent as encoded; garbage bytes before it leave it so), `damaged`
-(sent with bytes changed or left out) or `lost` (measured while the port was away, never sent). `t_write` is the monotonic time (s, `time.monotonic`) just before the write, which
-the tracker bench compares with the rig's arrival times.
+(sent with bytes changed or left out) or `lost` (dropped by the tracker, or due while the port was
+away, never sent). `t_write` is the monotonic time (s, `time.monotonic`) just before the write (for
+a lost record, when it was due), which the tracker bench compares with the rig's arrival times.
 """
 
 from __future__ import annotations
@@ -12,16 +15,26 @@ import time
 from dataclasses import dataclass
 from typing import Callable, Protocol, Sequence
 
+import numpy as np
+
 from rig.emulate.encode import Emission
-from rig.emulate.faults import FaultPlan
-from rig.emulate.motion import Motion
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
+from rig.sim.tracker import TrackerSamples
 
 SENT_COLUMNS = ("seq", "device_time", "t_write", "fate")
-# How long a sink waits for its reader to come (back) before the emulator gives up.
+# How long a sink waits for its first reader before the emulator gives up.
 READER_TIMEOUT_S = 60.0
-# Before a disconnect, and at the end, the emulator lets the reader take what is in flight.
+# How long after its last record the emulator waits for a reader to come back from a disconnect.
+READER_RETURN_S = 2.0
+# At the end the emulator lets the reader take what is in flight; before a disconnect, longer (up
+# to half the time the port is away), as a closed pty loses what its reader has not read yet and a
+# reader on a loaded machine may wait that long for the CPU.
 DRAIN_S = 0.05
+DISCONNECT_DRAIN_S = 0.25
+
+
+class ReaderGone(Exception):
+    """Raised by a sink that cannot send once its reader has gone (a pty's writes would block)."""
 
 
 class Sink(Protocol):
@@ -30,8 +43,6 @@ class Sink(Protocol):
     def wait_for_reader(self, stop_at: float) -> bool: ...
 
     def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]: ...
-
-    def connected(self) -> bool: ...
 
     def disconnect(self) -> None: ...
 
@@ -52,76 +63,73 @@ class SentCounts:
 
 
 def stream(
-    motion: Motion,
+    samples: TrackerSamples,
+    rates: np.ndarray,
     sink: Sink,
-    duration_s: float,
-    plan: FaultPlan,
+    rate_hz: float,
+    disconnect: tuple[float, float] | None,
     device_clock: Callable[[float], float],
     log: CsvRecord | None,
     on_event: Callable[[str], None] = lambda message: None,
+    on_start: Callable[[float], None] = lambda t: None,
 ) -> SentCounts:
-    """Sends duration_s * rate records through `sink` once a reader is there; `device_clock` turns a
-    monotonic time into the device's own. Returns what was sent."""
+    """Sends `samples` (with their angular `rates`) through `sink` once a reader is there;
+    `device_clock` turns the monotonic time a sample was measured at into the device's own time,
+    which its record carries; `disconnect` (when, for how long, in s from the start) is the one the
+    fault plan holds, if any. Returns what was sent."""
     counts = SentCounts()
-    rate = motion.rate_hz
-    total = int(round(duration_s * rate))
     if not sink.wait_for_reader(time.monotonic() + READER_TIMEOUT_S):
         on_event("no reader came; nothing sent")
         return counts
-    on_event(f"reader connected; sending {total} records at {rate:g} Hz")
-    motion.pose(0)  # the first block of poses is worked out before the clock starts, not late
+    on_event(f"reader connected; sending {int(np.count_nonzero(~samples.lost))} records at {rate_hz:g} Hz")
+    seqs, due, lost = samples.seq.tolist(), samples.t_arrival.tolist(), samples.lost.tolist()
+    measured, positions, orientations = samples.t_sensor.tolist(), samples.positions.tolist(), samples.orientations.tolist()
+    angular_rates = rates.tolist()
     start = time.monotonic()
-    held: list[Emission] = []
-    stalled = disconnected = False
+    on_start(start)
+
+    def emission(k: int) -> Emission:
+        return Emission(seqs[k], device_clock(start + measured[k]), tuple(positions[k]), tuple(orientations[k]), tuple(angular_rates[k]))
 
     def record(emissions: Sequence[Emission], fates: Sequence[str], t_write: float) -> None:
-        for emission, fate in zip(emissions, fates):
+        for sent, fate in zip(emissions, fates):
             setattr(counts, fate, getattr(counts, fate) + 1)
             if log is not None:
-                log.write((emission.seq, emission.device_time, t_write, fate))
+                log.write((sent.seq, sent.device_time, t_write, fate))
         if log is not None:
             log.flush()
 
-    def flush() -> None:
-        if held:
-            damaged, t_write = sink.send(held, rate)
-            record(held, ["damaged" if d else "intact" for d in damaged], t_write)
-            held.clear()
-
-    k = 0
-    while k < total:
-        t_k = start + k / rate
-        delay = t_k - time.monotonic()
-        if delay > 0:
-            time.sleep(delay)
-        elapsed = t_k - start
-        if plan.disconnect and not disconnected and elapsed >= plan.disconnect[0]:
-            disconnected = True
-            flush()
-            time.sleep(DRAIN_S)
+    away_until = -np.inf
+    k, count = 0, len(seqs)
+    while k < count:
+        if disconnect is not None and due[k] >= disconnect[0]:
+            time.sleep(min(DISCONNECT_DRAIN_S, disconnect[1] / 2))
             sink.disconnect()
-            on_event(f"disconnected at {elapsed:.3f} s for {plan.disconnect[1]:g} s")
-            time.sleep(max(0.0, start + plan.disconnect[0] + plan.disconnect[1] - time.monotonic()))
-            if not sink.reconnect(time.monotonic() + READER_TIMEOUT_S):
+            on_event(f"disconnected at {time.monotonic() - start:.3f} s for {disconnect[1]:g} s")
+            time.sleep(max(0.0, start + sum(disconnect) - time.monotonic()))
+            if not sink.reconnect(start + max(due) + READER_RETURN_S):
                 on_event("the reader did not come back; stopping")
                 break
-            resumed = time.monotonic()
-            on_event(f"reconnected at {resumed - start:.3f} s")
-            while k < total and start + k / rate < resumed:
-                t_lost = start + k / rate
-                lost = Emission(k, device_clock(t_lost), *motion.pose(k))
-                record([lost], ["lost"], t_lost)
-                k += 1
+            away_until, disconnect = time.monotonic() - start, None
+            on_event(f"reconnected at {away_until:.3f} s")
             continue
-        position, orientation, angular_rate = motion.pose(k)
-        held.append(Emission(k, device_clock(t_k), position, orientation, angular_rate))
-        in_stall = plan.stall is not None and plan.stall[0] <= elapsed < plan.stall[0] + plan.stall[1]
-        if in_stall and not stalled:
-            stalled = True
-            on_event(f"stalling at {elapsed:.3f} s for {plan.stall[1]:g} s")
-        if not in_stall and len(held) >= plan.burst:
-            flush()
-        k += 1
-    flush()
+        if lost[k] or due[k] < away_until:
+            record([emission(k)], ["lost"], start + due[k])
+            k += 1
+            continue
+        group = k + 1
+        while group < count and due[group] == due[k] and not lost[group]:
+            group += 1
+        delay = start + due[k] - time.monotonic()
+        if delay > 0:
+            time.sleep(delay)
+        emissions = [emission(j) for j in range(k, group)]
+        try:
+            damaged, t_write = sink.send(emissions, rate_hz)
+        except ReaderGone:
+            on_event("the reader went away; stopping")
+            break
+        record(emissions, ["damaged" if d else "intact" for d in damaged], t_write)
+        k = group
     time.sleep(DRAIN_S)
     return counts

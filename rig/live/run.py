@@ -36,7 +36,7 @@ from rig.live.still import RunEnded, SwingWatch
 from rig.live.view import View, view_from_positions
 from rig.lsl import MARKER_COLUMNS, PUBLISHED_COLUMNS, ExternalRenderer, LslPublisher, MarkerDisplay, PublishingRenderer
 from rig.lsl import StreamNames
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 from rig.render import RenderSetup, make_renderer
 from rig.session import PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
 from rig.session.session import Progress

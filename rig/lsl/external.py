@@ -27,7 +27,7 @@ from rig.devices.trackers.lsl_tracker import lsl_origin, pylsl, time_correction
 from rig.devices.window.refresh import RefreshModel
 from rig.errors import RigError
 from rig.lsl.streams import MARKER_CHANNELS, StreamNames
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 from rig.render.protocol import AppFrameRequest, AppFrameResult, DisplayFrameRequest, DisplayFrameResult, RenderSetup
 
 MARKER_COLUMNS = ("frame", "t_swap", "refresh")

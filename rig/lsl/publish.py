@@ -31,7 +31,7 @@ from rig.render.protocol import (
     Renderer,
     RenderSetup,
 )
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 
 PUBLISHED_COLUMNS = ("frame", "t_pose", *POSE_CHANNELS[1:])
 """`t_pose`: when the renderer was handed the pose (rig clock); the others as `RigPose`'s channels."""

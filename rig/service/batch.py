@@ -24,7 +24,7 @@ from analysis.errors import AnalysisError
 from predictors import PredictorError
 from rig.errors import ConfigError, RigError
 from rig.executor import executor
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 from rig.service.analyse import AnalysisRequest, analyse
 
 VIDEO_SUFFIXES = (".avi", ".mp4", ".mov", ".mkv", ".m4v", ".webm")

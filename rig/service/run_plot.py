@@ -11,7 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from rig.report.figures import LEGEND_BESIDE
-from rig.session.record import APP_FRAMES_FILE, DISPLAY_FRAMES_FILE, TRACKER_FILE
+from rig.session.run_record import APP_FRAMES_FILE, DISPLAY_FRAMES_FILE, TRACKER_FILE
 
 
 def _columns(path: Path, *names: str) -> list[np.ndarray]:

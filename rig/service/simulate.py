@@ -1,6 +1,6 @@
 """Simulate the rig: a session on a virtual clock with the simulated devices, and the run's truth.
 
-A run writes into its output folder as it goes (`rig.session.record`): `tracker.csv`,
+A run writes into its output folder as it goes (`rig.session.run_record`): `tracker.csv`,
 `app_frames.csv`, `display_frames.csv`, `video.avi` and `camera_frames.csv` (or the camera's
 `video.mp4` or `video.mov` with `frame_times.csv` too, `rig.film_file`), with a simulated board its
 recording in `board/` (`rig.sim.board`), and at the end `truth.json` (`rig.sim.truth`). A folder
@@ -101,7 +101,7 @@ def _film_truth(config: SimulationConfig, world: SimulatedWorld, film_times: np.
         led_row=led_row,
         sphere_row=sphere_row,
         container=camera.container,
-        codec=camera.codec,
+        codec=camera.film[1],
         frame_times=FRAME_TIMES_FILE if camera.container in STAMPED_CONTAINERS else None,
     )
 
@@ -145,7 +145,7 @@ def simulate(
         target=PhotonTarget(config.photon_target, config.persistence),
     )
     _prepare(out_dir, overwrite)
-    with RunRecord(out_dir, overwrite=overwrite, film=(config.camera.container, config.camera.codec)) as record:
+    with RunRecord(out_dir, overwrite=overwrite, film=config.camera.film) as record:
         log = Session(parts, world.t_begin, world.t_end, record, progress).run()
     impairments = config.camera.impairments
     truth = run_truth(

@@ -38,22 +38,17 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from analysis import AnalysisError, AnalysisOptions, LatencyResult
-from declared import from_table
+from declared import from_table, setting_of
 from rig.errors import ConfigError
 from rig.film_file import video_file_name
 from rig.executor import executor
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, analysed_row
 from rig.service.simulate import SimulationResult, simulate
-from rig.sim.board import SimulatedBoardConfig
 from rig.sim.config import SimulationConfig
 
 SIMULATED_ROIS = "simulated_rois"
 """The [analysis] option that analyses each video within its simulation's regions."""
-MEASURED = "measured"
-MEASURED_COSTS = ("app_frame_ms", "warp_ms")
-"""SimulationConfig's costs, None (this machine's GL time) where a sweep says MEASURED."""
-_NESTED = {"board": SimulatedBoardConfig}
 
 
 @dataclass(frozen=True)
@@ -135,58 +130,35 @@ def _merged(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, 
     return {**_dotted(base), **_dotted(overrides)}
 
 
-def _checked_number(field: dataclasses.Field, value: Any, prefix: str) -> Any:
-    """`value`, unless the field holds a number and the sweep gives it something else."""
-    declared = str(field.type).split(" | ")
-    number = declared[0] in ("float", "int") and not isinstance(value, bool) and isinstance(value, (int, float))
-    if declared[0] in ("float", "int") and not number and not (value is None and "None" in declared):
-        raise ConfigError(f"the sweep sets {prefix}{field.name} to {value!r}; it takes a number")
-    return value
-
-
-def build(kind: type, settings: Mapping[str, Any], prefix: str = "") -> Any:
-    """A config dataclass from dotted settings (`camera.fps`), every key checked against its fields."""
-    fields = {f.name: f for f in dataclasses.fields(kind)}
-    direct: dict[str, Any] = {}
-    nested: dict[str, dict[str, Any]] = {}
+def build(kind: type, settings: Mapping[str, Any]) -> Any:
+    """A config dataclass from dotted settings (`camera.fps`), every key and value checked against
+    its declaration (`declared.from_table`)."""
+    table: dict[str, Any] = {}
     for key, value in settings.items():
-        head, _, rest = key.partition(".")
-        if head not in fields:
-            raise ConfigError(f"the sweep sets {prefix}{key}, but {kind.__name__} has no {head!r}; it has: {', '.join(fields)}")
-        if rest:
-            nested.setdefault(head, {})[rest] = value
-        elif kind is SimulationConfig and head in MEASURED_COSTS and value == MEASURED:
-            direct[head] = None
-        else:
-            direct[head] = _checked_number(fields[head], value, prefix)
-    for head, values in nested.items():
-        default = getattr(kind(), head) if head not in _NESTED else None
-        if isinstance(default, dict):
-            direct[head] = values
-            continue
-        sub_kind = _NESTED.get(head) or type(default)
-        if not dataclasses.is_dataclass(sub_kind):
-            raise ConfigError(f"{prefix}{head} is a single value, not a group of settings")
-        direct[head] = build(sub_kind, values, f"{prefix}{head}.")
-    try:
-        return kind(**direct)
-    except TypeError as error:
-        raise ConfigError(f"bad sweep settings for {kind.__name__}: {error}") from None
+        *parents, name = key.split(".")
+        level = table
+        for depth, parent in enumerate(parents):
+            level = level.setdefault(parent, {})
+            if not isinstance(level, dict):
+                raise ConfigError(f"the sweep sets {'.'.join(parents[: depth + 1])} to a value and {key} as well")
+        level[name] = value
+    return from_table(kind, table, ConfigError, "the sweep")
 
 
 def settings_of(config: Any, default: Any = None) -> dict[str, Any]:
     """A point's settings that make `config`: the fields that differ from the defaults (`default`,
-    else the config's class's), nested configs as tables; a measured cost as MEASURED."""
+    else the config's class's), nested configs as tables; None as its setting's word (MEASURED)."""
     default = type(config)() if default is None else default
     settings: dict[str, Any] = {}
     for field_ in dataclasses.fields(config):
         value, usual = getattr(config, field_.name), getattr(default, field_.name)
+        declared = setting_of(field_)
         if value == usual:
             continue
         if dataclasses.is_dataclass(value):
             settings[field_.name] = settings_of(value, usual if usual is not None else type(value)())
-        elif value is None and isinstance(config, SimulationConfig) and field_.name in MEASURED_COSTS:
-            settings[field_.name] = MEASURED
+        elif value is None and declared is not None and declared.none:
+            settings[field_.name] = declared.none
         elif value is None:
             raise ConfigError(f"a sweep cannot set {field_.name} back to None")
         else:

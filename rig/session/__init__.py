@@ -3,10 +3,10 @@
     Session(parts, t_begin, t_end, record).run()
 
 `rig.session.session` holds the event loop, `rig.session.timing` the renderer's timing policies and
-cost models, `rig.session.record` the files a run writes as it goes.
+cost models, `rig.session.run_record` the files a run writes as it goes.
 """
 
-from rig.session.record import RUN_FILES, RunRecord
+from rig.session.run_record import RUN_FILES, RunRecord
 from rig.session.session import Session, SessionLog, SessionParts, ShownImage
 from rig.session.timing import (
     DEFAULT_SERVER_MS,

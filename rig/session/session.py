@@ -10,7 +10,7 @@ repeating the last image), the camera's finished frames go to the run's film, an
 beside the rig record up to the present.
 
 On a virtual clock that is a simulation, deterministic for a seed; on a monotonic clock, waiting
-means sleeping until an event is due. Every file is written as the run goes (`rig.session.record`),
+means sleeping until an event is due. Every file is written as the run goes (`rig.session.run_record`),
 so an interrupted run leaves a readable record.
 """
 
@@ -27,9 +27,9 @@ from predictors import Pose, PoseSample, Predictor, sample_row
 from rig.clock import Clock
 from rig.devices.protocols import NO_IMAGE, Camera, Display, Instrument, TrackerSource
 from rig.errors import RigError
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, DisplayFrameResult, Renderer, RenderSetup
-from rig.session.record import RunRecord
+from rig.session.run_record import RunRecord
 from rig.session.timing import CostModel, PhotonTarget, TimingPolicy
 
 Progress = Callable[[float, float], None]

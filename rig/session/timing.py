@@ -38,12 +38,12 @@ drives; the policy sees the session only as a `Stage` (the display, `show` and `
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol, Sequence
 
 import numpy as np
 
+from declared import Range, check, setting
 from rig.devices.protocols import Display
 from rig.errors import ConfigError
 from rig.render.protocol import AppFrameResult, DisplayFrameResult, Renderer
@@ -139,14 +139,18 @@ class PhotonTarget:
     less for a low-persistence (strobed) panel.
     """
 
-    mode: str = "photons"
-    persistence: float = 1.0
+    mode: str = setting(
+        "photons", "", "the instant each frame's pose is predicted for, at the sphere's row: 'photons' the middle of the "
+        "interval the row emits it (scan-out plus half the persistence), 'scanout' when scan-out reaches the row",
+        choices=PHOTON_TARGETS,
+    )  # fmt: skip
+    persistence: float = setting(
+        1.0, "", "share of a refresh each display row emits a frame: 1 for sample-and-hold (the simulated display), "
+        "less for a low-persistence panel", Range(0.0, 1.0, includes_high=True),
+    )  # fmt: skip
 
     def __post_init__(self) -> None:
-        if self.mode not in PHOTON_TARGETS:
-            raise ConfigError(f"the photon target must be one of {', '.join(PHOTON_TARGETS)}, got {self.mode!r}")
-        if not (math.isfinite(self.persistence) and 0.0 < self.persistence <= 1.0):
-            raise ConfigError(f"persistence is the share of a refresh a row emits, in (0, 1], got {self.persistence!r}")
+        check(self, ConfigError)
 
     def time(self, display: Display, k: int, row_fraction: float) -> float:
         """The instant refresh k's pose is predicted for, for an object at `row_fraction`."""

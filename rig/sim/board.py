@@ -15,7 +15,7 @@ split further at the swing's turning points (found by bisection), so the angle i
 each: every crossing in one is found, none is missed, and each is solved for by Newton's method
 kept inside its interval, to far better than a microsecond.
 
-Written into the board folder as the run goes, through rig.board.recording's writer in the format
+Written into the board folder as the run goes, through rig.board.recorder's writer in the format
 of analysis.board.recording:
 led.csv (the switch-on at the start of the run, every change during the blink with its bit, the
 switch back on after it), encoder.csv (every edge, `edges` = 1 as a board reporting every edge
@@ -36,12 +36,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from analysis.board.blink_code import BlinkSchedule, lfsr_bits
 from analysis.board.recording import METADATA, TABLES
+from declared import ANY, Range, check, setting
 from rig.board.events import BoardIdentity, EncoderEdge, LedChange
 from rig.board.protocol import protocol
-from rig.board.recording import BoardRecorder
+from rig.board.recorder import BoardRecorder
 from rig.clock import Clock
 from rig.errors import ConfigError
-from rig.session.record import BOARD_FOLDER
+from rig.session.run_record import BOARD_FOLDER
 from rig.sim.pendulum import Pendulum
 
 __all__ = ["BOARD_FOLDER", "SimulatedBoard", "SimulatedBoardConfig", "encoder_count", "remove_recording"]
@@ -57,39 +58,27 @@ _TIME_TOLERANCE_S = 1e-12
 
 @dataclass(frozen=True)
 class SimulatedBoardConfig:
-    """The simulated board: its clock offset, its blink and its encoder's resolution.
+    """The simulated board: its clock offset (board time = simulation time + board_offset_s), its
+    blink (as `rig board blink` asks for it) and its encoder's resolution, each declared on its field."""
 
-    board_offset_s: board time = simulation time + this.
-    blink_start_s: simulation time bit 0 of the blink starts.
-    blink_bits, blink_bit_s, blink_seed, blink_level: the blink, as `rig board blink` asks for it.
-    counts_per_rev: encoder counts per revolution of the pendulum.
-    """
-
-    board_offset_s: float = 100.0
-    blink_start_s: float = 0.25
-    blink_bits: int = 64
-    blink_bit_s: float = 0.05
-    blink_seed: int = 0xACE1
-    blink_level: int = 255
-    counts_per_rev: int = 2400
+    board_offset_s: float = setting(100.0, "seconds", "how far the board's clock runs ahead of the simulation's", ANY)
+    blink_start_s: float = setting(0.25, "seconds", "simulation time bit 0 of the blink starts", ANY)
+    blink_bits: int = setting(64, "bits", "bits in the blink code, as many as the board's protocol allows")
+    blink_bit_s: float = setting(0.05, "seconds", "how long each bit lasts, at least the board's shortest")
+    blink_seed: int = setting(0xACE1, "", "seed of the blink code", Range(1.0, 65535.0, True, True))
+    blink_level: int = setting(255, "", "the LED's drive level while lit", Range(1.0, 255.0, True, True))
+    counts_per_rev: int = setting(
+        2400, "counts", "encoder counts per revolution of the pendulum", Range(MIN_COUNTS_PER_REV, includes_low=True)
+    )
 
     def __post_init__(self) -> None:
-        spec = protocol()
-        if not math.isfinite(self.board_offset_s):
-            raise ConfigError(f"the board's clock offset must be a finite number of seconds, got {self.board_offset_s!r}")
-        if not math.isfinite(self.blink_start_s):
-            raise ConfigError(f"the blink's start must be a finite time in seconds, got {self.blink_start_s!r}")
+        check(self, ConfigError, "board.")
+        spec = protocol()  # the board's limits, from its protocol header
         if not 1 <= self.blink_bits <= spec["RIG_BLINK_MAX_BITS"]:
             raise ConfigError(f"the blink must have 1..{spec['RIG_BLINK_MAX_BITS']} bits, got {self.blink_bits!r}")
         shortest_bit = spec["RIG_BLINK_MIN_BIT_TICKS"] / spec["RIG_TICK_HZ"]
         if not (math.isfinite(self.blink_bit_s) and self.blink_bit_s >= shortest_bit):
             raise ConfigError(f"a blink bit must last at least {shortest_bit * 1e3:g} ms, got {self.blink_bit_s!r} s")
-        if not 0 < self.blink_seed < 1 << 16:
-            raise ConfigError(f"the blink seed must be 1..65535, got {self.blink_seed!r}")
-        if not 1 <= self.blink_level <= 255:
-            raise ConfigError(f"the blink's LED level must be 1..255, got {self.blink_level!r}")
-        if self.counts_per_rev < MIN_COUNTS_PER_REV:
-            raise ConfigError(f"the encoder needs at least {MIN_COUNTS_PER_REV} counts per revolution, got {self.counts_per_rev!r}")
 
     @cached_property
     def code(self) -> NDArray[np.bool_]:

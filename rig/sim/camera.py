@@ -29,11 +29,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from declared import NON_NEGATIVE, POSITIVE, Flag, Range, check, setting
 from rig.clock import Clock
 from rig.devices.protocols import CameraFrame, Fault
 from rig.errors import ConfigError
-from rig.film_file import check_film_format
-from rig.sim.impairments import FilmImpairments, FrameImpairer
+from rig.film_file import CODECS, CONTAINERS, check_film_format, default_codec
+from rig.sim.impairments import FILM, FilmImpairments, FrameImpairer
 
 if TYPE_CHECKING:
     from rig.sim.flash import FlashingLightScene
@@ -55,48 +56,60 @@ class CameraConfig:
     constant rate), size, sensor and film; `container` and `codec` are the film's file
     (`rig.film_file`: an MJPEG AVI, or H.264 or HEVC in an MP4 or a MOV)."""
 
-    fps: float = 240.0
-    exposure_s: float | None = None
-    width: int = 640
-    height: int = 480
-    noise_dn: float = 2.0
-    dark_dn: float = 8.0
-    led_peak_dn: float = 900.0
-    display_black_dn: float = 6.0
-    display_white_dn: float = 190.0
-    subsamples: int = 8
+    fps: float = setting(240.0, "frames per second", "camera frame rate", Range(1.0, 10000.0, True, True), flag="--camera-fps")
+    exposure_s: float | None = setting(
+        None, "seconds", "camera exposure, at most one frame interval", POSITIVE, unset="the whole frame interval",
+        flag=Flag(
+            "--exposure", unit="frame intervals", per="fps", range=Range(0.0, 1.0, includes_high=True), default=1.0, metavar="F",
+            help="camera exposure, as a fraction of the frame interval",
+        ),
+    )  # fmt: skip
+    width: int = setting(640, "pixels", "sensor width", Range(64.0, includes_low=True))
+    height: int = setting(480, "pixels", "sensor height", Range(48.0, includes_low=True))
+    noise_dn: float = setting(2.0, "DN", "sensor read noise, in digital numbers", NON_NEGATIVE, flag=Flag("--noise-dn", group=FILM))
+    dark_dn: float = setting(8.0, "DN", "the sensor's dark level", NON_NEGATIVE)
+    led_peak_dn: float = setting(900.0, "DN", "the LED's peak before the sensor saturates", POSITIVE)
+    display_black_dn: float = setting(6.0, "DN", "how bright the display's black films", NON_NEGATIVE)
+    display_white_dn: float = setting(
+        190.0, "DN", "how bright the display's white films: lower for a dim sphere", POSITIVE,
+        flag=Flag("--display-white-dn", group=FILM),
+    )  # fmt: skip
+    subsamples: int = setting(8, "", "instants of each exposure averaged (motion blur)", Range(1.0, includes_low=True))
     impairments: FilmImpairments = field(default_factory=FilmImpairments)
-    readout_s: float = 0.0
-    frame_jitter_s: float = 0.0
-    container: str = "avi"
-    codec: str = "mjpeg"
+    readout_s: float = setting(
+        0.0, "seconds", "rolling shutter: row y of H starts exposing y/H of this after row 0, at most a frame interval",
+        NON_NEGATIVE, flag=Flag("--readout-ms", unit="ms", factor=1e3, metavar="R"),
+    )  # fmt: skip
+    frame_jitter_s: float = setting(
+        0.0, "seconds", "start each exposure up to half this before or after its nominal time, drawn by the seed, as "
+        "phones do; needs an mp4 or mov, which stamps each frame", NON_NEGATIVE,
+        flag=Flag("--frame-jitter-ms", unit="ms", factor=1e3, metavar="J", group=FILM),
+    )  # fmt: skip
+    container: str = setting("avi", "", "the film's file", choices=CONTAINERS, flag=Flag("--container", group=FILM))
+    codec: str | None = setting(
+        None, "", "the film's codec", choices=CODECS, unset="mjpeg in an avi, h264 in an mp4 or mov",
+        flag=Flag("--codec", group=FILM),
+    )  # fmt: skip
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.fps) and 1.0 <= self.fps <= 10000.0):
-            raise ConfigError(f"camera frame rate must be 1-10000 fps, got {self.fps}")
-        if self.exposure_s is not None and not 0.0 < self.exposure_s <= 1.0 / self.fps:
+        check(self, ConfigError, "camera.")
+        if self.exposure_s is not None and not self.exposure_s <= 1.0 / self.fps:
             raise ConfigError(
                 f"camera exposure must be positive and at most one frame interval ({1e3 / self.fps:.3f} ms), "
                 f"got {self.exposure_s * 1e3:.3f} ms"
             )
-        if self.width < 64 or self.height < 48:
-            raise ConfigError(f"camera resolution must be at least 64x48, got {self.width}x{self.height}")
-        if self.noise_dn < 0 or self.subsamples < 1:
-            raise ConfigError("camera noise must be >= 0 and subsamples >= 1")
         self._check_timing()
-        check_film_format(self.container, self.codec, stamped=self.frame_jitter_s > 0.0)
+        check_film_format(*self.film, stamped=self.frame_jitter_s > 0.0)
 
     def _check_timing(self) -> None:
         """A readout within a frame interval (a sensor reads one frame's rows before the next's), and
         a jitter that never starts an exposure before the one before it is read out."""
         interval_ms = 1e3 / self.fps
-        if not (np.isfinite(self.readout_s) and 0.0 <= self.readout_s <= 1.0 / self.fps):
+        if self.readout_s > 1.0 / self.fps:
             raise ConfigError(
                 f"camera readout must be 0 (global shutter) up to one frame interval ({interval_ms:.3f} ms), "
                 f"got {self.readout_s * 1e3:g} ms"
             )
-        if not (np.isfinite(self.frame_jitter_s) and self.frame_jitter_s >= 0.0):
-            raise ConfigError(f"frame-timing jitter must be >= 0 ms, got {self.frame_jitter_s * 1e3:g} ms")
         busy = max(self.exposure, self.readout_s)
         if self.frame_jitter_s > 0.0 and self.frame_jitter_s > 1.0 / self.fps - busy:
             raise ConfigError(
@@ -104,6 +117,11 @@ class CameraConfig:
                 f"before has been exposed and read out ({busy * 1e3:.3f} ms of a {interval_ms:.3f} ms interval): "
                 f"give a jitter of at most {(1.0 / self.fps - busy) * 1e3:.3f} ms, or a shorter exposure"
             )
+
+    @property
+    def film(self) -> tuple[str, str]:
+        """The film's (container, codec) (`rig.film_file`)."""
+        return self.container, self.codec or default_codec(self.container)
 
     @property
     def exposure(self) -> float:

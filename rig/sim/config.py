@@ -6,11 +6,10 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-import numpy as np
-
+from declared import NON_NEGATIVE, POSITIVE, Flag, Range, check, like, setting
 from rig.errors import ConfigError
 from rig.session.timing import DEFAULT_SERVER_MS, PhotonTarget
-from rig.sim.bench import DEFAULT_LAYOUT, placement
+from rig.sim.layout import DEFAULT_LAYOUT, LAYOUT_HELP, placement
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -18,11 +17,21 @@ from rig.sim.flash import FlashTarget
 from rig.sim.pendulum import PendulumConfig
 from rig.sim.tracker import TrackerConfig
 
-
+MEASURED = "measured"
+"""A cost given as this (on the command line, in a spec) is what this machine's GL takes."""
 # (section, field) of settings a run's record leaves out at their defaults (`SimulationConfig.to_dict`).
 FILM_DEFAULTS = (
     ("camera", "readout_s"), ("camera", "frame_jitter_s"), ("camera", "container"), ("camera", "codec"), ("", "layout"), ("", "flash"),
 )  # fmt: skip
+
+
+def _layout_problem(layout: str) -> str | None:
+    """A layout named or spelt out, the LED's swing and the panel apart inside the frame (`placement`)."""
+    try:
+        placement(layout)
+    except ConfigError as error:
+        return str(error)
+    return None
 
 
 @dataclass(frozen=True)
@@ -30,49 +39,51 @@ class SimulationConfig:
     """Everything that defines a simulated run; the same config and seed give the same video
     (with modelled costs: a measured cost is this machine's).
 
-    app_frame_ms, warp_ms: what an application frame and a composed display frame cost on the
-    virtual clock, in ms (modelled), or None for what they take on this machine (measured).
-    photon_target, persistence: the instant each frame's pose is predicted for
-    (`rig.session.PhotonTarget`).
-    scene_load: what the load's scene_triangles make (`rig.render.gl.LOAD_SHAPES`; the renderer
-    checks it when it opens).
-    layout: where the LED and the display sit in the camera's frame (`rig.sim.bench.placement`).
-    flash: a calibration target the camera films instead of the bench (`rig.sim.flash`), or None.
+    Each setting is declared once on its field (`declared.setting`: unit, range, help, the command
+    line's option), nested configs' in their own modules: `rig simulate`'s options, a sweep's keys
+    and the docs' table are made from them. app_frame_ms, warp_ms: what an application frame and a
+    composed display frame cost on the virtual clock, in ms (modelled), or None (MEASURED) for what
+    they take on this machine. photon_target, persistence: `rig.session.PhotonTarget`'s. scene_load:
+    the renderer checks it when it opens. layout: where the LED and the display sit in the camera's
+    frame (`rig.sim.layout.placement`). The pendulum's release and the board's blink must fall within
+    the film. flash: a calibration target the camera films instead of the bench (`rig.sim.flash`), or
+    None.
     """
 
-    duration_s: float = 10.0
-    seed: int = 0
+    duration_s: float = setting(10.0, "seconds", "length of the film", Range(0.5, 3600.0, True, True), flag="--duration")
+    seed: int = setting(0, "", "random seed; the same seed gives the same video", NON_NEGATIVE, flag="--seed")
     pendulum: PendulumConfig = field(default_factory=PendulumConfig)
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     display: DisplayConfig = field(default_factory=DisplayConfig)
     camera: CameraConfig = field(default_factory=CameraConfig)
-    renderer: str = "direct"
-    predictor: str = "default"
+    renderer: str = setting(
+        "direct", "", "renderer under test (listed below) and its options, e.g. warp:views=2,recon=grid,holes=1",
+        flag=Flag("--renderer", metavar="NAME[:key=value,...]"),
+    )  # fmt: skip
+    predictor: str = setting("default", "", "pose predictor (listed below); on the command line with its parameters, --predictor")
     predictor_params: dict[str, Any] = field(default_factory=dict)
-    scene_triangles: int = 0
-    scene_load: str = "soup"
-    app_frame_ms: float | None = 5.0
-    warp_ms: float | None = DEFAULT_SERVER_MS
-    photon_target: str = "photons"
-    persistence: float = 1.0
-    warmup_s: float = 0.5
+    scene_triangles: int = setting(0, "triangles", "load geometry drawn behind the sphere", NON_NEGATIVE, flag="--scene-triangles")
+    scene_load: str = setting("soup", "", "what the load's triangles make (rig.render.gl.LOAD_SHAPES)")
+    app_frame_ms: float | None = setting(
+        5.0, "ms", "modelled application frame cost, or 'measured' for the real GL time", POSITIVE, none=MEASURED,
+        flag="--app-frame-ms",
+    )  # fmt: skip
+    warp_ms: float | None = setting(
+        DEFAULT_SERVER_MS, "ms", "modelled cost of each image a compositing (warp) renderer composes, or 'measured' for "
+        "the real GL time: a composition that takes longer than a refresh misses it", POSITIVE, none=MEASURED, flag="--warp-ms",
+    )  # fmt: skip
+    photon_target: str = like(PhotonTarget, "mode", flag=Flag("--predict-to"))
+    persistence: float = like(PhotonTarget, "persistence", flag=Flag("--persistence"))
+    warmup_s: float = setting(0.5, "seconds", "the rig clock's start before the camera's, so that the rig is in its steady state", NON_NEGATIVE)
     board: SimulatedBoardConfig | None = None
-    layout: str = DEFAULT_LAYOUT
+    layout: str = setting(
+        DEFAULT_LAYOUT, "", f"where the LED and the display sit in the frame: {LAYOUT_HELP}", rule=_layout_problem,
+        flag=Flag("--layout", metavar="LAYOUT"),
+    )  # fmt: skip
     flash: FlashTarget | None = None
 
     def __post_init__(self) -> None:
-        placement(self.layout)
-        if not (np.isfinite(self.duration_s) and 0.5 <= self.duration_s <= 3600.0):
-            raise ConfigError(f"duration must be 0.5-3600 s, got {self.duration_s}")
-        if self.scene_triangles < 0:
-            raise ConfigError(f"scene triangles must be >= 0, got {self.scene_triangles}")
-        if self.app_frame_ms is not None and not (np.isfinite(self.app_frame_ms) and self.app_frame_ms > 0):
-            raise ConfigError(f"application frame cost must be a positive number of ms, got {self.app_frame_ms}")
-        if self.warp_ms is not None and not (np.isfinite(self.warp_ms) and self.warp_ms > 0):
-            raise ConfigError(f"warp cost must be a positive number of ms, got {self.warp_ms}")
-        PhotonTarget(self.photon_target, self.persistence)
-        if self.warmup_s < 0:
-            raise ConfigError(f"warm-up must be >= 0 s, got {self.warmup_s}")
+        check(self, ConfigError)
         release = self.pendulum.release_s
         swing_s = self.pendulum.small_angle_period_s
         if release is not None and not 0.0 <= release <= self.duration_s - swing_s:
@@ -104,4 +115,4 @@ class SimulationConfig:
     def _film_default(self, section: str, name: str) -> bool:
         if section == "camera":
             return getattr(self.camera, name) == getattr(CameraConfig(), name)
-        return getattr(self, name) == getattr(SimulationConfig, name)
+        return getattr(self, name) == getattr(SimulationConfig(), name)

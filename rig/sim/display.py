@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from declared import ANY, FRACTION, Flag, Range, check, setting
 from rig.clock import Clock
 from rig.devices.protocols import NO_IMAGE
 from rig.errors import ConfigError
@@ -32,22 +33,18 @@ _KEEP_REFRESHES = 4
 
 @dataclass(frozen=True)
 class DisplayConfig:
-    refresh_hz: float = 60.0
-    width: int = 320
-    height: int = 240
-    scanout_fraction: float = 1.0
-    t0: float = 0.0
-    phase: float = 0.0
+    refresh_hz: float = setting(60.0, "Hz", "display refresh rate", Range(1.0, 1000.0, True, True), flag="--display-hz")
+    width: int = setting(320, "pixels", "display width", Range(16.0, includes_low=True))
+    height: int = setting(240, "pixels", "display height", Range(16.0, includes_low=True))
+    scanout_fraction: float = setting(1.0, "", "share of a refresh period that scan-out takes", Range(0.0, 1.0, includes_high=True))
+    t0: float = setting(0.0, "seconds", "the rig clock's time of the first refresh before its phase", ANY)
+    phase: float = setting(
+        0.0, "", "when the display's refreshes start against the camera's frames, as a fraction of a refresh", FRACTION,
+        flag=Flag("--display-phase", metavar="P"),
+    )  # fmt: skip
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.refresh_hz) and 1.0 <= self.refresh_hz <= 1000.0):
-            raise ConfigError(f"display refresh rate must be 1-1000 Hz, got {self.refresh_hz}")
-        if self.width < 16 or self.height < 16:
-            raise ConfigError(f"display resolution must be at least 16x16, got {self.width}x{self.height}")
-        if not 0.0 < self.scanout_fraction <= 1.0:
-            raise ConfigError(f"scan-out fraction must be in (0, 1], got {self.scanout_fraction}")
-        if not (np.isfinite(self.phase) and 0.0 <= self.phase < 1.0):
-            raise ConfigError(f"display phase must be a fraction of a refresh in [0, 1), got {self.phase}")
+        check(self, ConfigError, "display.")
 
     @property
     def origin(self) -> float:

@@ -8,7 +8,7 @@ Two targets, as a lab films them:
   the share of its own exposure window the LED was on, exactly, as bright as `level_dn` at the
   frame's centre and dimmer towards its corners (`vignette`, the share lost there), as a lens
   vignettes an evenly lit card.
-* ``display``: the display, where the bench layout puts it, shows full-field white for the first
+* ``display``: the display, where the layout puts it, shows full-field white for the first
   ceil(N / 2) of every N refreshes and black for the rest (a program alternating white and black
   frames at N = 2): it flashes at refresh_hz / N, each of its rows switching as the scan-out
   reaches it, and the camera integrates each refresh a row shows exactly (`FilmedScene`). The
@@ -23,8 +23,9 @@ from typing import Any
 
 import numpy as np
 
+from declared import ANY, FRACTION, OPEN_UNIT, POSITIVE, Range, check, setting
 from rig.errors import ConfigError
-from rig.sim.bench import BenchLayout
+from rig.sim.layout import BenchLayout
 from rig.sim.display import SimDisplay
 from rig.sim.scene import FilmedScene
 
@@ -33,29 +34,19 @@ FLASH_SOURCES = ("light", "display")
 
 @dataclass(frozen=True)
 class FlashTarget:
-    """What the camera films instead of the bench (see the module): `source` "light" (flashing at
-    `hz` with `duty`, from `phase_s`, at most `level_dn` bright, losing `vignette` of it at the
-    corners) or "display" (flashing full-field every `refreshes` refreshes)."""
+    """What the camera films instead of the bench (see the module), each setting declared on its
+    field; `rig simulate --flash-hz F [--flash-duty D]` or `--flash-display N` makes one."""
 
-    source: str = "light"
-    hz: float = 100.0
-    duty: float = 0.5
-    phase_s: float = 0.0
-    level_dn: float = 150.0
-    vignette: float = 0.3
-    refreshes: int = 2
+    source: str = setting("light", "", "what flashes: a card lit by an LED, or the display full-field", choices=FLASH_SOURCES)
+    hz: float = setting(100.0, "Hz", "the LED's flash frequency", POSITIVE)
+    duty: float = setting(0.5, "", "the share of each period the LED is on", OPEN_UNIT)
+    phase_s: float = setting(0.0, "seconds", "when the LED's first period starts", ANY)
+    level_dn: float = setting(150.0, "digital numbers", "how bright the card films at the frame's centre, the LED on", POSITIVE)
+    vignette: float = setting(0.3, "", "the share of the card's level lost at the frame's corners", FRACTION)
+    refreshes: int = setting(2, "refreshes", "the flashing display's period: white for the first half, black for the rest", Range(2.0, includes_low=True))
 
     def __post_init__(self) -> None:
-        if self.source not in FLASH_SOURCES:
-            raise ConfigError(f"a flashing target is one of {', '.join(FLASH_SOURCES)}, got {self.source!r}")
-        if not (math.isfinite(self.hz) and self.hz > 0):
-            raise ConfigError(f"the light's flash frequency must be a positive number of Hz, got {self.hz}")
-        if not 0.0 < self.duty < 1.0:
-            raise ConfigError(f"the light's duty cycle is the share of each period it is on, in (0, 1), got {self.duty}")
-        if not 0.0 <= self.vignette < 1.0 or self.level_dn <= 0:
-            raise ConfigError("the light's level must be positive and its vignetting in [0, 1)")
-        if self.refreshes < 2:
-            raise ConfigError(f"a flashing display needs at least 2 refreshes a period (white, then black), got {self.refreshes}")
+        check(self, ConfigError, "flash.")
 
     def display_duty(self) -> float:
         """The share of each period a flashing display shows white."""

@@ -16,6 +16,7 @@ from typing import Callable
 import cv2
 import numpy as np
 
+from declared import FRACTION, NON_NEGATIVE, Flag, Range, check, setting
 from rig.errors import ConfigError
 
 Rect = tuple[int, int, int, int]
@@ -23,39 +24,42 @@ OCCLUDABLE = ("sphere", "led")
 # A bar as wide as this fraction of a blob's swing, across its path a third of the way along.
 OCCLUDER_FRACTION = 0.12
 BRIGHT_OBJECT_SIGMA_PX = 4.0
+FILM = "film"
+"""The group of the command line's options that these settings are."""
 
 
 @dataclass(frozen=True)
 class FilmImpairments:
-    """blur_sigma_px: Gaussian defocus (0: sharp). dim_led: the LED's half of each frame (the left)
-    scaled by this after the sensor saturates, so a saturated LED shows dimmer than the sphere.
-    mirrored: the image flipped left to right (the LED on the right). bright_object_dn: the peak of
-    a static lamp between and above the two halves, saturating (0: none). occluded: "sphere" or
-    "led", a bar across that blob's path (None: none). missing_fraction: the share of frames, drawn
-    by the run's seed, whose sphere region is hidden. every_nth, first_frame: the film keeps every
-    n-th exposure from the first_frame-th (a film decimated from a faster camera)."""
+    """What a lab's camera does to its film, each setting declared on its field (`declared.setting`;
+    the LED's half is the left one, unless mirrored); they act in the order of the fields."""
 
-    blur_sigma_px: float = 0.0
-    dim_led: float = 1.0
-    mirrored: bool = False
-    bright_object_dn: float = 0.0
-    occluded: str | None = None
-    missing_fraction: float = 0.0
-    every_nth: int = 1
-    first_frame: int = 0
+    blur_sigma_px: float = setting(0.0, "pixels", "defocus blur, Gaussian sigma", NON_NEGATIVE, flag=Flag("--blur-px", group=FILM))
+    dim_led: float = setting(
+        1.0, "", "scale the LED's half of each frame by this, after the sensor saturates", Range(0.0, 1.0, includes_high=True),
+        flag=Flag("--dim-led", metavar="F", group=FILM),
+    )  # fmt: skip
+    mirrored: bool = setting(
+        False, "", "flip the film left to right: the LED on the right, the sphere on the left", flag=Flag("--mirrored", group=FILM)
+    )
+    bright_object_dn: float = setting(
+        0.0, "DN", "a static lamp in view between and above the two halves, its peak (0: none)", NON_NEGATIVE,
+        flag=Flag("--bright-object-dn", group=FILM),
+    )  # fmt: skip
+    occluded: str | None = setting(
+        None, "", "a bar hiding part of this blob's path", choices=OCCLUDABLE, unset="no bar", flag=Flag("--occluded", group=FILM)
+    )
+    missing_fraction: float = setting(
+        0.0, "", "hide the sphere in this share of the frames, drawn by the seed", FRACTION,
+        flag=Flag("--missing-fraction", metavar="F", group=FILM),
+    )  # fmt: skip
+    every_nth: int = setting(1, "", "film every N-th exposure only", Range(1.0, includes_low=True), flag=Flag("--every-nth", metavar="N", group=FILM))
+    first_frame: int = setting(
+        0, "", "with --every-nth, the first exposure filmed, 0 to N - 1", NON_NEGATIVE, flag=Flag("--first-frame", metavar="K", group=FILM)
+    )
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.blur_sigma_px) and self.blur_sigma_px >= 0.0):
-            raise ConfigError(f"camera blur must be >= 0 pixels, got {self.blur_sigma_px}")
-        if not 0.0 < self.dim_led <= 1.0:
-            raise ConfigError(f"the LED's dimming must be a factor in (0, 1], got {self.dim_led}")
-        if not (np.isfinite(self.bright_object_dn) and self.bright_object_dn >= 0.0):
-            raise ConfigError(f"a bright object's peak must be >= 0 DN, got {self.bright_object_dn}")
-        if self.occluded is not None and self.occluded not in OCCLUDABLE:
-            raise ConfigError(f"the occluded blob must be one of {', '.join(OCCLUDABLE)}, got {self.occluded!r}")
-        if not 0.0 <= self.missing_fraction < 1.0:
-            raise ConfigError(f"the share of frames missing the sphere must be in [0, 1), got {self.missing_fraction}")
-        if self.every_nth < 1 or not 0 <= self.first_frame < self.every_nth:
+        check(self, ConfigError, "camera.impairments.")
+        if not self.first_frame < self.every_nth:
             raise ConfigError(
                 f"a decimated film keeps every n-th frame (n >= 1) from frame 0 to n - 1, got every {self.every_nth} from {self.first_frame}"
             )

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
+from declared import ANY, NON_NEGATIVE, POSITIVE, Flag, Range, check, setting
 from rig.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -36,11 +37,6 @@ if TYPE_CHECKING:
 MAX_AMPLITUDE_DEG = 45.0
 _RTOL = 1e-11
 _ATOL = 1e-12
-
-
-def _positive_finite(value: float | None, name: str) -> None:
-    if value is None or not math.isfinite(value) or value <= 0.0:
-        raise ConfigError(f"pendulum.{name} must be a positive finite number, got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -52,54 +48,46 @@ class PendulumConfig:
     period at that amplitude) before the start time, so 0 starts at the release and 90 starts near
     the first downward zero crossing. release_s instead holds the pendulum at rest at +amplitude
     until that time (s, on the simulation's clock) and releases it then; phase_deg must be 0 with
-    it. quality is the Q factor of the viscous damping; math.inf means undamped.
+    it. quality is the Q factor of the viscous damping; math.inf means undamped. Each setting is
+    declared on its field (`declared.setting`).
     """
 
-    period_s: float | None = 1.0
-    length_m: float | None = None
-    amplitude_deg: float = 20.0
-    quality: float = 200.0
-    g: float = 9.80665
-    phase_deg: float = 0.0
-    pivot: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    release_s: float | None = None
+    period_s: float | None = setting(
+        1.0, "seconds", "pendulum period (small-angle); a spec may give length_m instead", POSITIVE, flag="--period-s"
+    )
+    length_m: float | None = setting(None, "metres", "pendulum length, instead of the period", POSITIVE, unset="from the period")
+    amplitude_deg: float = setting(
+        20.0, "degrees", "swing amplitude, the angle it is released from", Range(0.0, MAX_AMPLITUDE_DEG, includes_high=True),
+        flag="--amplitude-deg",
+    )  # fmt: skip
+    quality: float = setting(
+        200.0, "", "pendulum quality factor Q; inf for no damping", Range(0.0, math.inf, includes_high=True), flag="--quality"
+    )
+    g: float = setting(9.80665, "m/s^2", "gravity", POSITIVE)
+    phase_deg: float = setting(
+        0.0, "degrees", "where in the swing the simulation starts (0: at the release)", Range(0.0, 360.0, includes_low=True)
+    )
+    pivot: tuple[float, float, float] = setting((0.0, 0.0, 0.0), "metres", "the pivot's position", ANY)
+    release_s: float | None = setting(
+        None, "seconds", "hold the pendulum at rest at its amplitude and release it S seconds into the film (at least "
+        "one swing before the end)", ANY, unset="swinging from the start",
+        flag=Flag("--release-s", range=NON_NEGATIVE, metavar="S", group="lab"),
+    )  # fmt: skip
 
     def __post_init__(self) -> None:
+        check(self, ConfigError, "pendulum.")
         if (self.period_s is None) == (self.length_m is None):
             raise ConfigError(
                 "PendulumConfig needs exactly one of period_s and length_m; "
                 f"got period_s={self.period_s!r}, length_m={self.length_m!r}"
             )
-        if self.period_s is not None:
-            _positive_finite(self.period_s, "period_s")
-        else:
-            _positive_finite(self.length_m, "length_m")
-        _positive_finite(self.g, "g")
-        if not (0.0 < self.amplitude_deg <= MAX_AMPLITUDE_DEG):
+        if self.release_s is not None and self.phase_deg != 0.0:
             raise ConfigError(
-                f"pendulum.amplitude_deg must be in (0, {MAX_AMPLITUDE_DEG:g}] degrees, "
-                f"got {self.amplitude_deg!r}"
+                "pendulum.release_s and phase_deg exclude each other: a held pendulum starts "
+                f"from rest at its release, so leave phase_deg at 0 (got {self.phase_deg!r})"
             )
-        if math.isnan(self.quality) or self.quality <= 0.0:
-            raise ConfigError(
-                f"pendulum.quality must be a positive Q factor (math.inf for no damping), "
-                f"got {self.quality!r}"
-            )
-        if not (0.0 <= self.phase_deg < 360.0):
-            raise ConfigError(f"pendulum.phase_deg must be in [0, 360) degrees, got {self.phase_deg!r}")
-        if self.release_s is not None:
-            if not math.isfinite(self.release_s):
-                raise ConfigError(f"pendulum.release_s must be a finite time in seconds, got {self.release_s!r}")
-            if self.phase_deg != 0.0:
-                raise ConfigError(
-                    "pendulum.release_s and phase_deg exclude each other: a held pendulum starts "
-                    f"from rest at its release, so leave phase_deg at 0 (got {self.phase_deg!r})"
-                )
-        pivot = np.asarray(self.pivot, dtype=np.float64)
-        if pivot.shape != (3,) or not np.isfinite(pivot).all():
-            raise ConfigError(
-                f"pendulum.pivot must be three finite coordinates in metres, got {self.pivot!r}"
-            )
+        if len(self.pivot) != 3:
+            raise ConfigError(f"pendulum.pivot must be three finite coordinates in metres, got {self.pivot!r}")
 
     @property
     def resolved_length_m(self) -> float:

@@ -1,6 +1,6 @@
 """What the simulated camera films: the real LED on the pendulum and the light of the display panel.
 
-The camera sees the LED where the bench layout (`rig.sim.bench`) puts the pendulum, as bright as
+The camera sees the LED where the bench layout (`rig.sim.layout`) puts the pendulum, as bright as
 the board drives it, and the display panel as each of its rows emits at each instant (the
 display's scan-out and sample-and-hold, `rig.sim.display`), in camera digital numbers.
 """
@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 
 from rig.devices.protocols import NO_IMAGE
-from rig.sim.bench import BenchLayout
+from rig.sim.layout import BenchLayout
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.display import SimDisplay
 from rig.sim.pendulum import Pendulum

@@ -1,7 +1,10 @@
-"""The simulated tracker (`SimTracker`), a twin of `rig.devices.protocols.TrackerSource`.
+"""The simulated tracker: what a tracker on a moving body measures and when each sample reaches the
+host, worked out in one place for the in-process twin of a simulated run (`SimTracker`, a
+`rig.devices.protocols.TrackerSource`) and for the emulated tracker of `rig emulate-tracker`
+(`rig.emulate`, which encodes the same samples as a device's bytes and sends them in real time).
 
-The simulated sensor rides on the pendulum bob. It measures at a fixed rate on its own clock and
-sends each measurement over a serial/USB-like transport:
+The sensor rides on a `Motion` (the pendulum's bob, or a recorded trace). It measures at a fixed
+rate on its own clock and sends each measurement over a serial/USB-like transport:
 
 * t_sensor = t_start + phase_s + k / rate_hz, for every k with t_sensor < t_end;
 * the position gets independent Gaussian noise, position_noise_m per axis;
@@ -11,72 +14,100 @@ sends each measurement over a serial/USB-like transport:
   mean jitter_s (a transport is sometimes late, never early);
 * the transport never reorders: a sample that would overtake its predecessor arrives with it,
   so t_arrival is non-decreasing;
-* each sample is lost with probability `dropout`, independently.
+* each sample is lost with probability `dropout`, independently;
+* then the faults in time of a `FaultPlan` (`rig.sim.tracker_faults.delivered`: bursts, stalls,
+  disconnects); the faults in bytes are the emulator's, which sends bytes.
 
 All randomness comes from numpy's default_rng(seed), drawn for every sample in a fixed order, so a
 seed fixes the whole run and changing the dropout rate does not change the noise of the samples
-that are kept. The samples are worked out once, when the tracker connects, and handed out as the
-rig clock passes their arrival times.
+that are kept. `SimTracker` works the samples out when it connects and hands them out as the rig
+clock passes their arrival times.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
+from declared import FRACTION, NON_NEGATIVE, POSITIVE, Flag, check, setting
 from predictors import PoseSample
 from rig.clock import Clock
 from rig.devices.protocols import Fault
 from rig.errors import ConfigError, RigError
-from rig.sim.pendulum import Pendulum
+from rig.sim.tracker_faults import FaultPlan, delivered
+
+NO_FAULTS = FaultPlan()
+
+
+class Motion(Protocol):
+    """What the sensor rides on over [t_start, t_end] (`rig.sim.pendulum.Pendulum`, a trace)."""
+
+    t_start: float
+    t_end: float
+
+    def sensor_pose(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Positions (N, 3) and unit (w, x, y, z) orientations (N, 4) at the times `t` (N,)."""
 
 
 @dataclass(frozen=True)
 class TrackerConfig:
-    """Rate, noise and transport of a simulated tracker. Times in seconds, noise as std-devs."""
+    """Rate, noise and transport of a simulated tracker, each declared on its field (`declared.setting`)."""
 
-    rate_hz: float = 120.0
-    position_noise_m: float = 0.0002
-    orientation_noise_deg: float = 0.05
-    transport_delay_s: float = 0.004
-    jitter_s: float = 0.0005
-    dropout: float = 0.0
-    phase_s: float = 0.0
+    rate_hz: float = setting(120.0, "Hz", "tracker sample rate", POSITIVE, flag="--tracker-hz")
+    position_noise_m: float = setting(0.0002, "metres", "position noise, standard deviation per axis", NON_NEGATIVE)
+    orientation_noise_deg: float = setting(
+        0.05, "degrees", "orientation noise, standard deviation of each rotation-vector component", NON_NEGATIVE
+    )
+    transport_delay_s: float = setting(
+        0.004, "seconds", "fixed tracker-to-host delay", NON_NEGATIVE, flag=Flag("--transport-delay-ms", unit="ms", factor=1e3)
+    )
+    jitter_s: float = setting(0.0005, "seconds", "mean transport jitter, exponentially distributed", NON_NEGATIVE)
+    dropout: float = setting(0.0, "", "probability that a sample is lost", FRACTION)
+    phase_s: float = setting(0.0, "seconds", "first sensor time after the start, less than one sample interval", NON_NEGATIVE)
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.rate_hz) and self.rate_hz > 0.0):
-            raise ConfigError(
-                f"tracker.rate_hz must be a positive finite rate in Hz, got {self.rate_hz!r}"
-            )
-        for name in ("position_noise_m", "orientation_noise_deg", "transport_delay_s", "jitter_s"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ConfigError(f"tracker.{name} must be a finite number >= 0, got {value!r}")
-        if not (0.0 <= self.dropout < 1.0):
-            raise ConfigError(f"tracker.dropout must be a probability in [0, 1), got {self.dropout!r}")
-        if not (0.0 <= self.phase_s < 1.0 / self.rate_hz):
+        check(self, ConfigError, "tracker.")
+        if not self.phase_s < 1.0 / self.rate_hz:
             raise ConfigError(
                 f"tracker.phase_s must be in [0, 1 / rate_hz) = [0, {1.0 / self.rate_hz!r}) s, "
                 f"got {self.phase_s!r}"
             )
 
 
-def simulate_tracker(
-    pendulum: Pendulum, config: TrackerConfig, t_start: float, t_end: float, seed: int
-) -> list[PoseSample]:
-    """The samples a tracker on `pendulum` delivers for sensor times in [t_start, t_end).
+@dataclass(frozen=True)
+class TrackerSamples:
+    """Every sample measured in a window, in sensor-time order, as arrays: its number k on the
+    sensor's grid, sensor time, when it reaches the host (for a lost one, when it would have), the
+    measured position (N, 3) and orientation (N, 4), and whether it was lost."""
 
-    Sorted by t_arrival (which, as the transport keeps order, is also t_sensor order).
-    """
+    seq: np.ndarray
+    t_sensor: np.ndarray
+    t_arrival: np.ndarray
+    positions: np.ndarray
+    orientations: np.ndarray
+    lost: np.ndarray
+
+    def pose_samples(self) -> list[PoseSample]:
+        """The samples that reach the host, as a tracker source hands them on."""
+        kept = ~self.lost
+        return [
+            PoseSample(float(ts), float(ta), p, q)
+            for ts, ta, p, q in zip(self.t_sensor[kept], self.t_arrival[kept], self.positions[kept], self.orientations[kept])
+        ]
+
+
+def measure(motion: Motion, config: TrackerConfig, t_start: float, t_end: float, seed: int, faults: FaultPlan = NO_FAULTS) -> TrackerSamples:
+    """What a tracker on `motion` measures for sensor times in [t_start, t_end), and when each
+    sample reaches the host (see the module docstring)."""
     if not (math.isfinite(t_start) and math.isfinite(t_end) and t_end > t_start):
-        raise ConfigError(f"simulate_tracker needs t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
-    if t_start < pendulum.t_start or t_end > pendulum.t_end:
+        raise ConfigError(f"a simulated tracker needs t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}")
+    if t_start < motion.t_start or t_end > motion.t_end:
         raise ConfigError(
-            f"the tracker window [{t_start!r}, {t_end!r}] s is not inside the pendulum's "
-            f"[{pendulum.t_start!r}, {pendulum.t_end!r}] s; simulate the pendulum over a longer window"
+            f"the tracker window [{t_start!r}, {t_end!r}] s is not inside the motion's "
+            f"[{motion.t_start!r}, {motion.t_end!r}] s; simulate the pendulum over a longer window"
         )
     count = math.ceil((t_end - t_start - config.phase_s) * config.rate_hz) + 1
     t_sensor = t_start + config.phase_s + np.arange(count) / config.rate_hz
@@ -89,7 +120,7 @@ def simulate_tracker(
     jitter = config.jitter_s * rng.standard_exponential(n)
     kept = rng.random(n) >= config.dropout
 
-    positions, orientations = pendulum.sensor_pose(t_sensor)
+    positions, orientations = motion.sensor_pose(t_sensor)
     positions = positions + position_noise
     from scipy.spatial.transform import Rotation  # here: scipy.spatial takes longer to import than most runs take to use it
 
@@ -97,35 +128,43 @@ def simulate_tracker(
     orientations = measured.as_quat(scalar_first=True)
     orientations /= np.linalg.norm(orientations, axis=1, keepdims=True)
 
-    t_sensor, positions, orientations = t_sensor[kept], positions[kept], orientations[kept]
-    t_arrival = np.maximum.accumulate(t_sensor + config.transport_delay_s + jitter[kept])
-    return [
-        PoseSample(float(ts), float(ta), p, q)
-        for ts, ta, p, q in zip(t_sensor, t_arrival, positions, orientations)
-    ]
+    t_arrival = t_sensor + config.transport_delay_s + jitter
+    t_arrival[kept] = np.maximum.accumulate(t_sensor[kept] + config.transport_delay_s + jitter[kept])
+    t_arrival, lost = delivered(faults, t_arrival, ~kept)
+    return TrackerSamples(np.arange(n), t_sensor, t_arrival, positions, orientations, lost)
+
+
+def simulate_tracker(motion: Motion, config: TrackerConfig, t_start: float, t_end: float, seed: int) -> list[PoseSample]:
+    """The samples a tracker on `motion` delivers for sensor times in [t_start, t_end), sorted by
+    t_arrival (which, as the transport keeps order, is also t_sensor order)."""
+    return measure(motion, config, t_start, t_end, seed).pose_samples()
 
 
 class SimTracker:
-    """The simulated tracker of a run: samples for sensor times in [t_start, t_end), handed out
-    as the clock passes their arrival."""
+    """The simulated tracker of a run: samples for sensor times in [t_start, t_end), handed out as
+    the clock passes their arrival. `faults` may only be faults in time: there are no bytes here."""
 
-    def __init__(self, pendulum: Pendulum, config: TrackerConfig, t_start: float, t_end: float, seed: int) -> None:
-        self.pendulum = pendulum
+    def __init__(
+        self, motion: Motion, config: TrackerConfig, t_start: float, t_end: float, seed: int, faults: FaultPlan = NO_FAULTS
+    ) -> None:
+        if faults.damages_bytes:
+            raise ConfigError("a simulated tracker carries no bytes to damage: corrupt, drop and garbage are serial faults")
+        self.motion = motion
         self.config = config
         self.t_start = t_start
         self.t_end = t_end
         self.seed = seed
+        self.faults = faults
         self._clock: Clock | None = None
         self._samples: list[PoseSample] = []
         self._next = 0
 
     def connect(self, clock: Clock) -> None:
-        self._samples = simulate_tracker(self.pendulum, self.config, self.t_start, self.t_end, self.seed)
+        self._samples = measure(self.motion, self.config, self.t_start, self.t_end, self.seed, self.faults).pose_samples()
         if not self._samples:
             raise RigError("the tracker produced no samples; check its rate and dropout settings")
         self._clock = clock
         self._next = 0
-
     def poll(self) -> list[PoseSample]:
         """The samples that have arrived by now and were not handed out before."""
         now = self._connected().now()

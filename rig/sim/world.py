@@ -13,7 +13,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Callable
 
-from rig.sim.bench import BenchLayout, make_layout
+from rig.sim.layout import BenchLayout, make_layout
 from rig.sim.board import SimulatedBoard
 from rig.sim.camera import SimCamera
 from rig.sim.config import SimulationConfig

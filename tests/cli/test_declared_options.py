@@ -5,6 +5,7 @@ the range is refused while the command line is read, naming the option and the r
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import re
 
 import pytest
@@ -14,8 +15,14 @@ from analysis.shutter import ShutterOptions
 from declared import walk
 from rig.cli import main
 from rig.commands.declared_options import add_declared_options, config_from_args
+from rig.commands.simulation_options import add_simulation_options, simulation_config
+from rig.sim.board import SimulatedBoardConfig
+from rig.sim.camera import CameraConfig
+from rig.sim.config import SimulationConfig
+from rig.sim.impairments import FilmImpairments
+from rig.sim.pendulum import PendulumConfig
 
-DECLARED = {"analyse": AnalysisOptions, "calibrate-camera": ShutterOptions}
+DECLARED = {"analyse": AnalysisOptions, "simulate": SimulationConfig, "calibrate-camera": ShutterOptions}
 
 
 def _help(capsys: pytest.CaptureFixture[str], command: str) -> str:
@@ -28,14 +35,14 @@ def _help(capsys: pytest.CaptureFixture[str], command: str) -> str:
 @pytest.mark.parametrize("command", DECLARED)
 def test_help_lists_every_declared_option_with_its_unit_and_default(command: str, capsys: pytest.CaptureFixture[str]) -> None:
     text = _help(capsys, command)
-    for entry in walk(DECLARED[command]):
+    entries = [entry for entry in walk(DECLARED[command]) if entry.setting.flag is not None]
+    starts = sorted(text.index(f" {entry.setting.flag.name} ") for entry in entries)
+    for entry in entries:
         flag = entry.setting.flag
-        if flag is None:
-            continue
-        described = text[text.index(f"{flag.name} ") :]
-        described = described[: described.find(" --", 1)]
+        start = text.index(f" {flag.name} ")
+        described = text[start : next((s for s in starts if s > start), len(text))]
         unit = flag.unit if flag.unit is not None else entry.setting.unit
-        assert " ".join(entry.setting.help.split()) in described, flag.name
+        assert " ".join((flag.help or entry.setting.help).split()) in described, flag.name
         if unit:
             assert f"({unit};" in described or f"({unit})" in described, flag.name
         if entry.hint is not bool:
@@ -72,4 +79,45 @@ def test_a_value_outside_its_setting_is_refused_naming_the_option(
 ) -> None:
     with pytest.raises(SystemExit):
         _parsed(AnalysisOptions, *argv)
+    assert message in capsys.readouterr().err
+
+
+def _simulation(*argv: str) -> SimulationConfig:
+    parser = argparse.ArgumentParser()
+    add_simulation_options(parser, lab=True)
+    return simulation_config(parser.parse_args(argv))
+
+
+def test_an_option_in_another_unit_than_its_setting_is_converted_to_the_settings_unit() -> None:
+    config = _simulation("--camera-fps", "120", "--exposure", "0.5", "--transport-delay-ms", "2.5", "--app-frame-ms", "measured")
+    assert config.camera.exposure_s == 0.5 / 120 and config.tracker.transport_delay_s == 2.5 / 1e3
+    assert config.app_frame_ms is None
+    assert _simulation().camera.exposure_s == 1.0 / 240 and _simulation().tracker.transport_delay_s == 0.004
+
+
+def test_the_simulation_options_given_make_the_config_and_the_rest_keep_their_defaults() -> None:
+    config = _simulation("--predictor", "kalman-cv:position_noise=0.01", "--board", "--release-s", "2", "--mirrored", "--occluded", "led")
+    expected = SimulationConfig(
+        pendulum=dataclasses.replace(PendulumConfig(), release_s=2.0), predictor="kalman-cv", predictor_params={"position_noise": 0.01},
+        board=SimulatedBoardConfig(), camera=CameraConfig(exposure_s=1.0 / 240, impairments=FilmImpairments(mirrored=True, occluded="led")),
+    )  # fmt: skip
+    assert config == expected
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--exposure", "1.5"], "argument --exposure: must be a positive number of frame intervals at most 1, got 1.5"),
+        (["--transport-delay-ms", "-1"], "argument --transport-delay-ms: must be zero or a positive number of ms, got -1"),
+        (["--display-hz", "2000"], "argument --display-hz: must be a positive number of Hz from 1 to 1000, got 2000"),
+        (["--release-s=-1"], "argument --release-s: must be zero or a positive number of seconds, got -1"),
+        (["--app-frame-ms", "fast"], "argument --app-frame-ms: expected a number or 'measured', got 'fast'"),
+        (["--occluded", "lamp"], "argument --occluded: invalid choice: 'lamp'"),
+    ],
+)
+def test_a_simulation_option_outside_its_setting_is_refused_in_the_options_unit(
+    argv: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit):
+        _simulation(*argv)
     assert message in capsys.readouterr().err

@@ -37,6 +37,15 @@ def test_late_writes_go_on_past_a_failure_and_name_it(tmp_path: Path) -> None:
         writes.check()
 
 
+def test_late_csv_has_a_column_per_field_in_first_seen_order_and_notes_a_failure(tmp_path: Path) -> None:
+    writes = outputs.LateWrites()
+    writes.csv(tmp_path / "rows.csv", [{"a": 1, "b": None}, {"c": 2.5, "a": 3}])
+    assert (tmp_path / "rows.csv").read_text().splitlines() == ["a,b,c", "1,,", "3,,2.5"]
+    writes.csv(tmp_path / "gone" / "rows.csv", [{"a": 1}])
+    with pytest.raises(RigError, match=r"cannot write .*gone/rows\.csv \(No such file or directory\)"):
+        writes.check()
+
+
 def test_simulate_keeps_its_run_and_prints_it_when_the_plot_fails(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -12,7 +12,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from predictors import PredictorError, make, names
-from predictors.params import LOG, LOGIT, NON_NEGATIVE, OPEN_UNIT, POSITIVE, Param, declare_params
+from predictors.params import LOG, LOGIT, NON_NEGATIVE, OPEN_UNIT, Param, declare_params
 from predictors.registry import params_of
 
 laws = settings(deadline=None, max_examples=50, derandomize=True)

@@ -14,7 +14,7 @@ stamped at the start plus i intervals.
 
 A capture thread reads frames as they come, stamps each on the rig clock the moment it is grabbed
 (keeping the backend's timestamp beside it) and queues it for `poll()`, which hands over every frame
-captured since the last call (the run's film writes them, `rig.session.record.FilmRecord`). A
+captured since the last call (the run's film writes them, `rig.session.run_record.FilmRecord`). A
 camera that stops delivering (unplugged, the stream closed) ends the capture and says so in
 `fault()`; a file that has played to its end is `finished`.
 """

@@ -2,22 +2,18 @@
  * what arrives with CLOCK_MONOTONIC and queues it, until the source ends, fails or stop(). They
  * never touch the GIL, so at 1000 records a second the interpreter is not woken once per record:
  * the Python side takes everything queued in one call. A stamp is a rig time, (monotonic ns -
- * origin_ns) / 1e9, which is MonotonicClock's time line (the system's monotonic clock, counted
- * from its origin_ns) to the last bit. The thread's CPU time and how it ended are kept for the
- * Python side; stop(), or dropping the object, ends and joins it.
+ * origin_ns) / 1e9: a MonotonicClock's time line to the last bit where origin_ns is its own, any
+ * other clock's where origin_ns is measured against it (rig.devices.trackers.transport). The
+ * thread's CPU time and how it ended are kept for the Python side; stop(), or dropping the object,
+ * ends and joins it.
  *
  * FdReader(fd, origin_ns): a file descriptor (a serial device, a pty, a socket), waited on with
  * poll and read whole at each wake-up; a chunk is what one read gave.
  *
  * LslReader(pull_sample_d, inlet, channels, origin_ns, keep): an LSL inlet, pulled one sample at a
  * time with liblsl's lsl_pull_sample_d (its address, from the library the caller loaded, and the
- * inlet's handle); a chunk is one sample as LslLink queues samples, ([values], [LSL stamp]).
- * `keep` (the Python inlet) is held until the thread is joined, so the inlet outlives it.
- *
- * wait_read(fd, timeout_ms, size): one wait and read in one call that releases the GIL once, for a
- * reader thread in Python (where the stamps are on another clock than the system's). The bytes,
- * b"" at the end of the file, None if nothing came in time (or a signal interrupted the wait);
- * OSError as os.read raises it. */
+ * inlet's handle); a chunk is one sample, the tuple (LSL stamp, value, value, ...). `keep` (the
+ * Python inlet) is held until the thread is joined, so the inlet outlives it. */
 
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -40,41 +36,6 @@
 /* The threads' names, as top -H and /proc/PID/task/TID/comm show them (15 characters at most). */
 #define FD_THREAD_NAME "rig fd reader"
 #define LSL_THREAD_NAME "rig lsl reader"
-
-static PyObject *wait_read(PyObject *self, PyObject *args) {
-    int fd, timeout_ms;
-    Py_ssize_t size;
-    if (!PyArg_ParseTuple(args, "iin:wait_read", &fd, &timeout_ms, &size)) return NULL;
-    if (size < 0) {
-        PyErr_SetString(PyExc_ValueError, "size must not be negative");
-        return NULL;
-    }
-    if (size > MOST_BYTES) size = MOST_BYTES;
-    char buffer[MOST_BYTES];
-    struct pollfd wanted = {fd, POLLIN, 0};
-    int ready;
-    ssize_t got = 0;
-    int error = 0;
-    Py_BEGIN_ALLOW_THREADS
-    ready = poll(&wanted, 1, timeout_ms);
-    if (ready > 0) {
-        got = read(fd, buffer, (size_t)size);
-        if (got < 0) error = errno;
-    } else if (ready < 0) {
-        error = errno;
-    }
-    Py_END_ALLOW_THREADS
-    if (error == EINTR || error == EAGAIN) {
-        if (PyErr_CheckSignals() < 0) return NULL;
-        Py_RETURN_NONE;
-    }
-    if (error) {
-        errno = error;
-        return PyErr_SetFromErrno(PyExc_OSError);
-    }
-    if (ready == 0) Py_RETURN_NONE;
-    return PyBytes_FromStringAndSize(buffer, got);
-}
 
 enum outcome { RUNNING, STOPPED, END_OF_FILE, FAILED };
 static const char *OUTCOME_NAMES[] = {NULL, "stopped", "end of file", "error"};
@@ -184,7 +145,6 @@ static void finish(Reader *r, enum outcome outcome, int error) {
 
 static void *read_loop(void *arg) {
     Reader *r = arg;
-    pthread_setname_np(pthread_self(), FD_THREAD_NAME);
     enum outcome outcome = RUNNING;
     int error = 0;
     char *buffer = malloc(MOST_BYTES);
@@ -226,7 +186,6 @@ static void *read_loop(void *arg) {
 /* Pulls samples until stop() or an error; a chunk queued is the sample's LSL stamp, then its values. */
 static void *pull_loop(void *arg) {
     Reader *r = arg;
-    pthread_setname_np(pthread_self(), LSL_THREAD_NAME);
     double sample[1 + MOST_CHANNELS];
     enum outcome outcome = RUNNING;
     int32_t error = 0;
@@ -254,35 +213,25 @@ static PyObject *bytes_of(const void *self, const char *data, size_t size) {
     return PyBytes_FromStringAndSize(data, (Py_ssize_t)size);
 }
 
-/* ([values], [LSL stamp]): a pulled sample as LslLink queues samples. */
+/* (LSL stamp, value, value, ...): a pulled sample as the LSL decoder reads it. */
 static PyObject *sample_of(const void *self, const char *data, size_t size) {
     const double *sample = (const double *)data;
-    Py_ssize_t channels = (Py_ssize_t)(size / sizeof(double)) - 1;
-    PyObject *values = PyList_New(channels);
-    PyObject *stamps = PyList_New(1);
-    PyObject *result = NULL;
-    if (!values || !stamps) goto done;
-    for (Py_ssize_t i = 0; i < channels; i++) {
-        PyObject *value = PyFloat_FromDouble(sample[1 + i]);
-        if (!value) goto done;
-        PyList_SET_ITEM(values, i, value);
+    Py_ssize_t count = (Py_ssize_t)(size / sizeof(double));
+    PyObject *result = PyTuple_New(count);
+    if (!result) return NULL;
+    for (Py_ssize_t i = 0; i < count; i++) {
+        PyObject *value = PyFloat_FromDouble(sample[i]);
+        if (!value) {
+            Py_DECREF(result);
+            return NULL;
+        }
+        PyTuple_SET_ITEM(result, i, value);
     }
-    PyObject *stamp = PyFloat_FromDouble(sample[0]);
-    if (!stamp) goto done;
-    PyList_SET_ITEM(stamps, 0, stamp);
-    PyObject *samples = PyList_New(1);
-    if (!samples) goto done;
-    PyList_SET_ITEM(samples, 0, values);
-    values = NULL;
-    result = PyTuple_Pack(2, samples, stamps);
-    Py_DECREF(samples);
-done:
-    Py_XDECREF(values);
-    Py_XDECREF(stamps);
     return result;
 }
 
-static int start_thread(Reader *self, void *(*loop)(void *)) {
+/* Starts the thread, named before the constructor returns (so that it is found by name at once). */
+static int start_thread(Reader *self, void *(*loop)(void *), const char *name) {
     self->outcome = RUNNING;
     int failed = pthread_create(&self->thread, NULL, loop, self);
     if (failed) {
@@ -291,6 +240,7 @@ static int start_thread(Reader *self, void *(*loop)(void *)) {
         PyErr_SetFromErrno(PyExc_OSError);
         return -1;
     }
+    pthread_setname_np(self->thread, name);
     self->started = 1;
     return 0;
 }
@@ -311,7 +261,7 @@ static int FdReader_init(Reader *self, PyObject *args, PyObject *kwargs) {
     fcntl(self->wake[0], F_SETFD, FD_CLOEXEC);
     fcntl(self->wake[1], F_SETFD, FD_CLOEXEC);
     self->chunk_of = bytes_of;
-    return start_thread(self, read_loop);
+    return start_thread(self, read_loop, FD_THREAD_NAME);
 }
 
 static int LslReader_init(Reader *self, PyObject *args, PyObject *kwargs) {
@@ -339,7 +289,7 @@ static int LslReader_init(Reader *self, PyObject *args, PyObject *kwargs) {
     Py_INCREF(keep);
     self->keep = keep;
     self->chunk_of = sample_of;
-    return start_thread(self, pull_loop);
+    return start_thread(self, pull_loop, LSL_THREAD_NAME);
 }
 
 static PyObject *Reader_new(PyTypeObject *type, PyObject *args, PyObject *kwargs) {
@@ -542,7 +492,7 @@ static PyTypeObject LslReaderType = {
     .tp_name = "rig.devices.trackers._readers.LslReader",
     .tp_doc = "LslReader(pull_sample_d, inlet, channels, origin_ns, keep): pulls the LSL inlet (liblsl's\n"
               "lsl_pull_sample_d at that address, the inlet's handle) on a thread of its own, each sample\n"
-              "a chunk ([values], [LSL stamp]) stamped on the monotonic clock as (ns - origin_ns) /\n"
+              "a chunk (LSL stamp, values...) stamped on the monotonic clock as (ns - origin_ns) /\n"
               "1e9, until liblsl reports an error or stop(); `keep` (the inlet) is held until then.",
     .tp_basicsize = sizeof(Reader),
     .tp_flags = Py_TPFLAGS_DEFAULT,
@@ -553,14 +503,8 @@ static PyTypeObject LslReaderType = {
     .tp_getset = Reader_getset,
 };
 
-static PyMethodDef methods[] = {
-    {"wait_read", wait_read, METH_VARARGS,
-     "wait_read(fd, timeout_ms, size): the bytes fd holds once readable, b\"\" at its end, None if nothing came in time."},
-    {NULL, NULL, 0, NULL},
-};
-
 static struct PyModuleDef module = {
-    PyModuleDef_HEAD_INIT, "_readers", "Tracker reader threads in C, and a wait and read in one call.", -1, methods,
+    PyModuleDef_HEAD_INIT, "_readers", "Tracker reader threads in C.", -1, NULL,
 };
 
 static int add_type(PyObject *m, PyTypeObject *type, const char *name) {

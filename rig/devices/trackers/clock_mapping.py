@@ -21,6 +21,7 @@ so far, started afresh when the device's clock restarts.
 from __future__ import annotations
 
 import math
+from collections import deque
 from typing import Any, Protocol, Sequence
 
 from rig.board.clock_sync import CLOCK_RESTART_S, ClockModel, OffsetInterval
@@ -151,9 +152,10 @@ class OneWayMapping:
 
 
 class CorrectedMapping:
-    """Device time to rig time from round-trip corrections such as LSL's: `add_correction(c, u, at)`
-    says local = remote + c within +-u, where local is a host clock that read `origin_s` at the rig
-    clock's zero (set before the first correction)."""
+    """Device time to rig time from round-trip corrections such as LSL's: a correction (c, u, at) says
+    local = remote + c within +-u, where local is a host clock that read `origin_s` at the rig
+    clock's zero (set before the first correction). The transport measures them on its own thread
+    and `queue`s them; the consumer's `observe_many`, before it maps a batch, takes them in."""
 
     latency_known = True
 
@@ -161,6 +163,11 @@ class CorrectedMapping:
         self.model = ClockModel()
         self.origin_s: float | None = None
         self._last: tuple[float, float] | None = None
+        self._queued: deque[tuple[float, float, float]] = deque()
+
+    def queue(self, correction: float, uncertainty: float, at: float) -> None:
+        """A measurement, from any thread, for the consumer to take in."""
+        self._queued.append((correction, uncertainty, at))
 
     def add_correction(self, correction: float, uncertainty: float, at: float) -> None:
         """A new measurement (repeats of the last one are ignored)."""
@@ -171,7 +178,10 @@ class CorrectedMapping:
         self.model.add(OffsetInterval(offset - uncertainty, offset + uncertainty, at))
 
     def observe_many(self, device_times: list[float] | None, arrivals: list[float]) -> None:
-        pass
+        """Takes in the corrections queued since the last batch."""
+        queued, add = self._queued, self.add_correction
+        while queued:
+            add(*queued.popleft())
 
     def sensor_time(self, device_time: float, t_arrival: float) -> float:
         return self.model.to_rig_time(device_time)

@@ -1,9 +1,10 @@
 """Records out of a tracker's byte stream, as its profile describes them, resynchronising after damage.
 
-Each decoder is fed bytes as they arrive (`feed(data, t_arrival)`, or the chunks a reader queued
-since the last feed, each with its arrival: `feed_chunks(chunks, arrivals)`) and returns the
-readings of the records completed by them, each stamped with the arrival of the chunk that
-completed it; what it could not decode it discards and counts in `corrupt`:
+A decoder is pure: no device, no thread, no clock. It is fed the chunks a reader queued since the
+last feed, each with its arrival (`feed_chunks(chunks, arrivals)`, or one: `feed(data, t_arrival)`),
+and returns the readings of the records completed by them, each stamped with the arrival of the
+chunk that completed it; what it could not decode it discards and counts in `corrupt`. Tests feed
+it transcripts. `decoder_for(profile)` gives a profile's:
 
 * `TextDecoder`: records end in the profile's terminator; a line with the wrong number of fields
   or a field that is not a number is one corrupt record. A line of the field names (a header) is
@@ -26,13 +27,26 @@ import struct
 from bisect import bisect_left
 from itertools import accumulate, chain, repeat
 from operator import add
-from typing import Sequence
+from typing import Protocol, Sequence
 
 from rig.devices.trackers.checksums import CHECK_BYTES, CHECK_CODES, CHECK_VALUES
 from rig.devices.trackers.profile import Profile
 from rig.devices.trackers.readings import ReadingMaker, Readings
 
 MAX_LINE = 4096
+
+
+class Decoder(Protocol):
+    """What a tracker stream reads its transport's chunks with."""
+
+    corrupt: int
+
+    def feed_chunks(self, chunks: Sequence, arrivals: Sequence[float]) -> Readings:
+        """The readings of the records the chunks complete, in order, each stamped with the arrival
+        of the chunk that completed it."""
+
+    def reset(self) -> None:
+        """Forgets a partial record (counting it corrupt) and the time counter's history."""
 
 
 class _RecordDecoder:
@@ -233,9 +247,6 @@ class HidReportDecoder(_RecordDecoder):
         self._maker.reset()
 
 
-Decoder = TextDecoder | BinaryDecoder | HidReportDecoder
-
-
 def _joined(rest: bytes, chunks: Sequence[bytes]) -> tuple[bytes, list[int]]:
     """What was left of earlier feeds with the chunks after it, and where each chunk ends in that (a
     record whose last byte is before the end of chunk k, and after that of chunk k - 1, was
@@ -244,5 +255,5 @@ def _joined(rest: bytes, chunks: Sequence[bytes]) -> tuple[bytes, list[int]]:
     return rest + b"".join(chunks), ends[1:]
 
 
-def decoder_for(profile: Profile) -> Decoder:
+def decoder_for(profile: Profile) -> TextDecoder | BinaryDecoder | HidReportDecoder:
     return {"text": TextDecoder, "binary": BinaryDecoder, "hid": HidReportDecoder}[profile.format](profile)

@@ -9,21 +9,18 @@ methods (`read(max_length, timeout_ms)` giving a list of byte values, empty when
 
 from __future__ import annotations
 
+import errno
 from typing import Callable, Protocol
 
-from rig.clock import Clock
 from rig.devices.trackers.clock_mapping import mapping_for
 from rig.devices.trackers.decoders import HidReportDecoder
-from rig.devices.trackers.profile import Profile, load_profile
-from rig.devices.trackers.readings import Readings
-from rig.devices.trackers.link import LinkLost
+from rig.devices.trackers.profile import load_profile
 from rig.devices.trackers.stream import TrackerStream
+from rig.devices.trackers.transport import ThreadReader
 from rig.errors import ConfigError, RigError
 
 DEFAULT_PROFILE = "hid-quat16"
 READ_TIMEOUT_MS = 50
-# Longest report read: full-speed USB interrupt reports are at most 64 bytes, high-speed 1024.
-MAX_REPORT_BYTES = 1024
 
 
 class HidDevice(Protocol):
@@ -57,23 +54,20 @@ def parse_hid_address(address: str) -> tuple[int, int, str]:
     return vendor, product, parts[2] if len(parts) > 2 and parts[2] else DEFAULT_PROFILE
 
 
-class HidLink:
-    """One HID device's input reports through the profile's decoder."""
+class HidTransport:
+    """One HID device's input reports, read through hidapi's Python binding by a `ThreadReader`
+    (there is no compiled reader for HID): each report is a chunk."""
 
-    def __init__(self, vendor: int, product: int, profile: Profile, open_device: Callable[[int, int], HidDevice]) -> None:
+    def __init__(self, vendor: int, product: int, report_bytes: int, open_device: Callable[[int, int], HidDevice]) -> None:
         self.ids = f"{vendor:04x}:{product:04x}"
         self.description = f"HID device {self.ids}"
         self._vendor, self._product = vendor, product
         self._open_device = open_device
-        self._decoder = HidReportDecoder(profile)
-        self._read_bytes = max(self._decoder.report_bytes, 64)
+        self._read_bytes = max(report_bytes, 64)
         self._device: HidDevice | None = None
+        self._origin_ns = 0
 
-    @property
-    def corrupt(self) -> int:
-        return self._decoder.corrupt
-
-    def open(self, clock: Clock) -> None:
+    def open(self, origin_ns: int) -> None:
         try:
             self._device = self._open_device(self._vendor, self._product)
         except (OSError, ValueError) as error:
@@ -81,29 +75,20 @@ class HidLink:
                 f"cannot open HID device {self.ids} ({error}): check that it is plugged in (`rig devices` lists "
                 "what it sees) and that your user may read its /dev/hidraw* node (a udev rule)"
             ) from None
+        self._origin_ns = origin_ns
 
-    def native_reader(self, clock: Clock) -> None:
-        """None: hidapi's device is read through its Python binding, on the stream's thread."""
-        return None
+    def reader(self) -> ThreadReader:
+        return ThreadReader(self._receive, self._origin_ns, f"hid reader {self.ids}")
 
-    def upkeep(self, clock: Clock) -> None:
-        """Nothing: the device's clock is mapped from its records alone."""
-
-    def receive(self, clock: Clock) -> bytes | None:
-        device = self._device
-        if device is None:
-            raise LinkLost("the device is closed")
+    def _receive(self) -> bytes | None:
         try:
-            report = device.read(self._read_bytes, READ_TIMEOUT_MS)
-        except (OSError, ValueError) as error:
-            raise LinkLost(str(error)) from None
+            report = self._device.read(self._read_bytes, READ_TIMEOUT_MS)  # type: ignore[union-attr]
+        except ValueError as error:  # hidapi's, for a device that went away
+            raise OSError(errno.EIO, str(error)) from None
         return bytes(report) if report else None
 
-    def decode(self, chunks: list[bytes], arrivals: list[float]) -> Readings:
-        return self._decoder.feed_chunks(chunks, arrivals)
-
-    def restart(self) -> None:
-        self._decoder.reset()
+    def upkeep(self) -> None:
+        """Nothing: the device's clock is mapped from its records alone."""
 
     def close(self) -> None:
         device, self._device = self._device, None
@@ -120,9 +105,11 @@ def hid_tracker(address: str, open_device: Callable[[int, int], HidDevice] = ope
     profile = load_profile(profile_name)
     if profile.format != "hid":
         raise ConfigError(f"profile {profile.name} is a {profile.format} profile; a HID tracker needs format = \"hid\"")
+    decoder = HidReportDecoder(profile)
     return TrackerStream(
         f"hid:{address}",
-        HidLink(vendor, product, profile, open_device),
+        HidTransport(vendor, product, decoder.report_bytes, open_device),
+        decoder,
         mapping_for(profile),
         unit_tolerance=profile.unit_tolerance,
         sequence_bits=profile.sequence_bits,

@@ -164,64 +164,45 @@ def _column(group: _Group, records: Sequence[Sequence[float]]) -> list[tuple]:
 def keep_possible(readings: Readings, unit_tolerance: float) -> list[str]:
     """Removes the impossible readings (a number not finite, a quaternion not of unit norm within
     `unit_tolerance`), each counted discarded before the next, and normalises the quaternions of the
-    rest, in place; what was wrong with each removed, in order."""
-    normalised = _normalised(readings, unit_tolerance)
-    if normalised is not None:
-        readings.orientations = normalised
-        return []
-    problems = _remove_impossible(readings, unit_tolerance)
-    readings.orientations = _normalised(readings, unit_tolerance)  # type: ignore[assignment]
-    return problems
-
-
-def _problem(
-    position: tuple[float, float, float],
-    orientation: Quaternion,
-    rate: tuple[float, float, float] | None,
-    device_time: float | None,
-    unit_tolerance: float,
-) -> str | None:
-    """What makes one reading impossible, or None."""
-    w, x, y, z = orientation
-    px, py, pz = position
-    wx, wy, wz = rate or (0.0, 0.0, 0.0)
-    if not math.isfinite(w + x + y + z + px + py + pz + wx + wy + wz + (device_time or 0.0)):
-        return f"a value is not a finite number: position {position}, orientation {orientation}"
-    norm = math.sqrt(w * w + x * x + y * y + z * z)
-    if abs(norm - 1.0) > unit_tolerance:
-        return f"the quaternion {orientation} has norm {norm:.6g}, not 1 within {unit_tolerance:g}"
-    return None
-
-
-def _normalised(readings: Readings, unit_tolerance: float) -> list[Quaternion] | None:
-    """The readings' quaternions normalised, or None if one of them is impossible (`_problem`
-    finds the same, reading by reading: absent rates and time add zeros); one loop, for the reason
-    in `rig.devices.trackers.decoders.BinaryDecoder`."""
+    rest, in place; what was wrong with each removed, in order. One loop over the batch (absent
+    rates and time add zeros), for the reason in `rig.devices.trackers.decoders.BinaryDecoder`."""
     normalised: list[Quaternion] = []
+    impossible: list[int] = []
     append, sqrt, isfinite = normalised.append, math.sqrt, math.isfinite
     rates = readings.rates or repeat(_ORIGIN)
     times = readings.device_times or repeat(0.0)
     for (w, x, y, z), (px, py, pz), (wx, wy, wz), t in zip(readings.orientations, readings.positions, rates, times):
         norm = sqrt(w * w + x * x + y * y + z * z)
-        if not (isfinite(w + x + y + z + px + py + pz + wx + wy + wz + t) and abs(norm - 1.0) <= unit_tolerance):
-            return None
-        append((w / norm, x / norm, y / norm, z / norm))
-    return normalised
+        if isfinite(w + x + y + z + px + py + pz + wx + wy + wz + t) and abs(norm - 1.0) <= unit_tolerance:
+            append((w / norm, x / norm, y / norm, z / norm))
+        else:
+            impossible.append(len(normalised) + len(impossible))
+    problems = [_problem(readings.positions[k], readings.orientations[k], unit_tolerance) for k in impossible]
+    if impossible:
+        _remove(readings, impossible)
+    readings.orientations = normalised
+    return problems
 
 
-def _remove_impossible(readings: Readings, unit_tolerance: float) -> list[str]:
-    """`keep_possible`'s removal, reading by reading."""
+def _problem(position: tuple[float, float, float], orientation: Quaternion, unit_tolerance: float) -> str:
+    """What makes an impossible reading so."""
+    norm = math.sqrt(sum(q * q for q in orientation))
+    if all(map(math.isfinite, (*position, *orientation))) and abs(norm - 1.0) > unit_tolerance:
+        return f"the quaternion {orientation} has norm {norm:.6g}, not 1 within {unit_tolerance:g}"
+    return f"a value is not a finite number: position {position}, orientation {orientation}"
+
+
+def _remove(readings: Readings, impossible: list[int]) -> None:
+    """Leaves out the readings at the (sorted) indices `impossible` in every column but the
+    orientations, and tells each removed one, with the damage before it, to the next one kept."""
     count = len(readings)
-    rates = readings.rates or [None] * count
-    times = readings.device_times or [None] * count
-    columns = zip(readings.positions, readings.orientations, rates, times)
-    problems = [_problem(*values, unit_tolerance) for values in columns]  # type: ignore[misc]
+    dropped = set(impossible)
     kept: list[int] = []
     discarded: dict[int, int] = {}
     pending = 0
-    for index, problem in enumerate(problems):
+    for index in range(count):
         pending += readings.discarded.get(index, 0)
-        if problem is not None:
+        if index in dropped:
             pending += 1
             continue
         if pending:
@@ -231,7 +212,7 @@ def _remove_impossible(readings: Readings, unit_tolerance: float) -> list[str]:
     if pending:
         discarded[len(kept)] = pending
     pick = partial(_pick, kept)
-    readings.arrivals, readings.positions, readings.orientations = pick(readings.arrivals), pick(readings.positions), pick(readings.orientations)
+    readings.arrivals, readings.positions = pick(readings.arrivals), pick(readings.positions)
     if readings.device_times is not None:
         readings.device_times = pick(readings.device_times)
     if readings.seqs is not None:
@@ -239,7 +220,6 @@ def _remove_impossible(readings: Readings, unit_tolerance: float) -> list[str]:
     if readings.rates is not None:
         readings.rates = pick(readings.rates)
     readings.discarded = discarded
-    return [problem for problem in problems if problem is not None]
 
 
 def _pick(indices: list[int], column: list) -> list:

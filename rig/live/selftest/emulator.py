@@ -10,11 +10,9 @@ import time
 from typing import Any, Sequence
 
 from rig.clock import MonotonicClock
+from rig.emulate import EmulatorConfig, quiet_tracker, run_emulator
 from rig.emulate.encode import Emission
-from rig.emulate.faults import FaultPlan
-from rig.emulate.motion import Motion
 from rig.emulate.sinks import LslSink
-from rig.emulate.streamer import stream
 from rig.errors import RigError
 
 TRACKER_HZ = 500.0
@@ -50,16 +48,13 @@ def _emulate(name: str, duration_s: float, rate_hz: float, origin_s: float, star
     """The emulator's process: `ready` once its outlet is up, then stream until the duration is over
     or `stop` is set; `start` gets the rig time of the motion's time 0."""
     sink = _StoppableSink(name, rate_hz, stop)
-    motion = Motion(rate_hz, duration_s)
     ready.set()
 
-    def device_clock(t: float) -> float:
-        if math.isnan(start.value):
-            start.value = t - origin_s
-        return t
+    def started(t: float) -> None:
+        start.value = t - origin_s
 
     try:
-        stream(motion, sink, duration_s, FaultPlan(), device_clock, None)
+        run_emulator(EmulatorConfig("lsl", name, quiet_tracker(rate_hz), duration_s), sink, lambda message: None, started)
     except _Stopped:
         pass
     finally:

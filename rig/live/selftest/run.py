@@ -29,7 +29,7 @@ from rig.live.selftest.frame_clock import FixedRateFrameClock
 from rig.live.selftest.twin import ScreenCamera, TwinSetup
 from rig.live.view import View
 from rig.lsl import StreamNames
-from rig.sim.bench import make_layout
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig

@@ -34,7 +34,7 @@ import numpy as np
 
 from rig.clock import Clock, MonotonicClock
 from rig.devices.protocols import CameraFrame, Fault
-from rig.sim.bench import BenchLayout
+from rig.sim.layout import BenchLayout
 from rig.sim.camera import CameraConfig, CameraSensor
 from rig.sim.pendulum import Pendulum, PendulumConfig
 

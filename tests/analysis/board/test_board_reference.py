@@ -14,7 +14,7 @@ from analysis.errors import AnalysisError
 from analysis.onset import departure_time
 from analysis.tracking import Track
 from rig.board.events import EncoderEdge, LedChange
-from rig.board.recording import BoardRecorder
+from rig.board.recorder import BoardRecorder
 
 FPS = 120.0
 OFFSET_S = 250.0

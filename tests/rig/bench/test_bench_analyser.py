@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from rig.bench import analyser
+from rig.bench.contract import Context
 from rig.cli import main
 from rig.commands import bench
 from rig.service.sweep import SweepPoint, read_sweep
@@ -129,7 +130,7 @@ def test_rig_sweep_on_the_spec_gives_the_rows_of_the_bench(monkeypatch, tmp_path
     monkeypatch.setattr(analyser, "_case_record", lambda point, row, log, started: {"case": point.labels["case"], "group": "mixed"})
     monkeypatch.setattr(analyser, "summarise", lambda cases: {})
     monkeypatch.setattr(analyser, "targets_met", lambda summaries: {})
-    benched = analyser.run_bench(read_sweep(spec), tmp_path / "bench", lambda message: None)["sweep"]
+    benched = analyser.run(read_sweep(spec), Context(tmp_path / "bench", log=lambda message: None))["sweep"]
     assert main(["sweep", str(spec), "--out", str(tmp_path / "sweep"), "--json"]) == 0
     swept = json.loads(capsys.readouterr().out)
 
@@ -153,6 +154,6 @@ def test_grid_runs_the_points_of_its_group(monkeypatch, tmp_path: Path) -> None:
     monkeypatch.setattr(analyser, "measure_point", measured)
     monkeypatch.setattr(analyser, "summarise", lambda cases: {"cases": len(cases)})
     monkeypatch.setattr(analyser, "targets_met", lambda summaries: {})
-    report = analyser.run_bench(read_sweep(analyser.QUICK_SPEC), tmp_path, lambda message: None, groups=analyser.GROUPS["hard"])
+    report = analyser.run(analyser.of_groups(read_sweep(analyser.QUICK_SPEC), "hard"), Context(tmp_path, log=lambda message: None))
     assert ran == [case["case"] for case in report["cases"]] and len(ran) == 1 and ran[0].startswith("quick-dim-led")
     assert report["summaries"] == {"all": {"cases": 1}, "hard": {"cases": 1}}

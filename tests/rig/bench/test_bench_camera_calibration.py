@@ -12,16 +12,16 @@ from rig.bench import camera_calibration as bench
 SMALL = bench.CalibrationGrid(width=160, height=120)
 
 
-def test_a_light_case_scores_the_answer_against_the_simulated_camera() -> None:
-    row = bench.case_row(SMALL, 120.0, 6e-3, 2e-3, "light-25", seed=3)
+def test_a_light_case_scores_the_answer_against_the_simulated_camera(tmp_path: Path) -> None:
+    row = bench.case_row(SMALL, 120.0, 6e-3, 2e-3, "light-25", 3, tmp_path)
     assert row["refused"] is None and row["duty"] == 0.25
     assert row["readout_error_ms"] == pytest.approx(row["measured_readout_ms"] - 6.0)
     assert abs(row["readout_error_pct"]) < 5 and abs(row["exposure_error_pct"]) < 10
     assert row["readout_within"] and row["exposure_within"] and row["readout_covered"] and row["exposure_covered"]
 
 
-def test_a_global_shutter_is_within_when_it_reads_zero() -> None:
-    row = bench.case_row(SMALL, 120.0, 0.0, 2e-3, "light", seed=4)
+def test_a_global_shutter_is_within_when_it_reads_zero(tmp_path: Path) -> None:
+    row = bench.case_row(SMALL, 120.0, 0.0, 2e-3, "light", 4, tmp_path)
     assert row["global_shutter"] and row["readout_within"] and row["readout_error_pct"] is None
 
 
@@ -40,4 +40,6 @@ def test_the_summary_and_the_targets_count_the_rows(tmp_path: Path) -> None:
     assert light["readout_error_pct_max"] == 8.0 and light["exposure_error_pct_median"] == 2.0
     assert bench.targets_met(rows_of("good", "refused")) == dict.fromkeys(bench.targets_met([]), True)
     assert not any(bench.targets_met(rows_of("wide", "missed")).values())
-    assert "light" in bench.table(bench.summary(found))
+    assert "light" in bench.table({"rows": found})
+    bench.plot({"rows": found}, tmp_path / "camera.png")
+    assert (tmp_path / "camera.png").stat().st_size > 0

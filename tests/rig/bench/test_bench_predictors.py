@@ -10,6 +10,7 @@ import pytest
 from predictors import Trace, write_trace
 from predictors import quaternion as quat
 from predictors.synthetic import head_motion
+from rig.bench import predictor_scores
 from rig.bench import predictors as bench
 from rig.commands import bench as bench_command
 
@@ -54,8 +55,8 @@ def test_constant_velocity_is_always_run_as_the_baseline(tmp_path, capsys):
 def test_ratios_are_errors_over_constant_velocity_and_their_geometric_mean():
     traces = [head_motion(3.0, 60.0, seed=s).with_noise(0.001, math.radians(0.2), seed=s) for s in (1, 2)]
     traces = [Trace.from_samples(f"head{k}", tr.t, tr.position, tr.orientation) for k, tr in enumerate(traces)]
-    results = bench.run_bench(traces, [("slerp", {}), ("hold", {})], [20.0, 50.0], timing_repeats=1)
-    ratios = {entry.predictor: entry for entry in bench.ratios(results, [20.0, 50.0])}
+    results = bench.evaluate_all(traces, [("slerp", {}), ("hold", {})], [20.0, 50.0], timing_repeats=1)
+    ratios = {entry.predictor: entry for entry in predictor_scores.ratios(results, [20.0, 50.0])}
     by = {(r.trace, r.predictor): r for r in results}
     for trace in ("head0", "head1"):
         expected = by[(trace, "hold")].at(50.0).angular_rms_deg / by[(trace, "slerp")].at(50.0).angular_rms_deg
@@ -69,8 +70,8 @@ def test_ratios_are_errors_over_constant_velocity_and_their_geometric_mean():
 def test_a_trace_without_position_has_no_position_ratio():
     trace = head_motion(2.0, 60.0, seed=3)
     still = Trace.from_samples("still", trace.t, np.zeros((len(trace), 3)), trace.orientation)
-    results = bench.run_bench([still], [("slerp", {}), ("adaptive", {})], [50.0], timing_repeats=0)
-    entry = bench.ratios(results, [50.0])[1]
+    results = bench.evaluate_all([still], [("slerp", {}), ("adaptive", {})], [50.0], timing_repeats=0)
+    entry = predictor_scores.ratios(results, [50.0])[1]
     assert math.isnan(entry.position["still"][50.0]) and math.isnan(entry.geometric_mean("position", 50.0))
     assert entry.to_dict([50.0])["position"]["still"]["50"] is None
 

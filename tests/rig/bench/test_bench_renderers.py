@@ -11,17 +11,22 @@ from pathlib import Path
 
 import pytest
 
-from rig.bench import seed_table
+from rig.bench import renderers, seed_table
 from rig.bench.renderer_latency import FILMS_SPEC, film_latency
-from rig.bench.renderers import LATENCY_FIELDS, QUICK_SPEC, ROW_FIELDS, SPEC, BenchGrid, read_grid, scene_setup
+from rig.bench.renderer_setup import scene_setup
+from rig.bench.renderers import LATENCY_FIELDS, QUICK_SPEC, ROW_FIELDS, BenchGrid, read_grid
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
+from rig.bench.spec_reader import read_spec
 from rig.cli import EXIT_USER_ERROR, main
 from rig.commands import bench
-from rig.commands.bench_renderers import _grid
 from rig.service.sweep import read_sweep
 from rig.sim.camera import CameraConfig
 
-QUICK_GRID = read_grid(QUICK_SPEC)
+QUICK_GRID = read_spec(BenchGrid, QUICK_SPEC)
+
+
+def _grid(args: argparse.Namespace) -> BenchGrid:
+    return bench.spec(renderers.BENCH, args)
 
 
 def bench_parser() -> argparse.ArgumentParser:
@@ -112,8 +117,11 @@ def test_the_films_spec_sweeps_exactly_the_simulations_the_bench_filmed(quick_ru
         assert point.simulated_rois
 
 
-def test_the_specs_hold_the_grids_the_bench_had():
-    assert read_grid(SPEC) == BenchGrid()
+def test_a_spec_sets_the_settings_it_names_and_the_rest_keep_the_grids_defaults(tmp_path):
+    spec = tmp_path / "grid.toml"
+    spec.write_text("phases = 2\n[latency_camera]\nwidth = 320\n")
+    assert read_grid(spec) == BenchGrid(phases=2, latency_camera=CameraConfig(width=320))
+    assert read_grid(None) == BenchGrid()
     assert read_grid(QUICK_SPEC) == BenchGrid(
         triangles=(1_000, 8_000), resolutions=((160, 120),), ratios=(1, 3), phases=1, warp_rounds=3, direct_frames=3,
         direct_budget_s=1.0, latency_triangles=(1_000,), latency_camera=CameraConfig(width=320, height=240, subsamples=4),
@@ -124,8 +132,8 @@ def test_the_specs_hold_the_grids_the_bench_had():
 def test_the_specs_are_package_data():
     pyproject = tomllib.loads((Path(__file__).parents[3] / "pyproject.toml").read_text())
     patterns = pyproject["tool"]["setuptools"]["package-data"]["rig.bench"]
-    shipped = {path for pattern in patterns for path in SPEC.parents[1].glob(pattern)}
-    assert {SPEC, QUICK_SPEC} <= shipped
+    shipped = {path for pattern in patterns for path in QUICK_SPEC.parents[1].glob(pattern)}
+    assert QUICK_SPEC in shipped
 
 
 def test_the_options_override_the_spec(tmp_path):
@@ -151,7 +159,8 @@ def test_the_options_override_the_spec(tmp_path):
         ("server_ms = \"2\"\n", "server_ms must be a number"),
         ("[latency_camera]\nwidht = 320\n", "unknown key latency_camera.widht; CameraConfig takes fps, "),
         ("latency_camera = 320\n", "latency_camera must be a table of CameraConfig settings"),
-        ("ratios = [0]\n", "rate ratios are display frames per client frame, at least 1"),
+        ("ratios = [0]\n", "ratios must have each item a positive whole number at least 1, got \\(0,\\)"),
+        ("refresh_hz = 5000.0\n", "refresh_hz must be a positive number of Hz from 1 to 1000, got 5000.0"),
         ("ratios = []\n", "needs at least one"),
         ("triangles = [\n", "is not valid TOML"),
     ],

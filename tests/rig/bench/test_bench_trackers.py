@@ -34,7 +34,7 @@ def test_the_table_and_the_plot_show_every_row(tmp_path: Path) -> None:
     assert len(lines) == 4 and "40.0 (20.0), 70.0 | 18.0 | 2.5 | 0.100, 0.400 |" in lines[2]
     assert "| 18.0 | n/a | 0.100" in lines[3]
     trackers.plot([row], tmp_path / "trackers.png")
-    assert (tmp_path / "trackers.png").stat().st_size > 0
+    assert (tmp_path / "trackers.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and (tmp_path / "trackers.png").stat().st_size > 10_000
 
 
 def test_the_cpu_a_host_took_is_its_share_of_the_ticks_between_two_readings() -> None:

@@ -13,7 +13,7 @@ import pytest
 
 from analysis.board.recording import load_table
 from rig.board import BoardRecorder, ClockSynced, EncoderEdge, LedChange, LinkChange, PhotodiodePassage
-from rig.board.recording import FILES
+from rig.board.recorder import FILES
 from rig.errors import RigError
 
 

@@ -1,8 +1,7 @@
 """An LSL inlet pulled by the compiled reader thread (`_readers.LslReader`): every sample an outlet
-pushes comes out once, in order, with its values and LSL stamp, stamped on the rig clock between
+pushes comes out once, in order, with its LSL stamp and values, stamped on the rig clock between
 the readings around its pushing; the reader holds the inlet it pulls until its thread is joined,
-and stop() or dropping it ends that thread. On a clock of a test's own the stream's Python thread
-pulls instead, with pylsl."""
+and stop() or dropping it ends that thread. An LSL tracker reads through it whatever its clock."""
 
 from __future__ import annotations
 
@@ -19,7 +18,7 @@ from rig.clock import MonotonicClock
 from rig.devices.trackers import lsl_tracker as lsl_tracker_module
 from rig.devices.trackers import stream as stream_module
 from rig.devices.trackers._readers import LslReader
-from rig.devices.trackers.lsl_tracker import CHANNELS, OPEN_TIMEOUT_S, RESOLVE_TIMEOUT_S, LslLink, lsl_tracker, pylsl
+from rig.devices.trackers.lsl_tracker import CHANNELS, OPEN_TIMEOUT_S, RESOLVE_TIMEOUT_S, lsl_tracker, pylsl
 
 pytestmark = pytest.mark.slow
 
@@ -77,8 +76,8 @@ def test_every_sample_pushed_is_pulled_once_in_order_stamped_on_the_rig_clock(ou
     chunks, arrivals = _take_all(reader, len(sent))
     after = clock.now()
     reader.stop()
-    assert [samples for samples, _ in chunks] == [[values] for values in sent]
-    assert [stamp for _, (stamp,) in chunks] == pytest.approx(stamps, abs=1e-9)
+    assert [list(chunk[1:]) for chunk in chunks] == sent
+    assert [chunk[0] for chunk in chunks] == pytest.approx(stamps, abs=1e-9)
     assert before <= arrivals[0] and arrivals[-1] <= after and arrivals == sorted(arrivals)
     assert (reader.outcome, reader.errno) == ("stopped", 0)
     assert reader.cpu_s > 0.0
@@ -102,25 +101,17 @@ def test_bad_arguments_are_refused() -> None:
         LslReader(1, 1, 0, 0, None)
 
 
-def test_a_link_has_a_compiled_reader_on_the_system_clock_only(outlet: Any) -> None:
-    link = LslLink(outlet.get_info().name())
-    link.open(MonotonicClock())
-    try:
-        assert link.native_reader(MonotonicClock(read_ns=lambda: time.monotonic_ns())) is None
-        reader = link.native_reader(MonotonicClock())
-        assert reader is not None
-        reader.stop()
-    finally:
-        link.close()
-
-
 @pytest.mark.parametrize("clock_kind", ["system", "own"])
-def test_a_stream_reads_every_sample_on_either_path(outlet: Any, clock_kind: str) -> None:
-    """system: the compiled reader pulls; own (a clock reading the same time through a function of
-    the test's): the stream's Python thread pulls, with pylsl."""
+def test_a_stream_reads_every_sample_through_the_compiled_reader_on_any_clock(
+    outlet: Any, clock_kind: str, reader_threads: Callable[[str], set[str]]
+) -> None:
+    """system: the system's monotonic clock; own: a clock reading the same time through a function
+    of the test's, whose origin the stream measures."""
     clock = MonotonicClock() if clock_kind == "system" else MonotonicClock(read_ns=lambda: time.monotonic_ns())
     tracker = lsl_tracker(outlet.get_info().name())
+    others = reader_threads("rig lsl reader")
     tracker.connect(clock)
+    assert reader_threads("rig lsl reader") - others
     sent = _samples(50)
     for k, values in enumerate(sent):
         outlet.push_sample(values, 200.0 + k * 1e-3)
@@ -133,12 +124,9 @@ def test_a_stream_reads_every_sample_on_either_path(outlet: Any, clock_kind: str
     assert tracker.report()["counters"]["received"] == len(sent)
 
 
-@pytest.mark.parametrize("clock_kind", ["system", "own"])
-def test_clock_corrections_are_measured_on_the_reading_side_never_by_the_consumer(
-    outlet: Any, clock_kind: str, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_clock_corrections_are_measured_on_the_reading_side_never_by_the_consumer(outlet: Any, monkeypatch: pytest.MonkeyPatch) -> None:
     """liblsl's time correction can wait on the network: the consumer (a render loop) only hands the
-    mapping what the stream's thread measured."""
+    mapping what the stream's supervising thread measured."""
     monkeypatch.setattr(lsl_tracker_module, "CORRECTION_INTERVAL_S", 0.02)
     monkeypatch.setattr(stream_module, "UPKEEP_INTERVAL_S", 0.01)
     measured_on: list[int] = []
@@ -149,9 +137,8 @@ def test_clock_corrections_are_measured_on_the_reading_side_never_by_the_consume
         return measure(inlet, timeout_s)
 
     monkeypatch.setattr(lsl_tracker_module, "time_correction", spy)
-    clock = MonotonicClock() if clock_kind == "system" else MonotonicClock(read_ns=lambda: time.monotonic_ns())
     tracker = lsl_tracker(outlet.get_info().name())
-    tracker.connect(clock)
+    tracker.connect(MonotonicClock())
     measured_on.clear()  # the first is measured by connect(), before any reading
     added = []
     mapping_add = tracker.mapping.add_correction

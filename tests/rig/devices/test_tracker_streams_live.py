@@ -11,9 +11,9 @@ import pytest
 
 from predictors import read_samples, read_trace
 from rig.devices.trackers.clock_mapping import WINDOW_S
-from rig.emulate import EmulatorConfig
-from rig.emulate.faults import parse_faults
-from rig.service.record import DEVICE_FILE, TRACKER_FILE, record_tracker
+from rig.emulate import EmulatorConfig, quiet_tracker
+from rig.service.tracker_recording import DEVICE_FILE, TRACKER_FILE, record_tracker
+from rig.sim.tracker_faults import parse_faults
 
 pytestmark = pytest.mark.slow
 
@@ -32,7 +32,7 @@ def _device_seq(folder: Path) -> list[int]:
 @pytest.mark.parametrize("transport, profile", [("pty", "binary-pose"), ("tcp", "binary-pose"), ("pty", "csv")])
 def test_a_clean_serial_stream_is_recorded_whole_and_in_order(tmp_path: Path, emulated_tracker, transport: str, profile: str) -> None:
     address = str(tmp_path / "tracker") if transport == "pty" else "0"
-    config = EmulatorConfig(transport, address, RATE_HZ, DURATION_S, profile, log=tmp_path / "sent.csv")
+    config = EmulatorConfig(transport, address, quiet_tracker(RATE_HZ), DURATION_S, profile, log=tmp_path / "sent.csv")
     with emulated_tracker(config) as emulator:
         recording = record_tracker(emulator.spec, DURATION_S + MARGIN_S, tmp_path / "out")
     sent = emulator.fates()
@@ -53,7 +53,7 @@ def test_a_clean_serial_stream_is_recorded_whole_and_in_order(tmp_path: Path, em
 
 def test_corrupt_bytes_and_a_disconnect_lose_no_intact_record_and_fabricate_none(tmp_path: Path, emulated_tracker) -> None:
     faults = parse_faults("corrupt=0.01,garbage=20,disconnect=0.7:0.3")
-    config = EmulatorConfig("pty", str(tmp_path / "tracker"), RATE_HZ, DURATION_S, "binary-pose", faults=faults, seed=3,
+    config = EmulatorConfig("pty", str(tmp_path / "tracker"), quiet_tracker(RATE_HZ), DURATION_S, "binary-pose", faults=faults, seed=3,
                             log=tmp_path / "sent.csv")  # fmt: skip
     with emulated_tracker(config) as emulator:
         recording = record_tracker(emulator.spec, DURATION_S + MARGIN_S, tmp_path / "out")
@@ -71,7 +71,7 @@ def test_corrupt_bytes_and_a_disconnect_lose_no_intact_record_and_fabricate_none
 
 
 def test_an_lsl_stream_is_recorded_whole_with_its_latency_known(tmp_path: Path, emulated_tracker) -> None:
-    config = EmulatorConfig("lsl", f"rig-test-{tmp_path.name}", RATE_HZ, DURATION_S, log=tmp_path / "sent.csv")
+    config = EmulatorConfig("lsl", f"rig-test-{tmp_path.name}", quiet_tracker(RATE_HZ), DURATION_S, log=tmp_path / "sent.csv")
     with emulated_tracker(config) as emulator:
         recording = record_tracker(emulator.spec, DURATION_S + MARGIN_S, tmp_path / "out")
     assert recording.samples == len(emulator.fates()["intact"]) == int(RATE_HZ * DURATION_S)

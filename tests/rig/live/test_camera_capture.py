@@ -19,8 +19,8 @@ from rig.devices.camera import apply_settings, opencv_camera, parse_camera_addre
 from rig.devices.camera.opencv_camera import CameraSettings
 from rig.devices.protocols import CameraFrame
 from rig.errors import ConfigError, RigError
-from rig.records import VideoRecord
-from rig.session.record import FilmRecord
+from rig.writers import VideoRecord
+from rig.session.run_record import FilmRecord
 
 FPS = 50.0
 FRAMES = 40

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from rig.live.record import check_first_seconds
-from rig.records import VideoRecord
+from rig.live.camera_recording import check_first_seconds
+from rig.writers import VideoRecord
 
 FPS = 60.0
 

@@ -18,16 +18,16 @@ import numpy as np
 import pytest
 
 from rig.devices.window import WindowSettings
-from rig.emulate import EmulatorConfig, make_sink, run_emulator
+from rig.emulate import EmulatorConfig, make_sink, quiet_tracker, run_emulator
 from rig.errors import RigError
 from rig.live.run import LiveConfig, run_live
 from rig.live.selftest.frame_clock import FixedRateFrameClock
 from rig.live.view import View
-from rig.sim.bench import make_layout
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
-from rig.records import VideoRecord
+from rig.writers import VideoRecord
 
 pytestmark = pytest.mark.slow
 
@@ -73,7 +73,7 @@ def test_the_self_test_video_agrees_with_the_rigs_own_log(tmp_path: Path, x_disp
 
 
 def test_a_tracker_unplugged_mid_run_ends_it_cleanly_with_everything_kept(tmp_path: Path, x_display: str) -> None:
-    emulator = EmulatorConfig("pty", str(tmp_path / "tracker"), 400.0, 3.0, "binary-pose")
+    emulator = EmulatorConfig("pty", str(tmp_path / "tracker"), quiet_tracker(400.0), 3.0, "binary-pose")
     sink = make_sink(emulator)
     sent = {}
 

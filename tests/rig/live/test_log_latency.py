@@ -12,7 +12,7 @@ from predictors import SAMPLE_COLUMNS, PoseSample, sample_row
 from rig.errors import RigError
 from rig.live.log_latency import log_latency
 from rig.live.view import view_from_positions
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 
 PERIOD_S = 1.2
 REFRESH_S = 1.0 / 60.0

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from rig.errors import ConfigError
-from rig.records import VideoRecord
+from rig.writers import VideoRecord
 from rig.sim.camera import CameraConfig, CameraSensor
 
 NO_PANEL = (0, 0, 1, 1)

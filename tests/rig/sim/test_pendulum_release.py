@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rig.errors import ConfigError
-from rig.sim.bench import make_layout
+from rig.sim.layout import make_layout
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -69,8 +69,8 @@ def test_the_layout_frames_the_held_led_inside_its_roi() -> None:
     "kwargs, message",
     [
         (dict(release_s=1.0, phase_deg=90.0), "release_s and phase_deg exclude each other"),
-        (dict(release_s=math.nan), "release_s must be a finite time"),
-        (dict(release_s=math.inf), "release_s must be a finite time"),
+        (dict(release_s=math.nan), "pendulum.release_s must be a number of seconds, got nan"),
+        (dict(release_s=math.inf), "pendulum.release_s must be a number of seconds, got inf"),
     ],
 )
 def test_bad_releases_are_rejected(kwargs: dict, message: str) -> None:

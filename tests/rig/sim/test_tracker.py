@@ -1,4 +1,4 @@
-"""The simulated tracker against its configuration, and the tracker CSV format."""
+"""The simulated tracker against its configuration and its faults in time, and the tracker CSV format."""
 
 import math
 
@@ -9,7 +9,8 @@ from predictors import PoseSample
 from rig.clock import VirtualClock
 from rig.errors import ConfigError, RigError
 from rig.sim.pendulum import Pendulum, PendulumConfig
-from rig.sim.tracker import SimTracker, TrackerConfig, simulate_tracker
+from rig.sim.tracker import SimTracker, TrackerConfig, measure, simulate_tracker
+from rig.sim.tracker_faults import parse_faults
 
 QUIET = dict(position_noise_m=0.0, orientation_noise_deg=0.0, jitter_s=0.0)
 
@@ -129,7 +130,7 @@ def test_a_window_too_short_for_one_sample_gives_none(pendulum):
 
 @pytest.mark.parametrize("t_start, t_end", [(-0.1, 1.0), (0.0, 30.5)])
 def test_a_window_outside_the_pendulum_raises(pendulum, t_start, t_end):
-    with pytest.raises(ConfigError, match="not inside the pendulum"):
+    with pytest.raises(ConfigError, match="not inside the motion"):
         simulate_tracker(pendulum, TrackerConfig(), t_start, t_end, seed=0)
 
 
@@ -141,16 +142,16 @@ def test_an_empty_window_raises(pendulum):
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        (dict(rate_hz=0.0), "rate_hz must be a positive finite"),
-        (dict(rate_hz=math.inf), "rate_hz must be a positive finite"),
-        (dict(position_noise_m=-1e-3), "position_noise_m must be a finite number >= 0"),
-        (dict(orientation_noise_deg=math.nan), "orientation_noise_deg must be a finite number >= 0"),
-        (dict(transport_delay_s=-0.001), "transport_delay_s must be a finite number >= 0"),
-        (dict(jitter_s=math.inf), "jitter_s must be a finite number >= 0"),
-        (dict(dropout=1.0), r"dropout must be a probability in \[0, 1\)"),
-        (dict(dropout=-0.1), r"dropout must be a probability in \[0, 1\)"),
+        (dict(rate_hz=0.0), "tracker.rate_hz must be a positive number of Hz, got 0.0"),
+        (dict(rate_hz=math.inf), "tracker.rate_hz must be a positive number of Hz, got inf"),
+        (dict(position_noise_m=-1e-3), "tracker.position_noise_m must be zero or a positive number of metres, got -0.001"),
+        (dict(orientation_noise_deg=math.nan), "tracker.orientation_noise_deg must be zero or a positive number of degrees, got nan"),
+        (dict(transport_delay_s=-0.001), "tracker.transport_delay_s must be zero or a positive number of seconds, got -0.001"),
+        (dict(jitter_s=math.inf), "tracker.jitter_s must be zero or a positive number of seconds, got inf"),
+        (dict(dropout=1.0), "tracker.dropout must be zero or a positive number below 1, got 1.0"),
+        (dict(dropout=-0.1), "tracker.dropout must be zero or a positive number below 1, got -0.1"),
         (dict(rate_hz=100.0, phase_s=0.01), r"phase_s must be in \[0, 1 / rate_hz\)"),
-        (dict(phase_s=-0.001), r"phase_s must be in \[0, 1 / rate_hz\)"),
+        (dict(phase_s=-0.001), "tracker.phase_s must be zero or a positive number of seconds, got -0.001"),
     ],
 )
 def test_config_rejects_bad_values(kwargs, message):
@@ -186,3 +187,36 @@ def test_waiting_gives_nothing_when_no_sample_comes_in_time(pendulum):
 def test_an_unconnected_tracker_says_so(pendulum):
     with pytest.raises(RigError, match="not connected"):
         SimTracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=4).poll()
+
+
+def test_a_stall_holds_what_would_arrive_during_it_until_its_end(pendulum):
+    quiet = TrackerConfig(rate_hz=100.0, **QUIET)
+    samples = measure(pendulum, quiet, 0.0, 2.0, seed=0, faults=parse_faults("stall=0.5:0.25"))
+    held = (samples.t_sensor >= 0.5) & (samples.t_sensor < 0.75)
+    assert held.sum() == 25 and not samples.lost.any()
+    np.testing.assert_array_equal(samples.t_arrival[held], 0.75)
+    np.testing.assert_array_equal(samples.t_arrival[~held], samples.t_sensor[~held] + 0.004)
+
+
+def test_a_burst_holds_each_group_until_its_last_record(pendulum):
+    samples = measure(pendulum, TrackerConfig(rate_hz=100.0, dropout=0.1, **QUIET), 0.0, 1.0, seed=2, faults=parse_faults("burst=4"))
+    sent = samples.t_arrival[~samples.lost]
+    groups = [sent[k : k + 4] for k in range(0, sent.size, 4)]
+    assert all(np.all(group == group[-1]) for group in groups)
+    assert [group[-1] for group in groups] == sorted({*sent.tolist()}), "each group arrives at a time of its own"
+
+
+def test_a_disconnect_loses_what_would_arrive_while_the_link_is_away(pendulum):
+    tracker = SimTracker(pendulum, TrackerConfig(rate_hz=100.0, **QUIET), 0.0, 2.0, seed=0, faults=parse_faults("disconnect=1:0.5"))
+    tracker.connect(VirtualClock(0.0))
+    arrived = []
+    while more := tracker.wait(timeout_s=3.0):
+        arrived += more
+    arrivals = np.array([s.t_arrival for s in arrived])
+    assert arrivals.size == 200 - 50
+    assert not np.any((arrivals >= 1.0) & (arrivals < 1.5))
+
+
+def test_an_in_process_tracker_refuses_faults_in_bytes(pendulum):
+    with pytest.raises(ConfigError, match="no bytes to damage"):
+        SimTracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=0, faults=parse_faults("corrupt=0.01"))

@@ -25,7 +25,7 @@ from rig.clock import MonotonicClock
 from rig.devices.registry import make_tracker
 from rig.devices.trackers.stream import TrackerRecord, TrackerStream
 from rig.errors import RigError
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 
 TRACKER_FILE = "tracker.csv"
 DEVICE_FILE = "tracker_device.csv"

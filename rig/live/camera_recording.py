@@ -1,7 +1,7 @@
 """Recording a camera (`rig record`), its live preview, and the guided check of the first seconds.
 
 `record_camera` films for a duration into a folder: the film a run's camera makes
-(`rig.session.record.FilmRecord`: `video.avi`, `camera_frames.csv`) and `camera.json` (the camera's
+(`rig.session.run_record.FilmRecord`: `video.avi`, `camera_frames.csv`) and `camera.json` (the camera's
 report and the film's); Ctrl-C or an unplugged camera stops it with every frame kept. With a
 preview, a window shows the newest frame with both regions of interest drawn (given, or found by
 the analyser's calibration on the first second and a half of swing).
@@ -28,7 +28,7 @@ from rig.devices.camera.opencv_camera import opencv_camera
 from rig.devices.protocols import CameraFrame
 from rig.devices.window.gl_window import GlWindow, WindowSettings
 from rig.errors import RigError
-from rig.session.record import FilmRecord
+from rig.session.run_record import FilmRecord
 
 PREVIEW_EVERY_S = 1.0 / 30.0
 ROI_FRAMES = 90

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from predictors import SAMPLE_COLUMNS, PoseSample, read_samples, sample_row
 from rig.errors import RigError
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 
 
 def rows_of(path) -> list[list[str]]:

@@ -1,4 +1,4 @@
-"""Faults an emulated tracker injects on demand, from a spec such as
+"""The one fault model of the simulated tracker (`rig.sim.tracker`), from a spec such as
 `corrupt=0.01,disconnect=4:0.5`:
 
     corrupt=P         each byte replaced by another with probability P (serial)
@@ -8,7 +8,11 @@
     stall=AT:S        at AT s nothing is sent for S s; then what was held goes at once
     disconnect=AT:S   at AT s the port (or LSL outlet) goes away for S s; records meanwhile are lost
 
-All randomness comes from one seeded generator, so a seed fixes every fault.
+Times are on the tracker's time line (the stream's start for `rig emulate-tracker`, the rig clock
+in a simulated run). `delivered` applies the faults in time (burst, stall, disconnect) to when
+records reach the host, for the in-process tracker and the emulator alike; `ByteFaults` damages the
+bytes the emulator sends, so corrupt, drop and garbage exist only where there are bytes (a serial
+stream). All randomness comes from one seeded generator, so a seed fixes every fault.
 """
 
 from __future__ import annotations
@@ -90,6 +94,25 @@ def parse_faults(spec: str) -> FaultPlan:
         else:
             raise ConfigError(f"unknown fault {name!r}; faults: corrupt, drop, garbage, burst, stall, disconnect")
     return FaultPlan(**values)  # type: ignore[arg-type]
+
+
+def delivered(plan: FaultPlan, t_arrival: np.ndarray, lost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """When each record reaches the host under the plan's disconnect, stall and burst, and which are
+    lost, from when each would arrive (in order) and which were lost already: a disconnect loses
+    what would arrive while the link is away, a stall holds what would arrive during it until its
+    end, and a burst holds records until the last of each N sent has come."""
+    t, lost = t_arrival.copy(), lost.copy()
+    if plan.disconnect:
+        at, seconds = plan.disconnect
+        lost |= (t >= at) & (t < at + seconds)
+    if plan.stall:
+        at, seconds = plan.stall
+        t[(t >= at) & (t < at + seconds)] = at + seconds
+    if plan.burst > 1:
+        sent = np.flatnonzero(~lost)
+        last_of_group = np.minimum((np.arange(sent.size) // plan.burst + 1) * plan.burst, sent.size) - 1
+        t[sent] = t[sent[last_of_group]]
+    return t, lost
 
 
 class ByteFaults:

@@ -1,6 +1,6 @@
 """Writes a board recording as the events arrive: one CSV file per kind of event, in the format
 analysis.board.recording defines (the file names and columns come from there), through the rig's
-one CSV writer, rig.records.CsvRecord. Files are flushed after each batch the link delivers, so
+one CSV writer, rig.writers.CsvRecord. Files are flushed after each batch the link delivers, so
 nothing received is lost if the run stops.
 """
 
@@ -24,7 +24,7 @@ from rig.board.events import (
     PhotodiodeSample,
 )
 from rig.errors import RigError
-from rig.records import CsvRecord
+from rig.writers import CsvRecord
 
 # The file each kind of event goes to.
 FILES: dict[type, Table] = {

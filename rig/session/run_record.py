@@ -40,7 +40,7 @@ from predictors import SAMPLE_COLUMNS
 from rig.devices.protocols import CameraFrame
 from rig.errors import RigError
 from rig.film_file import StampedVideoRecord, video_file_name
-from rig.records import CsvRecord, VideoRecord
+from rig.writers import CsvRecord, VideoRecord
 
 TRACKER_FILE = "tracker.csv"
 APP_FRAMES_FILE = "app_frames.csv"

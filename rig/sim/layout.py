@@ -38,7 +38,7 @@ LAYOUTS = {
 }
 DEFAULT_LAYOUT = "side-by-side"
 LAYOUT_HELP = (
-    f"{', '.join(LAYOUTS)} (the LED 35 %% of the frame's height above or below the display), or "
+    f"{', '.join(LAYOUTS)} (the LED 35 % of the frame's height above or below the display), or "
     "LX,LY,LW/DX,DY,DW: the LED swing's centre and width, then the display panel's, as fractions of the "
     "frame (x and widths of its width, y of its height)"
 )

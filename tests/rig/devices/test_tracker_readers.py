@@ -1,48 +1,32 @@
-"""A serial port with a file descriptor is read in C: by a thread of its own (`_readers.FdReader`,
-on the system's monotonic clock), or, for a reader thread in Python, one wait and read per call
-(the compiled `_readers.wait_read` and its pure-Python fallback, a poll object). The thread
-queues every byte in order, stamped between the clock readings around its writing, and ends as the
-descriptor does; the wait-and-read gives the same bytes, None when nothing came, b"" at the end,
-OSError on a closed descriptor; a serial tracker reads the same records whichever reads it, and a
-clock of a test's own keeps it on the Python path."""
+"""The tracker readers: a port with a file descriptor is read by a compiled thread of its own
+(`_readers.FdReader`), anything else by a `ThreadReader` in Python with the same contract. Each
+queues every chunk in order, stamped between the clock readings around its writing, and ends as the
+link does; a serial tracker reads through the compiled thread whatever its clock, its stamps on
+that clock's time line."""
 
 from __future__ import annotations
 
 import errno
 import os
 import pty
+import select
 import socket
 import threading
 import time
 import tty
-from itertools import count
 from typing import Callable, Iterator
 
 import pytest
 
 from rig.clock import MonotonicClock
-from rig.devices.trackers import serial_tracker as serial_module
+from rig.devices.trackers._readers import FdReader
 from rig.devices.trackers.profile import load_profile
-from rig.devices.trackers.serial_tracker import serial_tracker, waiting_reader
+from rig.devices.trackers.serial_tracker import serial_tracker
+from rig.devices.trackers.transport import ThreadReader
 from rig.emulate.encode import Emission, RecordEncoder
 
 # Long enough never to run out on a loaded machine; a reader that works returns far sooner.
 PATIENCE_S = 10.0
-
-FdReader = serial_module.FdReader
-
-
-@pytest.fixture(params=["thread", "compiled", "python"])
-def implementation(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
-    """thread: the compiled reader thread; compiled: a Python thread on the compiled wait-and-read;
-    python: a Python thread on a poll object."""
-    assert serial_module.FdReader is not None, "rig.devices.trackers._readers is built by pip install -e ."
-    if request.param != "thread":
-        monkeypatch.setattr(serial_module, "FdReader", None)
-    if request.param == "python":
-        monkeypatch.setattr(serial_module, "wait_read", None)
-    return request.param
-
 
 class Pipe:
     """Both ends of an os.pipe; each closed once, by the test or afterwards."""
@@ -204,30 +188,54 @@ def test_the_threads_cpu_time_is_kept_once_it_has_ended(pipe: Pipe) -> None:
     assert 0.0 < running <= ended == reader.cpu_s
 
 
-def test_what_a_descriptor_holds_is_read_whole_and_nothing_more(implementation: str, pipe: Pipe) -> None:
-    read = waiting_reader(pipe.read_end)
-    data = bytes(range(256)) * 3
-    os.write(pipe.write_end, data)
-    assert read(0, 100) == data[:100]
-    assert read(0, 65536) == data[100:]
-    assert read(0, 65536) is None, "nothing waiting: None once the (zero) timeout has passed"
+def _python_reader(pipe: Pipe, origin_ns: int) -> ThreadReader:
+    """A ThreadReader of the pipe, as the HID and descriptor-less serial transports make theirs."""
+
+    def receive() -> bytes | None:
+        ready, _, _ = select.select([pipe.read_end], [], [], 0.01)
+        return os.read(pipe.read_end, 65536) if ready else None
+
+    return ThreadReader(receive, origin_ns, "test python reader")
+
+
+def test_a_python_reader_queues_every_chunk_in_order_stamped_on_the_rig_clock(pipe: Pipe) -> None:
+    clock = MonotonicClock()
+    reader = _python_reader(pipe, clock.origin_ns)
+    pieces = [bytes([k]) * (1 + k % 5) for k in range(50)]
+    before = clock.now()
+    for piece in pieces:
+        os.write(pipe.write_end, piece)
+    chunks, arrivals = _take_all(reader, sum(map(len, pieces)))
+    after = clock.now()
+    reader.stop()
+    assert b"".join(chunks) == b"".join(pieces)
+    assert before <= arrivals[0] and arrivals[-1] <= after and arrivals == sorted(arrivals)
+    assert (reader.outcome, reader.errno) == ("stopped", 0) and reader.take() == ([], [])
+
+
+def test_a_python_reader_ends_at_the_end_of_the_link_or_a_failed_read(pipe: Pipe) -> None:
+    reader = _python_reader(pipe, 0)
+    os.write(pipe.write_end, b"last words")
     pipe.close(pipe.write_end)
-    assert read(0, 65536) == b"", "the other end went away"
+    assert reader.wait_ended(PATIENCE_S)
+    assert (reader.outcome, reader.errno) == ("end of file", 0)
+    assert b"".join(reader.take()[0]) == b"last words"
+    reader.stop()
+
+    def fail() -> bytes:
+        raise OSError(errno.ENODEV, "unplugged")
+
+    failed = ThreadReader(fail, 0, "test failing reader")
+    assert failed.wait_ended(PATIENCE_S) and failed.wait(0.0)
+    assert (failed.outcome, failed.errno) == ("error", errno.ENODEV) and failed.cpu_s >= 0.0
+    failed.stop()
 
 
-def test_a_closed_descriptor_raises_os_error(implementation: str, pipe: Pipe) -> None:
-    read = waiting_reader(pipe.read_end)
-    os.write(pipe.write_end, b"x")
-    pipe.close(pipe.read_end)
-    with pytest.raises(OSError):
-        read(0, 16)
-
-
-def test_the_compiled_reader_refuses_a_negative_size() -> None:
-    if serial_module.wait_read is None:
-        pytest.fail("rig.devices.trackers._readers is built by pip install -e .")
-    with pytest.raises(ValueError):
-        serial_module.wait_read(0, 0, -1)
+def test_a_python_reader_waits_for_nothing_until_its_timeout(pipe: Pipe) -> None:
+    reader = _python_reader(pipe, 0)
+    assert not reader.wait(0.01) and not reader.wait_ended(0.0)
+    reader.stop()
+    assert reader.outcome == "stopped" and reader.wait_ended(0.0)
 
 
 class _PipePort:
@@ -254,12 +262,14 @@ def _emissions(n: int) -> list[Emission]:
     return [Emission(k, 1.0 + k * 1e-3, (0.01 * k, 0.0, 0.5), (1.0, 0.0, 0.0, 0.0)) for k in range(n)]
 
 
-def test_a_serial_tracker_reads_the_same_records_either_way(implementation: str, pipe: Pipe) -> None:
+def test_a_serial_tracker_reads_every_record_through_the_compiled_thread(pipe: Pipe, reader_threads: Callable[[str], set[str]]) -> None:
     encoder = RecordEncoder(load_profile("binary-pose"))
     sent = _emissions(50)
     tracker = serial_tracker("pipe?profile=binary-pose", open_port=lambda url, baud: _PipePort(pipe.read_end))
     clock = MonotonicClock()
+    others = reader_threads("rig fd reader")
     tracker.connect(clock)
+    assert reader_threads("rig fd reader") - others, "a port with a descriptor is read by the compiled thread"
     before = clock.now()
     for emission in sent:
         os.write(pipe.write_end, encoder.encode(emission))
@@ -294,19 +304,26 @@ def test_a_serial_tracker_reads_records_cut_anywhere_and_its_last_ones_after_clo
     assert tracker.report()["counters"]["corrupt"] == 0
 
 
-def test_a_clock_of_the_tests_own_keeps_the_reading_in_python(pipe: Pipe) -> None:
-    """The compiled thread stamps on the system's monotonic clock; on another clock the stream's
-    own thread reads and stamps, so arrivals are that clock's times."""
-    ticks = count(start=10**9, step=1000)
-    clock = MonotonicClock(read_ns=lambda: next(ticks), sleep=lambda s: None)
+def test_a_clock_of_the_tests_own_gets_the_compiled_readers_stamps_on_its_time_line(
+    pipe: Pipe, reader_threads: Callable[[str], set[str]]
+) -> None:
+    """A clock that reads the system's time through a function of the test's (not the system clock's
+    own, so its origin is measured): the compiled thread reads all the same, its stamps on that
+    clock's time line."""
+    clock = MonotonicClock(read_ns=lambda: time.monotonic_ns())
     encoder = RecordEncoder(load_profile("binary-pose"))
     tracker = serial_tracker("pipe?profile=binary-pose", open_port=lambda url, baud: _PipePort(pipe.read_end))
+    others = reader_threads("rig fd reader")
     tracker.connect(clock)
+    assert reader_threads("rig fd reader") - others
+    before = clock.now()
     for emission in _emissions(5):
         os.write(pipe.write_end, encoder.encode(emission))
     records = []
     while len(records) < 5:
         records += tracker.wait_records(PATIENCE_S)
+    after = clock.now()
     tracker.close()
     assert [r.seq for r in records] == list(range(5))
-    assert all(r.t_arrival < 1.0 for r in records), "stamped by the test's clock, microseconds a reading"
+    # The two clocks' origins are measured a few microseconds apart: the stamps are within that of the readings around.
+    assert all(before - 1e-3 <= r.t_arrival <= after + 1e-3 for r in records)

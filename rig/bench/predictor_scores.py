@@ -1,0 +1,138 @@
+"""The predictor bench's scores (`rig.bench.predictors`): each predictor's RMS errors over those of
+constant velocity from the last two samples (BASELINE), its cost over another's, and its score
+tuned on every trace but the one it is scored on."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable, Sequence
+
+from predictors import Evaluation, Trace, evaluate
+
+BASELINE = "slerp"
+
+
+def label(name: str, params: dict[str, Any]) -> str:
+    """A predictor spec as one word: its name, and its parameters where any were given."""
+    return name if not params else f"{name}:" + ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
+
+
+@dataclass(frozen=True)
+class Ratios:
+    """One predictor's RMS errors over constant velocity's on each trace, per horizon (ms): angular,
+    and positional (NaN where constant velocity's position error is zero: no position to predict)."""
+
+    predictor: str
+    angular: dict[str, dict[float, float]]
+    position: dict[str, dict[float, float]]
+    us_per_update: dict[str, float]
+
+    def geometric_mean(self, part: str, horizon_ms: float) -> float:
+        """The geometric mean of one part's ratios across the traces that have it (NaN if none)."""
+        values = [by_horizon[horizon_ms] for by_horizon in getattr(self, part).values()]
+        values = [v for v in values if math.isfinite(v) and v > 0.0]
+        return math.exp(sum(math.log(v) for v in values) / len(values)) if values else math.nan
+
+    def worst(self, part: str, horizon_ms: float) -> float:
+        """The largest ratio of one part across the traces (NaN if none)."""
+        values = [by_horizon[horizon_ms] for by_horizon in getattr(self, part).values()]
+        values = [v for v in values if math.isfinite(v)]
+        return max(values) if values else math.nan
+
+    def to_dict(self, horizons: Sequence[float]) -> dict[str, Any]:
+        """Plain JSON-ready values, the geometric means and worst ratios per horizon included."""
+        return {
+            "predictor": self.predictor,
+            "angular": _keyed(self.angular),
+            "position": _keyed(self.position),
+            "us_per_update": self.us_per_update,
+            "geometric_mean": {part: {f"{h:g}": _finite(self.geometric_mean(part, h)) for h in horizons} for part in ("angular", "position")},
+            "worst": {part: {f"{h:g}": _finite(self.worst(part, h)) for h in horizons} for part in ("angular", "position")},
+        }
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def _keyed(ratios: dict[str, dict[float, float]]) -> dict[str, dict[str, float | None]]:
+    return {trace: {f"{h:g}": _finite(v) for h, v in by_horizon.items()} for trace, by_horizon in ratios.items()}
+
+
+def ratios(results: Sequence[Evaluation], horizons: Sequence[float]) -> list[Ratios]:
+    """Every predictor's ratios to the baseline (`BASELINE`, which must be among the results)."""
+    baseline = {r.trace: r for r in results if r.predictor == BASELINE and not r.params}
+    missing = sorted({r.trace for r in results} - set(baseline))
+    if missing:
+        raise ValueError(f"ratios need {BASELINE} with its defaults on every trace; missing on {', '.join(missing)}")
+    by_label: dict[str, Ratios] = {}
+    for result in results:
+        entry = by_label.setdefault(label(result.predictor, result.params), Ratios(label(result.predictor, result.params), {}, {}, {}))
+        base = baseline[result.trace]
+        entry.angular[result.trace] = {h: _ratio(result.at(h).angular_rms_deg, base.at(h).angular_rms_deg) for h in horizons}
+        entry.position[result.trace] = {h: _ratio(result.at(h).position_rms_mm, base.at(h).position_rms_mm) for h in horizons}
+        entry.us_per_update[result.trace] = result.us_per_update
+    return list(by_label.values())
+
+
+def _ratio(error: float, baseline: float) -> float:
+    return error / baseline if baseline > 0.0 else math.nan
+
+
+def cost_ratios(results: Sequence[Evaluation]) -> dict[str, float]:
+    """kalman-cv's us/update over desp's, per trace where both ran."""
+    cost = {(r.trace, r.predictor): r.us_per_update for r in results}
+    return {
+        trace: cost[(trace, "kalman-cv")] / cost[(trace, "desp")]
+        for trace, name in cost
+        if name == "kalman-cv" and (trace, "desp") in cost
+    }
+
+
+@dataclass(frozen=True)
+class HeldOut:
+    """A predictor tuned at `horizon_ms` on every trace but `trace`, scored on `trace`: its angular
+    and position RMS error there over constant velocity's, and its defaults' ratios beside them."""
+
+    predictor: str
+    trace: str
+    horizon_ms: float
+    params: dict[str, Any]
+    angular: float
+    position: float
+    defaults_angular: float
+    defaults_position: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-ready values (None for a ratio on a trace without that part)."""
+        return {k: _finite(v) if isinstance(v, float) else v for k, v in vars(self).items()}
+
+
+def leave_one_out(
+    name: str, traces: Sequence[Trace], horizon_ms: float, max_iterations: int,
+    progress: Callable[[float, float], object] | None = None,
+) -> list[HeldOut]:
+    """Tune `name` on all traces but one and score it on that one, for each trace in turn."""
+    from predictors.tuning import tune  # imports JAX: only when asked
+
+    horizon = horizon_ms / 1e3
+    held = []
+    for k, trace in enumerate(traces):
+        others = [t for i, t in enumerate(traces) if i != k]
+        params = tune(name, others, horizon, max_iterations=max_iterations).params
+        scores = {
+            key: evaluate(predictor, trace, [horizon], given, timing_repeats=0).scores[0]
+            for key, predictor, given in (("tuned", name, params), ("defaults", name, {}), ("baseline", BASELINE, {}))
+        }
+        base = scores["baseline"]
+        held.append(HeldOut(
+            name, trace.name, horizon_ms, params,
+            _ratio(scores["tuned"].angular_rms_deg, base.angular_rms_deg),
+            _ratio(scores["tuned"].position_rms_mm, base.position_rms_mm),
+            _ratio(scores["defaults"].angular_rms_deg, base.angular_rms_deg),
+            _ratio(scores["defaults"].position_rms_mm, base.position_rms_mm),
+        ))
+        if progress is not None:
+            progress(k + 1, len(traces))
+    return held

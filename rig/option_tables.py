@@ -1,0 +1,49 @@
+"""The docs' tables of options and settings (docs/options.md), made from their declarations:
+`python -m rig.option_tables > docs/options.md` after changing a declaration (a test checks the
+file is current)."""
+
+from __future__ import annotations
+
+from analysis import AnalysisOptions
+from analysis.shutter import ShutterOptions
+from declared.docs import markdown_table
+from rig.bench.renderers import BenchGrid
+from rig.sim.config import SimulationConfig
+
+SECTIONS = (
+    ("Analysis", AnalysisOptions, True, "`rig analyse`'s options, and a sweep's `[analysis]` table by the setting's name."),
+    (
+        "The simulated rig",
+        SimulationConfig,
+        True,
+        "`rig simulate`'s and `rig demo`'s options (and `--predictor NAME[:key=value,...]`, the predictor with its "
+        "parameters, `predictor_params` in a spec; `rig simulate --board`, the simulated board with the defaults "
+        "below; `rig simulate --flash-hz F [--flash-duty D]` or `--flash-display N`, the calibration target `flash` "
+        "with the defaults below), and a sweep's `[base]`, `[grid]` and `[[points]]` keys.",
+    ),
+    ("Calibrating a camera", ShutterOptions, True, "`rig calibrate-camera`'s options (with `--flash-hz F`, which every film needs)."),
+    (
+        "The renderer bench's grid",
+        BenchGrid,
+        False,
+        "`rig bench renderers --spec FILE.toml` (its `--triangles`, `--resolutions`, `--ratios`, `--warp`, `--server-ms`, "
+        "`--predictor` and `--direct-predictor` override the file).",
+    ),
+)
+
+
+def options_markdown() -> str:
+    """docs/options.md: a table per declaring config (its options too, where a command's are made from it)."""
+    parts = [
+        "# Options and settings\n",
+        "Made from the declarations by `python -m rig.option_tables > docs/options.md`; do not edit by hand. A "
+        "setting is a key of a spec (TOML; nested ones dotted, or as tables), an option is the command line's, "
+        "in the unit shown where it differs from the setting's.\n",
+    ]
+    for title, kind, options, used in SECTIONS:
+        parts += [f"## {title} (`{kind.__module__}.{kind.__name__}`)\n", f"{used}\n", markdown_table(kind, options)]
+    return "\n".join(parts)
+
+
+if __name__ == "__main__":
+    print(options_markdown(), end="")
