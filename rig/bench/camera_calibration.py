@@ -3,7 +3,7 @@ films whose camera the simulation knows (30, 60, 120 and 240 fps; readouts of 0,
 to 95 % of the frame interval; exposures of an eighth to a whole frame interval; a light flashing
 at 50 % and at 25 %, and a display flashing full-field), each measured as the command does, with
 the readout's and the exposure's error, the refusals, how many are within 5 % and 10 % and how
-many 95 % intervals hold the truth, and the seconds per film (about 8 minutes on two shared cores;
+many 95 % intervals hold the truth, and the seconds per film (5 to 8 minutes on two shared cores;
 --quick films four small cases).
 
 Each case films a calibration target (`rig.sim.flash`) with the simulated camera: a light flashing
