@@ -8,7 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from analysis.errors import AnalysisError
-from declared import NON_NEGATIVE, OPEN_UNIT, POSITIVE, Flag, Range, check, setting
+from analysis.options import AnalysisOptions
+from declared import NON_NEGATIVE, OPEN_UNIT, POSITIVE, Flag, Range, check, like, setting
 
 ROI = tuple[int, int, int, int]
 SOURCES = ("light", "display")
@@ -41,10 +42,7 @@ class ShutterOptions:
         None, "pixels", "look for the flashing light only here, X,Y,W,H (a display: its whole height)", NON_NEGATIVE,
         unset="the whole frame", flag=Flag("--roi", metavar="X,Y,W,H"),
     )  # fmt: skip
-    fps: float | None = setting(
-        None, "frames per second", "the camera's frame rate, overriding the file's; needed for image folders", POSITIVE,
-        unset="the file's", flag="--fps",
-    )  # fmt: skip
+    fps: float | None = like(AnalysisOptions, "fps")
     max_exposure_s: float | None = setting(
         None, "seconds", "the longest the camera's exposure can be", POSITIVE, unset="a frame interval",
         flag=Flag("--max-exposure-ms", unit="ms", factor=1e3, metavar="MS"),
