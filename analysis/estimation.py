@@ -1,7 +1,7 @@
 """The second part of an analysis: both tracks in, the latency out (``estimate`` -> ``LatencyResult``).
 
 First each blob's samples are dated by the rows they come from where the camera's readout is
-given, or the readout is bounded by the frame rate (``analysis.shutter``). The free swing is then
+given, or the readout is bounded by the frame rate (``analysis.readout``). The free swing is then
 measured once (``analysis.swing``); its phase lag, known modulo one period, and the swing's
 one-off events decide the whole number of periods (``analysis.cycles``); then each requested
 estimator (``analysis.estimators``) runs on the same context, each taking that same whole number
@@ -30,7 +30,7 @@ from analysis.phase import fft_phase_latency
 from analysis.result import LatencyResult, MethodResult
 from analysis.sampling import SamplingBias, measure_sampling
 from analysis.sampling.residuals import timing_residuals
-from analysis.shutter import RollingShutter, rolling_shutter
+from analysis.readout import RollingShutter, rolling_shutter
 from analysis.swing import during, measure_swing
 from analysis.timing import implausible_period_warning
 from analysis.tracking import Track
@@ -54,7 +54,7 @@ def estimate(
     them, and without them the video is searched for both (``analysis.sampling``); ``readout_ms``
     is the camera's readout, the time its rolling shutter takes from the frame's top row to its
     bottom one (0 for a global shutter), and without it the interval allows for any readout up to
-    the frame interval (``analysis.shutter``).
+    the frame interval (``analysis.readout``).
     ``reference_departures(led_track)`` names times (s, on the video's clock) at which other
     instruments saw the pendulum depart from rest, in the sense of ``analysis.onset`` (e.g. a rig
     board's encoder, its clock aligned by the LED's blink code, which it reads from the LED track);

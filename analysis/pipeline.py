@@ -37,7 +37,7 @@ def analyse(
     the camera's exposure (else the video is searched for both, to work out how the camera's
     sampling of the display biases the latency, ``analysis.sampling``), and of the camera's
     rolling-shutter readout (each blob's samples are then dated by their rows; else the interval
-    allows for any readout up to the frame interval, ``analysis.shutter``).
+    allows for any readout up to the frame interval, ``analysis.readout``).
     ``progress(done, total)`` is called as frames are tracked (for clips of
     ``analysis.tracks.PROGRESS_MIN_SECONDS`` or more); ``tracks_csv`` receives the tracks as they
     are measured. ``reference_departures(led_track)`` names times (s, on the video's clock) at which

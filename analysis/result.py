@@ -8,7 +8,7 @@ from typing import Any
 from analysis.cycles import CycleResolution
 from analysis.misfit import MisfitReport
 from analysis.sampling import SamplingBias
-from analysis.shutter import RollingShutter
+from analysis.readout import RollingShutter
 from analysis.tracking import Roi, Track
 from analysis.windows import WindowedLatency
 
@@ -49,7 +49,7 @@ class LatencyResult:
     be decided (see ``analysis.cycles``); a warning then says why. sampling says what the
     camera's sampling of the display may do to the latency (None where it could not be measured),
     checks how well the model fits (``analysis.misfit``), shutter the camera's readout given or
-    bounded and the rows each blob was filmed on (``analysis.shutter``); each method's latency and
+    bounded and the rows each blob was filmed on (``analysis.readout``); each method's latency and
     interval already allow for all three, and ``warnings`` says where any changed them. The tracks
     are dated by their rows where the readout was given.
     """

@@ -2,7 +2,7 @@
 
 Each track is reduced to one signal, its displacement along its main axis of motion (pixels), at
 its own times: a rolling shutter exposes each blob when the readout reaches its rows
-(``analysis.shutter``), so the LED's and the sphere's samples of one frame may be dated apart.
+(``analysis.readout``), so the LED's and the sphere's samples of one frame may be dated apart.
 Invalid frames stay NaN here; each estimator decides how to treat them: the fits give them no
 weight, the FFT and cross-correlation interpolate over them on a uniform time grid.
 """

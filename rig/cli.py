@@ -34,6 +34,7 @@ COMMANDS = {
     "demo": "demo",
     "simulate": "simulate",
     "analyse": "analyse",
+    "calibrate-camera": "calibrate_camera",
     "plan": "plan",
     "sweep": "sweep",
     "report": "report",

@@ -5,6 +5,7 @@ file is current)."""
 from __future__ import annotations
 
 from analysis import AnalysisOptions
+from analysis.shutter import ShutterOptions
 from declared.docs import markdown_table
 from rig.bench.renderers import BenchGrid
 from rig.sim.config import SimulationConfig
@@ -17,8 +18,10 @@ SECTIONS = (
         True,
         "`rig simulate`'s and `rig demo`'s options (and `--predictor NAME[:key=value,...]`, the predictor with its "
         "parameters, `predictor_params` in a spec; `rig simulate --board`, the simulated board with the defaults "
-        "below), and a sweep's `[base]`, `[grid]` and `[[points]]` keys.",
+        "below; `rig simulate --flash-hz F [--flash-duty D]` or `--flash-display N`, the calibration target `flash` "
+        "with the defaults below), and a sweep's `[base]`, `[grid]` and `[[points]]` keys.",
     ),
+    ("Calibrating a camera", ShutterOptions, True, "`rig calibrate-camera`'s options (with `--flash-hz F`, which every film needs)."),
     (
         "The renderer bench's grid",
         BenchGrid,

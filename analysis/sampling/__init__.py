@@ -208,7 +208,7 @@ def measure_sampling(
     residuals against the LED (``analysis.sampling.residuals``) and the LED's track (its blur);
     ``refresh_hz`` and ``exposure_s`` are the display's refresh and the camera's exposure where the
     user knows them; ``row_time_s`` the time per row the sphere's samples were dated by and the range
-    the camera's true time per row lies in (``analysis.shutter``). The correction is left at 0 unless the video identifies the bias: every rate it
+    the camera's true time per row lies in (``analysis.readout``). The correction is left at 0 unless the video identifies the bias: every rate it
     allows agrees, and the bias's 95 % range is narrow against its size."""
     frame_interval = residuals.frame_interval
     exposure = given_exposure(exposure_s, frame_interval) if exposure_s is not None else exposure_from_blur(led, frame_interval)

@@ -2,7 +2,7 @@
 
 A display switches row after row from the top, so the rows of a sphere switch over a part of a
 refresh, and a sphere lower down the display switches later. A rolling-shutter camera likewise
-exposes each row later than the one above (``analysis.shutter``). What counts for the sphere's
+exposes each row later than the one above (``analysis.readout``). What counts for the sphere's
 timing is the difference, the net slope m (s per camera row): a row u rows below the sphere's
 centroid starts its exposure m u less long after its switch than the centroid's row does. With
 kappa the display's scan-out time per camera row and r the camera's readout time per row,

@@ -9,4 +9,5 @@ SUBJECTS = (
     ("trackers",),
     ("batch",),
     ("live",),
+    ("camera_calibration",),
 )

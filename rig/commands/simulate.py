@@ -6,20 +6,23 @@ import argparse
 import json
 
 from rig.commands import outputs
-from rig.commands.simulation_options import add_simulation_options, simulation_config
+from rig.commands.simulation_options import add_flash_options, add_simulation_options, simulation_config
 from rig.progress import ProgressBar
-from rig.service import simulate
+from rig.service import SimulationConfig, simulate
 from rig.service.run_plot import plot_run
 from rig.sim.board import BOARD_FOLDER
 
 
 def _run(args: argparse.Namespace) -> int:
-    result = simulate(simulation_config(args), args.out, ProgressBar("simulating"), args.overwrite)
+    config = simulation_config(args)
+    result = simulate(config, args.out, ProgressBar("simulating"), args.overwrite)
     writes = outputs.LateWrites()
     if args.plot is not None:
         writes.write(args.plot, lambda: plot_run(result.out_dir, result.truth.latency_ms, args.plot))
     if args.json:
         print(json.dumps(result.summary()))
+    elif config.flash is not None:
+        print(f"wrote {result.truth.frames} frames of {flash_line(config)} to {result.video_path}")
     else:
         truth = result.truth
         d = truth.display_frame_delay_ms
@@ -55,4 +58,16 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "the newest sample to its photons beside the true latency",
     )
     add_simulation_options(parser, lab=True)
+    add_flash_options(parser)
     parser.set_defaults(func=_run)
+
+
+def flash_line(config: SimulationConfig) -> str:
+    """What a calibration film shows and the shutter that filmed it, in one line."""
+    flash, camera = config.flash, config.camera
+    assert flash is not None
+    if flash.source == "light":
+        shown = f"a light flashing at {flash.hz:g} Hz ({flash.duty:.0%} on)"
+    else:
+        shown = f"the display flashing at {config.display.refresh_hz / flash.refreshes:g} Hz ({flash.display_duty():.0%} white)"
+    return f"{shown}, filmed with a {camera.readout_s * 1e3:g} ms readout and a {camera.exposure * 1e3:g} ms exposure"

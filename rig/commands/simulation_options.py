@@ -1,7 +1,8 @@
 """The options that describe a simulated rig and the lab's procedure (shared by `rig simulate` and
 `rig demo`), made from `SimulationConfig`'s declarations (`rig.commands.declared_options`), and the
-config they give. Two options are not a single setting: --predictor (the predictor and its
-parameters) and --board (the simulated board, with its defaults)."""
+config they give. Some options are not a single setting: --predictor (the predictor and its
+parameters), --board (the simulated board, with its defaults), and `rig simulate`'s calibration
+target, --flash-hz or --flash-display (`add_flash_options`)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.errors import ConfigError
 from rig.service import SimulationConfig
 from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
+from rig.sim.flash import FlashTarget
 from rig.sim.impairments import FILM
 
 RIG = "simulated rig"
@@ -44,8 +46,37 @@ def add_simulation_options(parser: argparse.ArgumentParser, lab: bool = False) -
         )
 
 
+def add_flash_options(parser: argparse.ArgumentParser) -> None:
+    """A calibration target filmed instead of the bench (`rig.sim.flash`), for `rig calibrate-camera`."""
+    light = FlashTarget()
+    group = parser.add_argument_group(
+        "calibration target",
+        "Film a flashing light instead of the bench, to measure the camera's readout and exposure with "
+        "`rig calibrate-camera` (the pendulum, tracker and renderer still run, unseen).",
+    )
+    target = group.add_mutually_exclusive_group()
+    target.add_argument("--flash-hz", type=options.positive_float, metavar="F",
+                        help="a white card lit by an LED flashing at F Hz fills the view")  # fmt: skip
+    target.add_argument("--flash-display", type=options.positive_int, metavar="N",
+                        help="the display flashes full-field: white for the first half of every N refreshes (N = 2 "
+                        "alternates white and black), black for the rest")  # fmt: skip
+    group.add_argument("--flash-duty", type=options.positive_float, default=light.duty, metavar="D",
+                       help="with --flash-hz, the share of each period the LED is on (default: %(default)s)")  # fmt: skip
+
+
+def _flash_target(args: argparse.Namespace) -> FlashTarget | None:
+    """The calibration target the flash options ask for, if any."""
+    if getattr(args, "flash_hz", None) is not None:
+        return FlashTarget("light", hz=args.flash_hz, duty=args.flash_duty)
+    if getattr(args, "flash_display", None) is not None:
+        return FlashTarget("display", refreshes=args.flash_display)
+    return None
+
+
 def simulation_config(args: argparse.Namespace) -> SimulationConfig:
     """The simulated run the options ask for."""
     predictor, params = args.predictor
     board = SimulatedBoardConfig() if getattr(args, "board", False) else None
-    return config_from_args(SimulationConfig, args, ConfigError, predictor=predictor, predictor_params=params, board=board)
+    return config_from_args(
+        SimulationConfig, args, ConfigError, predictor=predictor, predictor_params=params, board=board, flash=_flash_target(args)
+    )

@@ -6,11 +6,13 @@ Each is a plain function with a typed request or config and a typed result: `sim
 simulated rig (`SimulationConfig` -> `SimulationResult` with its `Truth`), `analyse` measures the
 latency in a video (`AnalysisRequest` -> `Measurement`), `demo` does both and compares
 (`DemoReport`), `tune` fits a predictor to recorded motion (`TuneReport`), `plan` recommends how
-to film (`PlanRequest` -> `Plan`). The benchmarks are in
-`rig.bench`, registered by name.
+to film (`PlanRequest` -> `Plan`), `calibrate_camera` measures a camera's readout and exposure
+from a film of a flashing light (`CalibrationRequest` -> `analysis.shutter.ShutterResult`). The
+benchmarks are in `rig.bench`, registered by name.
 """
 
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
+from rig.service.calibrate import CalibrationRequest, calibrate_camera
 from rig.service.demo import DemoReport, compare_renderers, comparison_config, demo
 from rig.service.plan import Plan, PlanRequest, plan
 from rig.service.simulate import SimulationResult, simulate
@@ -20,6 +22,7 @@ from rig.sim.truth import Truth
 
 __all__ = [
     "AnalysisRequest",
+    "CalibrationRequest",
     "DemoReport",
     "Measurement",
     "Plan",
@@ -29,6 +32,7 @@ __all__ = [
     "Truth",
     "TuneReport",
     "analyse",
+    "calibrate_camera",
     "compare_renderers",
     "comparison_config",
     "demo",

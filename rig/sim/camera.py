@@ -37,6 +37,7 @@ from rig.film_file import CODECS, CONTAINERS, check_film_format, default_codec
 from rig.sim.impairments import FILM, FilmImpairments, FrameImpairer
 
 if TYPE_CHECKING:
+    from rig.sim.flash import FlashingLightScene
     from rig.sim.scene import FilmedScene
 
 LED_SIGMA_PX = 2.2
@@ -242,7 +243,7 @@ class SimCamera:
     `seed` the sensor's noise and the frame-timing jitter.
     """
 
-    def __init__(self, config: CameraConfig, scene: FilmedScene, duration_s: float, seed: int, impairment_seed: int) -> None:
+    def __init__(self, config: CameraConfig, scene: FilmedScene | FlashingLightScene, duration_s: float, seed: int, impairment_seed: int) -> None:
         self.config = config
         self.fps = config.film_fps
         self.width = config.width

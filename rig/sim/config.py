@@ -13,13 +13,16 @@ from rig.sim.layout import DEFAULT_LAYOUT, LAYOUT_HELP, placement
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
+from rig.sim.flash import FlashTarget
 from rig.sim.pendulum import PendulumConfig
 from rig.sim.tracker import TrackerConfig
 
 MEASURED = "measured"
 """A cost given as this (on the command line, in a spec) is what this machine's GL takes."""
 # (section, field) of settings a run's record leaves out at their defaults (`SimulationConfig.to_dict`).
-FILM_DEFAULTS = (("camera", "readout_s"), ("camera", "frame_jitter_s"), ("camera", "container"), ("camera", "codec"), ("", "layout"))
+FILM_DEFAULTS = (
+    ("camera", "readout_s"), ("camera", "frame_jitter_s"), ("camera", "container"), ("camera", "codec"), ("", "layout"), ("", "flash"),
+)  # fmt: skip
 
 
 def _layout_problem(layout: str) -> str | None:
@@ -43,7 +46,8 @@ class SimulationConfig:
     they take on this machine. photon_target, persistence: `rig.session.PhotonTarget`'s. scene_load:
     the renderer checks it when it opens. layout: where the LED and the display sit in the camera's
     frame (`rig.sim.layout.placement`). The pendulum's release and the board's blink must fall within
-    the film.
+    the film. flash: a calibration target the camera films instead of the bench (`rig.sim.flash`), or
+    None.
     """
 
     duration_s: float = setting(10.0, "seconds", "length of the film", Range(0.5, 3600.0, True, True), flag="--duration")
@@ -76,6 +80,7 @@ class SimulationConfig:
         DEFAULT_LAYOUT, "", f"where the LED and the display sit in the frame: {LAYOUT_HELP}", rule=_layout_problem,
         flag=Flag("--layout", metavar="LAYOUT"),
     )  # fmt: skip
+    flash: FlashTarget | None = None
 
     def __post_init__(self) -> None:
         check(self, ConfigError)

@@ -173,7 +173,7 @@ def make_layout(pendulum: Pendulum, camera: CameraImage, display: DisplayConfig,
 
     arc = np.linspace(-amplitude, amplitude, 201)
     arc_positions = np.stack([length * np.sin(arc), -length * np.cos(arc), np.zeros_like(arc)], axis=1)
-    layout = BenchLayout(
+    mapped = BenchLayout(
         camera_width=width,
         camera_height=height,
         px_per_m=px_per_m,
@@ -188,12 +188,12 @@ def make_layout(pendulum: Pendulum, camera: CameraImage, display: DisplayConfig,
         led_roi=(0, 0, 0, 0),
         sphere_roi=(0, 0, 0, 0),
     )
-    led_roi = _bounding_rect(layout.led_pixels(arc_positions), ROI_MARGIN_PX, width, height)
-    _check_fits(layout.led_pixels(arc_positions), panel, led_roi, layout_name=layout, width=width, height=height)
+    led_roi = _bounding_rect(mapped.led_pixels(arc_positions), ROI_MARGIN_PX, width, height)
+    _check_fits(mapped.led_pixels(arc_positions), panel, led_roi, layout_name=layout, width=width, height=height)
     px, py, pw, ph = panel
-    sphere_points = layout.panel_pixels(arc_positions) - (px, py)
+    sphere_points = mapped.panel_pixels(arc_positions) - (px, py)
     sx, sy, sw, sh = _bounding_rect(sphere_points, ROI_MARGIN_PX + SPHERE_RADIUS_PX, pw, ph)
-    return replace(layout, led_roi=led_roi, sphere_roi=(px + sx, py + sy, sw, sh))
+    return replace(mapped, led_roi=led_roi, sphere_roi=(px + sx, py + sy, sw, sh))
 
 
 def _check_fits(led_path: np.ndarray, panel: Rect, led_roi: Rect, layout_name: str, width: int, height: int) -> None:

@@ -57,14 +57,8 @@ class FilmedScene:
         (`starts`, one per panel row from the top: a rolling shutter exposes lower rows later):
         each refresh a row shows counts for exactly the time it shows it during the row's exposure
         (scan-out), so where a refresh switches inside an exposure is not rounded to an instant."""
+        refresh, shown = self.refresh_shares(starts, exposure)
         display = self.display
-        start = np.asarray(starts, dtype=np.float64)
-        end = start + exposure
-        first = display.refresh_shown(start, self._rows)
-        last = display.refresh_shown(end, self._rows)
-        refresh = first[None, :] + np.arange(int((last - first).max()) + 1)[:, None]
-        begins = display.vblank_time(refresh) + display.scanout_delay(self._rows)[None, :]
-        shown = np.clip(np.minimum(begins + display.period_s, end) - np.maximum(begins, start), 0.0, None) / exposure
         # Only the last few refreshes can be on screen: look them up without copying all of content.
         oldest = max(int(refresh.min()), 0)
         recent = np.asarray(display.content[oldest:])
@@ -76,6 +70,19 @@ class FilmedScene:
             image = self._panel_image(int(image_id)) if image_id != NO_IMAGE else self._black
             light += weight[:, None] * image
         return light
+
+    def refresh_shares(self, starts: np.ndarray, exposure: float) -> tuple[np.ndarray, np.ndarray]:
+        """The refreshes each panel row shows during its exposure from `starts` (one per panel row)
+        for `exposure`, (K, rows), and the share of the exposure each shows there, (K, rows)."""
+        display = self.display
+        start = np.asarray(starts, dtype=np.float64)
+        end = start + exposure
+        first = display.refresh_shown(start, self._rows)
+        last = display.refresh_shown(end, self._rows)
+        refresh = first[None, :] + np.arange(int((last - first).max()) + 1)[:, None]
+        begins = display.vblank_time(refresh) + display.scanout_delay(self._rows)[None, :]
+        shown = np.clip(np.minimum(begins + display.period_s, end) - np.maximum(begins, start), 0.0, None) / exposure
+        return refresh, shown
 
     def _panel_image(self, image_id: int) -> np.ndarray:
         """The display image `image_id` as the camera sees it on the panel, in digital numbers."""

@@ -18,6 +18,7 @@ from rig.sim.board import SimulatedBoard
 from rig.sim.camera import SimCamera
 from rig.sim.config import SimulationConfig
 from rig.sim.display import DisplayConfig, SimDisplay
+from rig.sim.flash import FlashingDisplayScene, FlashingLightScene
 from rig.sim.pendulum import Pendulum
 from rig.sim.scene import FilmedScene
 from rig.sim.tracker import SimTracker
@@ -50,12 +51,18 @@ class SimulatedWorld:
         return {"tracker": self.tracker, "display": self.display, "camera": self.camera}
 
     def camera(self) -> SimCamera:
-        """The world's one camera (filming its display)."""
+        """The world's one camera, filming its display's bench, or the calibration target the
+        config puts in front of it (`rig.sim.flash`)."""
         if self._camera is None:
             c = self.config
-            scene = FilmedScene(
-                self.pendulum, self._display, self.layout, c.camera.display_black_dn, c.camera.display_white_dn, c.board
-            )
+            bench = (self.pendulum, self._display, self.layout, c.camera.display_black_dn, c.camera.display_white_dn, c.board)
+            scene: FilmedScene | FlashingLightScene
+            if c.flash is None:
+                scene = FilmedScene(*bench)
+            elif c.flash.source == "light":
+                scene = FlashingLightScene(c.flash, self.layout, self._display)
+            else:
+                scene = FlashingDisplayScene(c.flash, *bench)
             self._camera = SimCamera(c.camera, scene, c.duration_s, seed=c.seed + 1, impairment_seed=c.seed)
         return self._camera
 

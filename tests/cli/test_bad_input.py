@@ -179,6 +179,13 @@ CASES = [
     ("analyse-plot-is-a-folder", "analyse {lab}/blob.avi --plot {lab}/mixed", "is a folder"),
     ("analyse-csv-folder-missing", "analyse {lab}/blob.avi --csv {lab}/nowhere/tracks.csv", "does not exist"),
     ("analyse-summary-over-a-file", "analyse {lab}/blob.avi {lab}/grey.avi --summary {lab}/a-file", "--summary"),
+    # calibrate-camera: the film of a flashing light
+    ("calibrate-camera-missing-file", "calibrate-camera {lab}/nothing.avi --flash-hz 80", "does not exist"),
+    ("calibrate-camera-corrupt-video", "calibrate-camera {lab}/corrupt.avi --flash-hz 80", "corrupt.avi"),
+    ("calibrate-camera-no-flashing-light", "calibrate-camera {lab}/grey.avi --flash-hz 80", "no flashing light"),
+    ("calibrate-camera-no-flash-frequency", "calibrate-camera {lab}/grey.avi", "--flash-hz"),
+    ("calibrate-camera-duty-out-of-range", "calibrate-camera {lab}/grey.avi --flash-hz 80 --duty 1.5", "--duty"),
+    ("calibrate-camera-display-without-its-rate", "calibrate-camera {lab}/grey.avi --flash-hz 30 --source display", "--display-hz"),
     # tune: traces and where the parameters go
     ("tune-trace-with-nan", "tune kalman-cv --trace {lab}/nan.csv --horizon-ms 20 --out {lab}/p.json", "finite"),
     ("tune-trace-missing-column", "tune kalman-cv --trace {lab}/missing-column.csv --horizon-ms 20 --out {lab}/p.json", "pz"),

@@ -11,6 +11,7 @@ import re
 import pytest
 
 from analysis import AnalysisError, AnalysisOptions
+from analysis.shutter import ShutterOptions
 from declared import walk
 from rig.cli import main
 from rig.commands.declared_options import add_declared_options, config_from_args
@@ -21,7 +22,7 @@ from rig.sim.config import SimulationConfig
 from rig.sim.impairments import FilmImpairments
 from rig.sim.pendulum import PendulumConfig
 
-DECLARED = {"analyse": AnalysisOptions, "simulate": SimulationConfig}
+DECLARED = {"analyse": AnalysisOptions, "simulate": SimulationConfig, "calibrate-camera": ShutterOptions}
 
 
 def _help(capsys: pytest.CaptureFixture[str], command: str) -> str:

@@ -133,6 +133,6 @@ def test_every_registered_subject_and_mode_is_a_command():
         assert parser.parse_args(["bench", subject.name]).mode is subject
         for mode in modes:
             assert parser.parse_args(["bench", subject.name, f"--{mode.name}"]).mode is mode
-    assert subjects == ["analyser", "predictors", "renderers", "trackers", "batch", "live"]
+    assert subjects == ["analyser", "predictors", "renderers", "trackers", "batch", "live", "camera-calibration"]
     with pytest.raises(SystemExit):
         parser.parse_args(["bench", "renderers", "--seed-table", "--variants"])

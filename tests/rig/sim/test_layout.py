@@ -67,5 +67,6 @@ def test_an_explicit_layout_places_both_where_it_says(pendulum: Pendulum) -> Non
     ],
 )
 def test_impossible_layouts_are_refused(pendulum: Pendulum, spec: str, message: str) -> None:
-    with pytest.raises(ConfigError, match=message):
+    with pytest.raises(ConfigError, match=message) as refused:
         make_layout(pendulum, CAMERA, DISPLAY, spec)
+    assert repr(spec) in str(refused.value) and "BenchLayout" not in str(refused.value)
