@@ -62,6 +62,11 @@ class AnalysisOptions:
         None, "ms", "the camera's exposure, if known", POSITIVE, unset="estimated from the LED's motion blur",
         flag="--exposure-ms",
     )  # fmt: skip
+    readout_ms: float | None = setting(
+        None, "ms", "the camera's rolling-shutter readout, top row to bottom row (0 for a global shutter), if known: "
+        "each blob is then timed by its rows", NON_NEGATIVE, unset="any readout up to the frame interval is allowed for",
+        flag="--readout-ms",
+    )  # fmt: skip
 
     def __post_init__(self) -> None:
         check(self, AnalysisError)

@@ -33,9 +33,11 @@ def analyse(
     (required for arrays and image folders), the regions or the LED's side (else the two largest
     moving bright regions are used, the LED the one the physical evidence names, and an
     AnalysisError asks for the regions when it does not decide), the estimator, the latencies
-    considered, the bayes sampler's seed, and what the user knows of the display's refresh rate and
+    considered, the bayes sampler's seed, what the user knows of the display's refresh rate and
     the camera's exposure (else the video is searched for both, to work out how the camera's
-    sampling of the display biases the latency, ``analysis.sampling``).
+    sampling of the display biases the latency, ``analysis.sampling``), and of the camera's
+    rolling-shutter readout (each blob's samples are then dated by their rows; else the interval
+    allows for any readout up to the frame interval, ``analysis.readout``).
     ``progress(done, total)`` is called as frames are tracked (for clips of
     ``analysis.tracks.PROGRESS_MIN_SECONDS`` or more); ``tracks_csv`` receives the tracks as they
     are measured. ``reference_departures(led_track)`` names times (s, on the video's clock) at which

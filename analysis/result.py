@@ -8,6 +8,7 @@ from typing import Any
 from analysis.cycles import CycleResolution
 from analysis.misfit import MisfitReport
 from analysis.sampling import SamplingBias
+from analysis.readout import RollingShutter
 from analysis.tracking import Roi, Track
 from analysis.windows import WindowedLatency
 
@@ -47,8 +48,10 @@ class LatencyResult:
     from the sphere. ambiguous is True when the whole number of periods in the latency could not
     be decided (see ``analysis.cycles``); a warning then says why. sampling says what the
     camera's sampling of the display may do to the latency (None where it could not be measured),
-    checks how well the model fits (``analysis.misfit``); each method's latency and interval already
-    allow for both, and ``warnings`` says where either changed them.
+    checks how well the model fits (``analysis.misfit``), shutter the camera's readout given or
+    bounded and the rows each blob was filmed on (``analysis.readout``); each method's latency and
+    interval already allow for all three, and ``warnings`` says where any changed them. The tracks
+    are dated by their rows where the readout was given.
     """
 
     latency_ms: float
@@ -73,6 +76,7 @@ class LatencyResult:
     sphere_track: Track = field(repr=False)
     sampling: SamplingBias | None = field(default=None, repr=False)
     checks: MisfitReport | None = None
+    shutter: RollingShutter | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready summary (without the tracks)."""
@@ -96,5 +100,6 @@ class LatencyResult:
             "windowed": self.windowed.to_dict() if self.windowed is not None else None,
             "sampling": None if self.sampling is None else self.sampling.to_dict(),
             "checks": None if self.checks is None else self.checks.to_dict(),
+            "rolling_shutter": None if self.shutter is None else self.shutter.to_dict(),
             "diagnostics": dict(self.diagnostics),
         }

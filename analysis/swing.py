@@ -71,9 +71,11 @@ def _swing_events(
     return events, (max(begin, float(led.t[0])), min(end, float(led.t[-1])))
 
 
-def during(track: Track, span: tuple[float, float]) -> Track:
-    """The part of a track inside [start, end]."""
-    inside = (track.t >= span[0]) & (track.t <= span[1])
+def during(track: Track, span: tuple[float, float], clock: np.ndarray | None = None) -> Track:
+    """The frames of a track whose times lie inside [start, end]: its own times, or ``clock``'s (the
+    LED's, so that the sphere, dated by other rows, keeps the same frames)."""
+    times = track.t if clock is None else clock
+    inside = (times >= span[0]) & (times <= span[1])
     columns = {column.name: getattr(track, column.name) for column in dataclasses.fields(Track)}
     return Track(**{name: values[inside] if values is not None else None for name, values in columns.items()})
 
@@ -83,7 +85,7 @@ def measure_swing(led: Track, sphere: Track, reference_departures: Mapping[str, 
     at which other instruments saw the pendulum depart from rest; each, with the sphere's own
     departure, is one more event lag."""
     events, span = _swing_events(led, sphere, reference_departures)
-    signals = swing_signals(during(led, span), during(sphere, span))
+    signals = swing_signals(during(led, span), during(sphere, span, led.t))
     uniform = signals.uniform()
     fps = 1.0 / signals.frame_interval
     frequency = estimate_frequency(uniform[1], fps)

@@ -66,7 +66,7 @@ class Tracks:
     from ("given" or "auto"), led_rule how the LED was told from the sphere. warnings are for the
     user, in the order they arose; diagnostics are JSON-ready facts about the reading (time source,
     dropped and repeated frames, detection rates, clipped frames); seconds is how long reading and
-    tracking took.
+    tracking took; frame_size the frames' (width, height) in pixels.
     """
 
     led: Track
@@ -80,6 +80,7 @@ class Tracks:
     warnings: tuple[str, ...]
     diagnostics: dict[str, Any]
     seconds: float
+    frame_size: tuple[int, int]
 
     def write_csv(self, path: str | Path) -> None:
         """Write both tracks to a CSV file, one row per frame (``analysis.tracks_csv``)."""
@@ -305,7 +306,18 @@ def track(
         "clipped_frames": {"led": int(np.count_nonzero(led.clipped)), "sphere": int(np.count_nonzero(sphere.clipped))},
     }
     tracks = Tracks(
-        led, sphere, stamps, times, led_roi, sphere_roi, calibration.roi_source, rule, tuple(warnings), diagnostics, seconds
+        led,
+        sphere,
+        stamps,
+        times,
+        led_roi,
+        sphere_roi,
+        calibration.roi_source,
+        rule,
+        tuple(warnings),
+        diagnostics,
+        seconds,
+        video.frame_size,
     )
     if tracks_csv is not None:
         tracks.write_csv(tracks_csv)

@@ -96,7 +96,8 @@ def _window_fit(
 
 def window_phases(signals: SwingSignals, frequency_hz: float, damping: float = 0.0) -> WindowPhases:
     """Phases and amplitudes (those of the fundamental) of both signals in consecutive one-period
-    windows; ``damping`` (1/s, see damping_rate) shapes the swing inside each window."""
+    windows of frames, each signal fitted at its own times; ``damping`` (1/s, see damping_rate)
+    shapes the swing inside each window."""
     period = 1.0 / frequency_hz
     omega = 2 * math.pi * frequency_hz
     start = signals.t[0]
@@ -107,9 +108,8 @@ def window_phases(signals: SwingSignals, frequency_hz: float, damping: float = 0
     squares = {"led": [0.0, 0], "sphere": [0.0, 0]}
     for index in range(count):
         sl = slice(edges[index], edges[index + 1])
-        t = signals.t[sl] - middles[index]
-        for name, values in (("led", signals.led[sl]), ("sphere", signals.sphere[sl])):
-            phase, amplitude, rss, used = _window_fit(t, values, omega, period, damping)
+        for name, times, values in (("led", signals.t[sl], signals.led[sl]), ("sphere", signals.sphere_t[sl], signals.sphere[sl])):
+            phase, amplitude, rss, used = _window_fit(times - middles[index], values, omega, period, damping)
             rows[name].append((phase, amplitude))
             squares[name][0] += rss
             squares[name][1] += max(used - WINDOW_PARAMETERS, 0)

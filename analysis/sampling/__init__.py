@@ -2,9 +2,11 @@
 
 A camera filming a sample-and-hold display sees the sphere at whatever phase of each refresh its
 exposures fall, and reads the latency off by the mean of that phase's bias
-(``analysis.sampling.model``). ``measure_sampling`` works out which refresh rates, phases and
-exposures the video allows (``analysis.sampling.inference``, with the exposure from the LED's
-blur, ``analysis.sampling.exposure``, or as given), and ``SamplingBias.apply`` turns a latency
+(``analysis.sampling.model``), averaged over the sphere's rows, which the display's scan-out and
+the camera's readout reach one after another (``analysis.sampling.rows``). ``measure_sampling``
+works out which refresh rates, phases, exposures and row slopes the video allows
+(``analysis.sampling.inference``, with the exposure from the LED's blur,
+``analysis.sampling.exposure``, or as given), and ``SamplingBias.apply`` turns a latency
 and its interval into the corrected latency and an interval that holds every bias still possible.
 Where the video identifies the bias it is corrected; where it does not (the camera phase-locked to
 the display, or a rate the video does not show), the interval is widened by it and a warning says
@@ -19,9 +21,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.sampling.exposure import Exposure, exposure_from_blur, given_exposure
-from analysis.sampling.inference import RATE_TOLERANCE, RefreshHypothesis, refresh_hypotheses
+from analysis.sampling.inference import BIAS_RANGE, RefreshHypothesis, refresh_hypotheses
 from analysis.sampling.model import commensurate
+from analysis.sampling.rates import RATE_TOLERANCE
 from analysis.sampling.residuals import TimingResiduals
+from analysis.sampling.rows import SphereRows
 from analysis.tracking import Track
 
 # Residuals may be correlated over this fraction of a swing period.
@@ -38,8 +42,6 @@ WIDENING_NOTICE_S = 0.05e-3
 MIXTURE_COMPONENTS = 64
 QUANTILE_GRID = 512
 NORMAL_95 = 1.959963984540054
-# The bias's range: all but this much of its posterior either side.
-BIAS_RANGE = (0.005, 0.995)
 
 
 @dataclass(frozen=True)
@@ -167,8 +169,8 @@ def _components(means: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.
     means, weights = means[kept], weights[kept]
     if means.size <= MIXTURE_COMPONENTS:
         return means, weights / weights.sum()
-    edges = np.linspace(means.min(), means.max(), MIXTURE_COMPONENTS + 1)
-    index = np.clip(np.searchsorted(edges, means, side="right") - 1, 0, MIXTURE_COMPONENTS - 1)
+    least, most = float(means.min()), float(means.max())
+    index = np.clip(((means - least) / max(most - least, 1e-300) * MIXTURE_COMPONENTS).astype(np.int64), 0, MIXTURE_COMPONENTS - 1)
     total = np.bincount(index, weights, MIXTURE_COMPONENTS)
     centre = np.bincount(index, weights * means, MIXTURE_COMPONENTS)
     used = total > 0
@@ -200,16 +202,21 @@ def measure_sampling(
     period_s: float,
     refresh_hz: float | None = None,
     exposure_s: float | None = None,
+    row_time_s: tuple[float, tuple[float, float]] = (0.0, (0.0, 0.0)),
 ) -> SamplingBias:
     """What the camera's sampling of the display may do to the latency, from the sphere's timing
     residuals against the LED (``analysis.sampling.residuals``) and the LED's track (its blur);
     ``refresh_hz`` and ``exposure_s`` are the display's refresh and the camera's exposure where the
-    user knows them. The correction is left at 0 unless the video identifies the bias: every rate it
+    user knows them; ``row_time_s`` the time per row the sphere's samples were dated by and the range
+    the camera's true time per row lies in (``analysis.readout``). The correction is left at 0 unless the video identifies the bias: every rate it
     allows agrees, and the bias's 95 % range is narrow against its size."""
     frame_interval = residuals.frame_interval
     exposure = given_exposure(exposure_s, frame_interval) if exposure_s is not None else exposure_from_blur(led, frame_interval)
     bandwidth = max(1, round(CORRELATION_PERIODS * period_s / frame_interval))
-    hypotheses = refresh_hypotheses(residuals, 1.0 / frame_interval, refresh_hz, (exposure.low_s, exposure.high_s), bandwidth)
+    rows = None
+    if residuals.rows is not None:
+        rows = SphereRows(residuals.rows - float(np.mean(residuals.rows)), residuals.row_sd, *row_time_s)
+    hypotheses = refresh_hypotheses(residuals, 1.0 / frame_interval, refresh_hz, (exposure.low_s, exposure.high_s), bandwidth, rows)
     best = hypotheses[0]
     ranges = [h.range_s(*BIAS_RANGE) for h in hypotheses]
     low, high = min(r[0] for r in ranges), max(r[1] for r in ranges)

@@ -18,7 +18,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.sampling.residuals import elongation_along
 from analysis.tracking import Track
 
 # A pixel at this level or above is saturated (8-bit video).
@@ -60,6 +59,14 @@ def given_exposure(exposure_s: float, frame_interval: float) -> Exposure:
     """The exposure the user gives; it cannot exceed the frame interval."""
     exposure = min(exposure_s, frame_interval)
     return Exposure(exposure, exposure, "given", exposure)
+
+
+def elongation_along(spread: np.ndarray, axis: tuple[np.ndarray, np.ndarray] | np.ndarray) -> np.ndarray:
+    """Per frame, a blob's variance along ``axis`` (a unit vector, or one per frame) less across
+    it (px^2), from its moments xx, yy, xy."""
+    sxx, syy, sxy = spread.T
+    ux, uy = axis
+    return (ux * ux - uy * uy) * (sxx - syy) + 4 * ux * uy * sxy
 
 
 def _velocities(track: Track) -> tuple[np.ndarray, np.ndarray]:

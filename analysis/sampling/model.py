@@ -23,10 +23,8 @@ no exposure holds it, anywhere in a gap of (T / p - E) between exposures, the bi
 in +-(T / p - E) / 2 (phase-locked, p = 1: up to half a refresh). ``analysis.sampling.inference``
 works out which phases a video is consistent with.
 
-A frame whose exposure holds a switch shows the sphere twice (or more), once per refresh it saw,
-each image weighted by how long it was shown: the blob's variance along its motion exceeds its
-own by (v T)^2 V(s, e), v the speed and V the variance of the refresh index under those weights
-(``exposure_spread``). That says where the switches fall even when the timing does not.
+The sphere is not a point: its rows switch one after another as the display's scan-out reaches
+them (``analysis.sampling.rows``), so a frame's bias is g averaged over its rows' phases.
 """
 
 from __future__ import annotations
@@ -45,17 +43,6 @@ def exposure_bias(s: np.ndarray | float, e: np.ndarray | float) -> np.ndarray:
     starting ``s`` refreshes after the sphere's row switched (broadcast)."""
     s, e = np.asarray(s, dtype=np.float64), np.asarray(e, dtype=np.float64)
     return (_antiderivative(s + e) - _antiderivative(s)) / e
-
-
-def exposure_spread(s: np.ndarray | float, e: np.ndarray | float) -> np.ndarray:
-    """V(s, e): the variance of the refresh index over an exposure of ``e`` refreshes starting
-    ``s`` refreshes (0 <= s < 1) after a switch, each refresh weighted by its share of the exposure
-    (broadcast)."""
-    s, e = np.broadcast_arrays(np.asarray(s, dtype=np.float64), np.asarray(e, dtype=np.float64))
-    refreshes = np.arange(int(np.ceil(float(np.max(s + e)))) + 1, dtype=np.float64).reshape((-1,) + (1,) * s.ndim)
-    weights = np.clip(np.minimum(refreshes + 1, s + e) - np.maximum(refreshes, s), 0.0, None) / e
-    mean = np.sum(weights * refreshes, axis=0)
-    return np.sum(weights * refreshes**2, axis=0) - mean**2
 
 
 def frame_phases(times: np.ndarray, refresh_hz: float, phase: np.ndarray | float) -> np.ndarray:

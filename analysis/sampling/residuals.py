@@ -5,9 +5,9 @@ exposure, so each frame shows it a little early or late (``analysis.sampling.mod
 the LED delayed by the measured latency, mapped onto the sphere's track by a cubic (a lens or a
 display may bend one a little against the other) plus a slow drift, a frame's residual r is about
 -v (b - mean b), v the sphere's speed and b that frame's timing bias: the pattern of the biases is
-seen, their weighted mean is not (it is in the latency). A frame's exposure may also show the
-sphere several times, once per refresh it saw; the blob's variance along its motion less its
-variance across it records that (``analysis.sampling.model.exposure_spread``).
+seen, their weighted mean is not (it is in the latency). Each frame's centroid row, and the spread
+of the sphere's light over its rows, say when the display's scan-out and the camera's readout reach
+it (``analysis.sampling.rows``).
 """
 
 from __future__ import annotations
@@ -17,22 +17,24 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.longrun import long_run_variance
-from analysis.signals import SwingSignals, main_axis
+from analysis.signals import SwingSignals
 from analysis.tracking import Track
 
 
 @dataclass(frozen=True)
 class TimingResiduals:
-    """Per used frame: its time (s), the sphere's residual r (px) and speed v (px/s) against the LED
-    reference, the frame's index on the camera's frame grid (for spectra), and the sphere's variance
-    along its motion less across it (px^2; NaN where not measured, None without its moments)."""
+    """Per used frame: the sphere's time (s, from the first frame's), its residual r (px) and speed
+    v (px/s) against the LED reference, the frame's index on the camera's frame grid (for spectra),
+    and its centroid row (px; None without its track); row_sd is the standard deviation of its light
+    over its rows (px; 0 where its moments were not measured), the median over frames."""
 
     t: np.ndarray
     r: np.ndarray
     v: np.ndarray
     index: np.ndarray
     frame_interval: float
-    elongation: np.ndarray | None = None
+    rows: np.ndarray | None = None
+    row_sd: float = 0.0
 
 
 def _catmull_rom(grid_t: np.ndarray, values: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -52,29 +54,21 @@ def _catmull_rom(grid_t: np.ndarray, values: np.ndarray, t: np.ndarray) -> tuple
     return value, slope, inside
 
 
-def elongation_along(spread: np.ndarray, axis: tuple[np.ndarray, np.ndarray] | np.ndarray) -> np.ndarray:
-    """Per frame, a blob's variance along ``axis`` (a unit vector, or one per frame) less across
-    it (px^2), from its moments xx, yy, xy."""
-    sxx, syy, sxy = spread.T
-    ux, uy = axis
-    return (ux * ux - uy * uy) * (sxx - syy) + 4 * ux * uy * sxy
-
-
 def timing_residuals(
     signals: SwingSignals, latency_s: float, sphere_track: Track | None = None
 ) -> TimingResiduals | None:
-    """The sphere's residuals and speeds against the LED delayed by ``latency_s`` (see the module
-    docstring), with its elongation where ``sphere_track`` (its track over the signals' frames) has its
-    moments; None when too few frames overlap."""
+    """The sphere's residuals and speeds at its own times against the LED delayed by ``latency_s``
+    (see the module docstring), with its rows where ``sphere_track`` (its track over the signals'
+    frames) is given; None when too few frames overlap."""
     grid, led, _ = signals.uniform()
     frame_interval = signals.frame_interval
     if grid.size < 8:
         return None
-    level, slope, inside = _catmull_rom(grid, led, signals.t - latency_s)
+    level, slope, inside = _catmull_rom(grid, led, signals.sphere_t - latency_s)
     used = inside & signals.sphere_valid
     if np.count_nonzero(used) < 32:
         return None
-    t, reference, rate = signals.t[used], level[used], slope[used]
+    t, reference, rate = signals.sphere_t[used], level[used], slope[used]
     sphere = signals.sphere[used]
     scale = max(float(np.std(reference)), 1e-12)
     u = (reference - reference.mean()) / scale
@@ -83,12 +77,13 @@ def timing_residuals(
     coefficients, *_ = np.linalg.lstsq(basis, sphere, rcond=None)
     residual = sphere - basis @ coefficients
     speed = (coefficients[1] + 2 * coefficients[2] * u + 3 * coefficients[3] * u**2) * rate / scale
-    index = np.rint((t - signals.t[0]) / frame_interval).astype(np.int64)
-    elongation = None
-    if sphere_track is not None and sphere_track.spread is not None:
-        valid = sphere_track.valid
-        elongation = elongation_along(sphere_track.spread, main_axis(sphere_track.x[valid], sphere_track.y[valid]))[used]
-    return TimingResiduals(t - signals.t[0], residual, speed, index, frame_interval, elongation)
+    index = np.rint((signals.t[used] - signals.t[0]) / frame_interval).astype(np.int64)
+    rows, row_sd = None, 0.0
+    if sphere_track is not None:
+        rows = sphere_track.y[used]
+        if sphere_track.spread is not None:
+            row_sd = float(np.sqrt(max(float(np.median(sphere_track.spread[sphere_track.valid, 1])), 0.0)))
+    return TimingResiduals(t - signals.t[0], residual, speed, index, frame_interval, rows, row_sd)
 
 
 def inflation(series: np.ndarray, bandwidth: int) -> float:

@@ -11,8 +11,9 @@ from analysis import MethodResult, register_estimator, unregister_estimator
 from rig.cli import main
 
 
-# The clip's camera (120 fps, exposing whole frames) and display (60 Hz), as a lab that knows them says.
-KNOWN = ["--display-hz", "60", "--exposure-ms", f"{1e3 / 120.0}"]
+# The clip's camera (120 fps, exposing whole frames, a global shutter) and display (60 Hz), as a lab
+# that knows them says.
+KNOWN = ["--display-hz", "60", "--exposure-ms", f"{1e3 / 120.0}", "--readout-ms", "0"]
 
 
 @pytest.fixture

@@ -61,13 +61,15 @@ GRID = [
 
 # Every camera and display rate of the grid is commensurate, so how the exposures sample the refreshes
 # depends on the exposure: the grid gives the camera's settings, as a lab that knows them does
-# (--display-hz, --exposure-ms). Without them the interval widens (see test_analysis_sampling).
+# (--display-hz, --exposure-ms, and --readout-ms 0 for its global shutter). Without them the interval
+# widens (see test_analysis_sampling and test_analysis_shutter).
 @pytest.mark.parametrize(("latency_ms", "period_s", "fps", "display_hz", "decay", "seconds"), GRID)
 def test_latency_is_recovered_on_the_grid(scene, render_video, latency_ms, period_s, fps, display_hz, decay, seconds):
     clip = scene(
         latency_s=latency_ms / 1e3, period_s=period_s, fps=fps, display_hz=display_hz, decay=decay, duration_s=seconds
     )
-    result = analyse(render_video(clip), AnalysisOptions(fps=fps, display_hz=display_hz, exposure_ms=clip.exposure * 1e3 / fps))
+    known = AnalysisOptions(fps=fps, display_hz=display_hz, exposure_ms=clip.exposure * 1e3 / fps, readout_ms=0.0)
+    result = analyse(render_video(clip), known)
     frame_ms = 1e3 / fps
     assert result.latency_ms == pytest.approx(latency_ms, abs=FRAMES_TOLERANCE * frame_ms)
     assert result.ci95_ms[0] < result.latency_ms < result.ci95_ms[1]
@@ -149,7 +151,7 @@ def test_missing_detections_are_left_out_and_reported(scene, render_video):
     frames = render_video(clip).copy()
     hidden = np.random.default_rng(7).choice(clip.frame_count, size=clip.frame_count * 5 // 100, replace=False)
     frames[hidden, :, 80:] = 21
-    result = analyse(frames, AnalysisOptions(fps=clip.fps, display_hz=clip.display_hz, exposure_ms=1e3 / clip.fps))
+    result = analyse(frames, AnalysisOptions(fps=clip.fps, display_hz=clip.display_hz, exposure_ms=1e3 / clip.fps, readout_ms=0.0))
     assert result.latency_ms == pytest.approx(50.0, abs=0.3)
     assert result.frames_used == clip.frame_count - hidden.size
     assert not result.sphere_track.valid[hidden].any()

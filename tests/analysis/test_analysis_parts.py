@@ -16,7 +16,7 @@ def test_analyse_is_track_then_estimate(scene, render_video):
     assert tracks.warnings == ("the sphere was missing in 1 frames (0.3%), of them 1 dark (off or hidden); those frames were left out",)
     assert np.array_equal(tracks.stamps, np.arange(clip.frame_count) / clip.fps)
     assert tracks.led.t is tracks.times.t and tracks.diagnostics["time_source"] == tracks.times.source
-    known = {"display_hz": clip.display_hz, "exposure_ms": 1e3 / clip.fps}
+    known = {"display_hz": clip.display_hz, "exposure_ms": 1e3 / clip.fps, "readout_ms": 0.0}
     whole = analyse(frames, AnalysisOptions(fps=clip.fps, method="fft", **known))
     parts = estimate(tracks, AnalysisOptions(method="fft", **known))
     assert parts.latency_ms == whole.latency_ms

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from analysis.sampling.model import bias_range_s, commensurate, exposure_bias, exposure_spread, frame_phases
+from analysis.sampling.model import bias_range_s, commensurate, exposure_bias, frame_phases
 
 PHASES = np.linspace(0.0, 1.0, 4000, endpoint=False)
 
@@ -26,14 +26,6 @@ def test_a_short_exposure_is_off_by_the_mean_age_of_the_refresh_it_sees(e: float
     s = np.linspace(0.0, 1.0 - e, 50)
     np.testing.assert_allclose(exposure_bias(s, e), s + e / 2 - 0.5, atol=1e-12)
     assert np.abs(exposure_bias(PHASES, e)).max() == pytest.approx((1 - e) / 2, abs=1e-3)
-
-
-def test_a_straddling_exposure_shows_two_images_weighted_by_their_time() -> None:
-    # [0.8, 1.2] of a refresh: half of it before the switch, half after.
-    assert exposure_spread(0.8, 0.4) == pytest.approx(0.25)
-    assert exposure_spread(0.3, 0.4) == pytest.approx(0.0)
-    # [0.9, 1.2]: a third before, two thirds after.
-    assert exposure_spread(0.9, 0.3) == pytest.approx(2 / 9)
 
 
 @pytest.mark.parametrize(

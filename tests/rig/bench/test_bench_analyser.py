@@ -13,6 +13,7 @@ from rig.bench.contract import Context
 from rig.cli import main
 from rig.commands import bench
 from rig.service.sweep import SweepPoint, read_sweep
+from rig.sim.layout import placement
 
 
 @pytest.fixture
@@ -62,7 +63,7 @@ def _cases(spec: Path) -> list[SweepPoint]:
 def test_the_shipped_spec_parses_into_the_mixed_grid_its_named_cases_and_the_hard_grid() -> None:
     points = _cases(analyser.SPEC)
     groups = [point.labels["group"] for point in points]
-    assert groups == ["mixed"] * 48 + ["named"] * 5 + ["hard"] * 50
+    assert groups == ["mixed"] * 48 + ["named"] * 5 + ["hard"] * 58
     assert len({point.labels["case"] for point in points}) == len(points)
     mixed = [point for point in points if point.labels["group"] == "mixed"]
     configs = [point.config for point in mixed]
@@ -94,6 +95,17 @@ def test_the_hard_grid_has_every_rate_pair_exposure_impairment_and_decimation() 
     assert {c.film_fps for c in decimated} == {60.0}
     table = [p.config for p in hard if p.labels["case"].startswith("table-")]
     assert [(c.camera.fps, c.display.refresh_hz, c.display.phase) for c in table] == [(60.0, 60.0, 0.0), (144.0, 144.0, 0.0)]
+
+
+@pytest.mark.parametrize("spec", [analyser.SPEC, analyser.SPECS / "analyser-rolling.toml", analyser.SPECS / "analyser-rolling-told.toml"])
+def test_the_rolling_shutter_films_read_out_within_a_frame_with_the_blobs_a_third_of_the_frame_apart(spec: Path) -> None:
+    rolling = [p.config for p in _cases(spec) if p.labels["impairment"] == "rolling-shutter"]
+    assert {c.camera.fps for c in rolling} == {30.0, 60.0, 120.0, 240.0}
+    assert all(0.0 < c.camera.readout_s <= 1.0 / c.camera.fps for c in rolling)
+    for config in rolling:
+        led, display = placement(config.layout).led, placement(config.layout).display
+        assert 0.30 <= abs(display[1] - led[1]) <= 0.40
+    assert len(rolling) == (8 if spec == analyser.SPEC else 40)
 
 
 def test_the_specs_are_package_data() -> None:
