@@ -28,10 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.blobs import Track
 from analysis.phase import estimate_frequency
 from analysis.sampling.exposure import SATURATED_LEVEL
 from analysis.signals import swing_signals
-from analysis.tracking import Track
 
 DECISION_MARGIN = 3.0
 SMOOTHING_PERIODS = 0.08

@@ -10,7 +10,7 @@ from analysis.hints import HintCheck
 from analysis.misfit import MisfitReport
 from analysis.sampling import SamplingBias
 from analysis.readout import RollingShutter
-from analysis.tracking import Roi, Track
+from analysis.blobs import Roi, Track
 from analysis.windows import WindowedLatency
 
 

@@ -38,7 +38,7 @@ from analysis.errors import AnalysisError
 from analysis.identity import Identity, identify
 from analysis.options import AnalysisOptions
 from analysis.timing import FrameTimes, check_count, frame_times, recorder_repeats
-from analysis.tracking import BlobTracker, Detection, Roi, Track
+from analysis.blobs import BlobTracker, Detection, Roi, Track
 from analysis.tracks_csv import TrackStream, write_tracks_csv
 from analysis.video.file import VideoFile
 from analysis.video.frames import Crop, Frame, FrameSource, Repeats

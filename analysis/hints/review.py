@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from analysis.blobs import Track
 from analysis.errors import AnalysisError
 from analysis.hints.hint import AGREES, CANNOT_CHECK, CONTRADICTS, IDENTITY, OVERRULED, Hint, HintCheck, in_words
 from analysis.identity import DECISION_MARGIN, identify
@@ -40,7 +41,6 @@ from analysis.sampling.exposure import exposure_from_blur
 from analysis.sampling.rates import COMMON_REFRESH_HZ
 from analysis.sampling.residuals import TimingResiduals
 from analysis.timing import RATE_AGREEMENT
-from analysis.tracking import Track
 from analysis.tracks import Tracks
 
 # A blob's row may differ from the hint's by this share of the frame's height.
@@ -120,7 +120,6 @@ def review(tracks: Tracks, options: AnalysisOptions) -> tuple[Tracks, AnalysisOp
     checks = HintReview(order=options.hints)
     used = options.hinted()
     dropped: list[str] = []
-    interval = float(np.median(np.diff(tracks.times.t)))
     active: dict[str, Hint] = {}
     for hint in options.hints:
         given = options.overruling(hint.name)
@@ -131,7 +130,7 @@ def review(tracks: Tracks, options: AnalysisOptions) -> tuple[Tracks, AnalysisOp
     stale = "fps" in active and not _frame_rate(active["fps"], tracks, checks)
     tracks = _identity([active[name] for name in IDENTITY if name in active], tracks, checks)
     for name in CAMERA_SETTING:
-        if name in active and not _camera_value(active[name], stale, interval, tracks, checks):
+        if name in active and not _camera_value(active[name], stale, float(np.median(np.diff(tracks.times.t))), tracks, checks):
             dropped.append(name)
     for name in ("led_row", "sphere_row"):
         if name in active:
