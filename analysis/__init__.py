@@ -4,7 +4,9 @@
 measures by how much the sphere lags the LED. It is two parts, which can be called alone, each
 taking the same options: ``track(video, options) -> Tracks`` (read, calibrate, track, time and
 check) and ``estimate(tracks, options) -> LatencyResult`` (the free swing, the whole number of
-periods, the estimators). ``AnalysisOptions`` declares every option once (``analysis.options``).
+periods, the estimators). ``AnalysisOptions`` declares every option once (``analysis.options``);
+its ``hints`` carry what a lab says of its bench (``Hint``), each checked against the video
+(``analysis.hints``).
 ``Tracks.write_csv`` saves tracks; the estimators are listed by ``methods()``, and
 ``register_estimator`` adds one (see ``analysis.estimators``). JAX is imported only when a fit
 (sinefit, bayes) is asked for, and no import changes a JAX setting.
@@ -14,6 +16,7 @@ from analysis.errors import AnalysisError
 from analysis.estimation import estimate
 from analysis.estimators.contract import EstimationContext, Estimator
 from analysis.estimators.registry import methods, register_estimator, unregister_estimator
+from analysis.hints import Hint
 from analysis.options import AnalysisOptions
 from analysis.pipeline import analyse
 from analysis.result import LatencyResult, MethodResult
@@ -24,6 +27,7 @@ __all__ = [
     "AnalysisOptions",
     "EstimationContext",
     "Estimator",
+    "Hint",
     "LatencyResult",
     "MethodResult",
     "Tracks",

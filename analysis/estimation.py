@@ -1,7 +1,10 @@
 """The second part of an analysis: both tracks in, the latency out (``estimate`` -> ``LatencyResult``).
 
-First each blob's samples are dated by the rows they come from where the camera's readout is
-given, or the readout is bounded by the frame rate (``analysis.readout``). The free swing is then
+First the options' hints (what the lab says of its bench) are compared with the tracks, and those
+the video contradicts are not used as they stand (``analysis.hints.review``; the display's
+refresh is compared in the sampling step). Then each blob's samples are dated by the rows they
+come from where the camera's readout is given, or the readout is bounded by the frame rate
+(``analysis.readout``). The free swing is then
 measured once (``analysis.swing``); its phase lag, known modulo one period, and the swing's
 one-off events decide the whole number of periods (``analysis.cycles``); then each requested
 estimator (``analysis.estimators``) runs on the same context, each taking that same whole number
@@ -24,11 +27,12 @@ import numpy as np
 from analysis.cycles import resolve_cycles
 from analysis.estimators.contract import EstimationContext
 from analysis.estimators.registry import ALL, DEFAULT_METHOD, estimators_for
+from analysis.hints.review import review as review_hints
 from analysis.misfit import MisfitReport, check_fit
 from analysis.options import AnalysisOptions
 from analysis.phase import fft_phase_latency
 from analysis.result import LatencyResult, MethodResult
-from analysis.sampling import SamplingBias, measure_sampling
+from analysis.sampling import SamplingBias
 from analysis.sampling.residuals import timing_residuals
 from analysis.readout import RollingShutter, rolling_shutter
 from analysis.swing import during, measure_swing
@@ -54,7 +58,9 @@ def estimate(
     them, and without them the video is searched for both (``analysis.sampling``); ``readout_ms``
     is the camera's readout, the time its rolling shutter takes from the frame's top row to its
     bottom one (0 for a global shutter), and without it the interval allows for any readout up to
-    the frame interval (``analysis.readout``).
+    the frame interval (``analysis.readout``). The options' hints (``AnalysisOptions.hints``) fill
+    the options they leave unset, each checked against the video (``analysis.hints.review``): give
+    the options as made, not ``hinted()``.
     ``reference_departures(led_track)`` names times (s, on the video's clock) at which other
     instruments saw the pendulum depart from rest, in the sense of ``analysis.onset`` (e.g. a rig
     board's encoder, its clock aligned by the LED's blink code, which it reads from the LED track);
@@ -64,7 +70,8 @@ def estimate(
     estimators = estimators_for(method)
     range_s = options.latency_range_s
     started = time.perf_counter()
-    warnings = list(tracks.warnings)
+    tracks, options, hints = review_hints(tracks, options)
+    warnings = [*tracks.warnings, *hints.warnings]
     shutter = rolling_shutter(tracks.led, tracks.sphere, tracks.frame_size[1], options.readout_ms)
     led_track, sphere_track = shutter.dated(tracks.led), shutter.dated(tracks.sphere)
     references = reference_departures(led_track) if reference_departures is not None else {}
@@ -84,18 +91,13 @@ def estimate(
     residuals = timing_residuals(swing.signals, measured.latency_ms / 1e3, during(sphere_track, swing.span_s, led_track.t))
     half_width_s = (measured.ci95_ms[1] - measured.ci95_ms[0]) / 2e3 if measured.ci95_ms is not None else 0.0
     checks = check_fit(swing, windowed_latency(swing.windows, measured.latency_ms / 1e3), residuals, half_width_s)
+    reviewed = len(hints.warnings)
     sampling = (
-        measure_sampling(
-            residuals,
-            led_track,
-            swing.period_s,
-            options.display_hz,
-            None if options.exposure_ms is None else options.exposure_ms / 1e3,
-            (shutter.row_time_s, shutter.row_time_range_s),
-        )
+        hints.sampling(residuals, led_track, swing.period_s, options, (shutter.row_time_s, shutter.row_time_range_s))
         if residuals is not None
-        else None
+        else hints.no_sampling()
     )
+    warnings.extend(hints.warnings[reviewed:])
     results = {name: _adjusted(result, checks, sampling) for name, result in results.items()}
     sampled = results[primary_name]
     shutter_warning = shutter.warning(_interval_s(sampled))
@@ -135,6 +137,7 @@ def estimate(
         sampling=sampling,
         checks=checks,
         shutter=shutter,
+        hints=hints.records,
         led_track=led_track,
         sphere_track=sphere_track,
     )

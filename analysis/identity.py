@@ -28,8 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.sampling.exposure import SATURATED_LEVEL
 from analysis.blobs import Track
+from analysis.phase import estimate_frequency
+from analysis.sampling.exposure import SATURATED_LEVEL
+from analysis.signals import swing_signals
 
 DECISION_MARGIN = 3.0
 SMOOTHING_PERIODS = 0.08
@@ -140,3 +142,10 @@ def decide(first: Track, second: Track, signals: tuple[np.ndarray, np.ndarray], 
     margin = sum(evidence.values())
     decided = None if abs(margin) < DECISION_MARGIN else margin > 0
     return Identity(decided, margin, evidence)
+
+
+def identify(first: Track, second: Track) -> Identity:
+    """Whether ``first`` (the left blob) is the LED, from both whole tracks (see ``decide``)."""
+    signals = swing_signals(first, second)
+    frequency = estimate_frequency(signals.uniform()[1], 1.0 / signals.frame_interval)
+    return decide(first, second, (signals.led, signals.sphere), signals.frame_interval, 1.0 / frequency)

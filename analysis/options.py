@@ -7,13 +7,17 @@ are made from these declarations, so a new option is one field here (and the cod
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from analysis.calibration import SIDES
 from analysis.cycles import DEFAULT_LATENCY_RANGE_S
 from analysis.errors import AnalysisError
 from analysis.estimators.registry import ALL, DEFAULT_METHOD, methods
-from declared import ANY, NON_NEGATIVE, POSITIVE, Flag, check, setting
+from analysis.hints.hint import APPLIED, CHECKED, IDENTITY, Hint, HintedFacts, in_words
+from declared import ANY, NON_NEGATIVE, POSITIVE, Flag, check, setting, setting_of
+from declared.settings import hints as field_types
+from declared.settings import whole_numbers
 
 ROI = tuple[int, int, int, int]
 
@@ -23,7 +27,7 @@ def _methods() -> tuple[str, ...]:
     return (*methods(), ALL)
 
 
-def _increasing(pair: tuple[float, float]) -> str | None:
+def increasing(pair: tuple[float, float]) -> str | None:
     """LOW below HIGH."""
     return None if pair[0] < pair[1] else "LOW must be below HIGH"
 
@@ -51,7 +55,7 @@ class AnalysisOptions:
     method: str = setting(DEFAULT_METHOD, "", "estimator, as listed below", choices=_methods, flag="--method")
     latency_range_ms: tuple[float, float] = setting(
         tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S), "ms", "latencies considered, to fix the whole number of swing periods",
-        ANY, rule=_increasing, flag=Flag("--latency-range", metavar="LOW,HIGH"),
+        ANY, rule=increasing, flag=Flag("--latency-range", metavar="LOW,HIGH"),
     )  # fmt: skip
     seed: int = setting(0, "", "random seed of the bayes sampler", NON_NEGATIVE, flag="--seed")
     display_hz: float | None = setting(
@@ -68,11 +72,48 @@ class AnalysisOptions:
         flag="--readout-ms",
     )  # fmt: skip
 
+    hints: tuple[Hint, ...] = ()
+    """What the lab says of its bench (`analysis.hints`): each fills the option of its name where it
+    is unset here, and is checked against the video."""
+
     def __post_init__(self) -> None:
         check(self, AnalysisError)
+        names = [hint.name for hint in self.hints]
+        for hint in self.hints:
+            problem = _hint_problem(hint) or ("is given twice" if names.count(hint.name) > 1 else None)
+            if problem is not None:
+                raise AnalysisError(f"the hint {hint.name} ({hint.source}) {problem}, got {hint.value!r}")
+
+    def hinted(self) -> AnalysisOptions:
+        """These options with each hint that fills an option (`analysis.hints.APPLIED`) put in where
+        the option is unset (the side and the regions only where the options give neither: they
+        answer one question); analyse with the options as given, which keep the hints apart."""
+        values = {hint.name: hint.value for hint in self.hints if self.overruling(hint.name) is None and hint.name in APPLIED}
+        return dataclasses.replace(self, **values) if values else self
+
+    def overruling(self, name: str) -> str | None:
+        """What these options give that overrules a hint of this name, in words (None: nothing)."""
+        if name in IDENTITY:
+            given = [f"{option} {in_words(getattr(self, option))}" for option in IDENTITY if getattr(self, option) is not None]
+            return " and ".join(given) or None
+        value = getattr(self, name) if name in (*APPLIED, "fps") else None
+        return None if value is None else f"{name} {in_words(value)}"
 
     @property
     def latency_range_s(self) -> tuple[float, float]:
         """The latencies considered, in seconds."""
         low, high = self.latency_range_ms
         return low / 1e3, high / 1e3
+
+
+def _hint_problem(hint: Hint) -> str | None:
+    """What is wrong with a hint's name or value ("must ..."), by the declaration of its name: the
+    option's, or the fact's (`analysis.hints.HintedFacts`)."""
+    if hint.name not in (*APPLIED, *CHECKED):
+        return f"is not one a bench gives ({', '.join((*APPLIED, *CHECKED))})"
+    for kind in (AnalysisOptions, HintedFacts):
+        field = next((field for field in dataclasses.fields(kind) if field.name == hint.name), None)
+        declared = setting_of(field) if field is not None else None
+        if declared is not None:
+            return declared.problem(hint.value, whole_numbers(field_types(kind)[hint.name]))
+    return None

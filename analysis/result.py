@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from analysis.cycles import CycleResolution
+from analysis.hints import HintCheck
 from analysis.misfit import MisfitReport
 from analysis.sampling import SamplingBias
 from analysis.readout import RollingShutter
@@ -51,7 +52,8 @@ class LatencyResult:
     checks how well the model fits (``analysis.misfit``), shutter the camera's readout given or
     bounded and the rows each blob was filmed on (``analysis.readout``); each method's latency and
     interval already allow for all three, and ``warnings`` says where any changed them. The tracks
-    are dated by their rows where the readout was given.
+    are dated by their rows where the readout was given. hints holds what the analysis made of
+    each hint the options carried (``analysis.hints``).
     """
 
     latency_ms: float
@@ -77,6 +79,7 @@ class LatencyResult:
     sampling: SamplingBias | None = field(default=None, repr=False)
     checks: MisfitReport | None = None
     shutter: RollingShutter | None = None
+    hints: tuple[HintCheck, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready summary (without the tracks)."""
@@ -101,5 +104,6 @@ class LatencyResult:
             "sampling": None if self.sampling is None else self.sampling.to_dict(),
             "checks": None if self.checks is None else self.checks.to_dict(),
             "rolling_shutter": None if self.shutter is None else self.shutter.to_dict(),
+            "hints": [check.to_dict() for check in self.hints],
             "diagnostics": dict(self.diagnostics),
         }

@@ -35,10 +35,8 @@ from analysis.calibration import (
     calibration_window,
 )
 from analysis.errors import AnalysisError
-from analysis.identity import Identity, decide
+from analysis.identity import Identity, identify
 from analysis.options import AnalysisOptions
-from analysis.phase import estimate_frequency
-from analysis.signals import swing_signals
 from analysis.timing import FrameTimes, check_count, frame_times, recorder_repeats
 from analysis.blobs import BlobTracker, Detection, Roi, Track
 from analysis.tracks_csv import TrackStream, write_tracks_csv
@@ -222,9 +220,7 @@ def check_track(track: Track, name: str, warnings: list[str]) -> None:
 def _identity(first: Track, second: Track, fps: float) -> Identity:
     """Which of the two blobs is the LED (``analysis.identity``); AnalysisError when the evidence
     does not decide, which names the evidence and asks for the regions."""
-    signals = swing_signals(first, second)
-    frequency = estimate_frequency(signals.uniform()[1], 1.0 / signals.frame_interval)
-    identity = decide(first, second, (signals.led, signals.sphere), signals.frame_interval, 1.0 / frequency)
+    identity = identify(first, second)
     if identity.first_is_led is None:
         evidence = ", ".join(f"{name} {value:+.1f}" for name, value in identity.evidence.items())
         raise AnalysisError(
@@ -260,12 +256,15 @@ def track(
     for arrays and image folders; the ROIs are [x, y, width, height] in pixels: give both or
     neither; without them the two largest moving bright regions are used, the LED being the one on
     ``led_side`` ("left" or "right") if given, else the one the physical evidence names
-    (``analysis.identity``; an AnalysisError asks for the ROIs when it does not decide). ``progress(done, total)`` is called
+    (``analysis.identity``; an AnalysisError asks for the ROIs when it does not decide); the regions
+    and the side may come from the options' hints (``AnalysisOptions.hinted``), which ``estimate``
+    checks against the video. ``progress(done, total)`` is called
     as frames are tracked (for clips of PROGRESS_MIN_SECONDS or more). ``tracks_csv`` receives
     every frame's row as it is measured (the left blob first as the LED while that is undecided),
     then the final table once the frame times are decided (``analysis.tracks_csv``); it is
     written before the tracks are checked, so tracks that fail a check stay on disk to look at.
     """
+    options = options.hinted()
     fps = options.fps
     video = open_frames(source, fps)
     given = _rois(video, options.led_roi, options.sphere_roi)

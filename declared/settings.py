@@ -94,12 +94,13 @@ def setting(default: Any, unit: str, help: str, range: Range | None = None, *, f
     return dataclasses.field(default=default, metadata={_KEY: Setting(unit, help, range, flag=flag, **declared)})
 
 
-def like(kind: type, name: str, **changes: Any) -> Any:
-    """A field declared as the field `name` of the dataclass `kind` is, with its default: the same
-    setting held in a second place (`changes` to its `Setting`, such as a flag of its own)."""
+def like(kind: type, name: str, *, default: Any = dataclasses.MISSING, **changes: Any) -> Any:
+    """A field declared as the field `name` of the dataclass `kind` is, with its default (or
+    `default`: None where the second place may leave it unsaid): the same setting held in a second
+    place (`changes` to its `Setting`, such as a flag of its own)."""
     field = next(field for field in dataclasses.fields(kind) if field.name == name)
     declared = dataclasses.replace(setting_of(field), **changes)
-    return dataclasses.field(default=field.default, metadata={_KEY: declared})
+    return dataclasses.field(default=field.default if default is dataclasses.MISSING else default, metadata={_KEY: declared})
 
 
 def setting_of(field: dataclasses.Field) -> Setting | None:

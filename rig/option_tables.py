@@ -8,6 +8,7 @@ from analysis import AnalysisOptions
 from analysis.shutter import ShutterOptions
 from declared.docs import markdown_table
 from rig.bench.renderers import BenchGrid
+from rig.service.bench_profile import BenchProfile
 from rig.sim.config import SimulationConfig
 
 SECTIONS = (
@@ -22,6 +23,14 @@ SECTIONS = (
         "with the defaults below), and a sweep's `[base]`, `[grid]` and `[[points]]` keys.",
     ),
     ("Calibrating a camera", ShutterOptions, True, "`rig calibrate-camera`'s options (with `--flash-hz F`, which every film needs)."),
+    (
+        "The bench profile",
+        BenchProfile,
+        False,
+        "The keys of a bench profile's `[camera]`, `[display]` and `[layout]` tables: `rig plan --bench` and `rig "
+        "calibrate-camera --bench` write it, `rig analyse --bench`, `rig measure --bench` and a sweep's `[analysis] "
+        "bench` read it, each value a hint checked against the video.",
+    ),
     (
         "The renderer bench's grid",
         BenchGrid,

@@ -8,12 +8,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from analysis.errors import AnalysisError
+from analysis.hints.hint import HintedFacts
 from analysis.options import AnalysisOptions
 from declared import NON_NEGATIVE, OPEN_UNIT, POSITIVE, Flag, Range, check, like, setting
 
 ROI = tuple[int, int, int, int]
 SOURCES = ("light", "display")
-SCANOUTS = ("top-down", "bottom-up")
 DISPLAY_GROUP = "a flashing display (its own scan-out sweeps the rows, and is accounted for)"
 
 
@@ -31,9 +31,7 @@ class ShutterOptions:
     display_hz: float | None = setting(
         None, "Hz", "the flashing display's refresh rate", POSITIVE, unset="no display", flag=Flag("--display-hz", metavar="HZ", group="display"),
     )  # fmt: skip
-    scanout: str = setting(
-        "top-down", "", "which way the display's scan-out moves in the film", choices=SCANOUTS, flag=Flag("--scanout", group="display"),
-    )  # fmt: skip
+    scanout: str = like(HintedFacts, "scanout", flag=Flag("--scanout", group="display"))
     scanout_share: float | None = setting(
         None, "", "the share of each refresh the display's scan-out takes (active lines over total lines)",
         Range(0.0, 1.0, includes_high=True), unset="0.88 to 1 allowed for", flag=Flag("--scanout-share", metavar="S", group="display"),

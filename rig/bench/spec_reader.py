@@ -9,7 +9,7 @@ from typing import TypeVar
 
 from declared import from_table
 from rig.errors import ConfigError
-from rig.service.sweep import read_toml
+from rig.toml_file import read_toml
 
 Spec = TypeVar("Spec")
 

@@ -16,15 +16,18 @@ from rig.commands import options, outputs
 from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
 from rig.commands.choices import methods_listing
 from rig.commands.declared_options import add_declared_options, config_from_args
-from rig.commands.formatting import board_line, summary_line
+from rig.commands.formatting import board_line, hints_line, summary_line
 from rig.progress import ProgressBar
 from rig.service import AnalysisRequest, analyse
 from rig.service.batch import find_videos
+from rig.service.bench_profile import read_profile, with_profile
 
 
 def _run(args: argparse.Namespace) -> int:
     videos = find_videos(args.videos)
     how = config_from_args(AnalysisOptions, args, AnalysisError)
+    if args.bench is not None:
+        how = with_profile(how, read_profile(args.bench), args.bench)
     request = AnalysisRequest(videos[0], how, board=args.board, tracks_csv=args.csv)
     if is_batch(args, videos):
         check_batch_options(args)
@@ -37,6 +40,9 @@ def _run(args: argparse.Namespace) -> int:
         print(summary_line(result))
         if board is not None:
             print(board_line(board, result))
+        hints = hints_line(result)
+        if hints is not None:
+            print(hints)
         for name, estimate in result.methods.items():
             if name != result.method:
                 ci = f" (95% {estimate.ci95_ms[0]:.2f} to {estimate.ci95_ms[1]:.2f})" if estimate.ci95_ms else ""
@@ -73,6 +79,14 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "more than one makes a batch",
     )
     add_declared_options(parser, AnalysisOptions)
+    parser.add_argument(
+        "--bench",
+        type=Path,
+        metavar="FILE.toml",
+        help="the bench profile (`rig plan --bench`, `rig calibrate-camera --bench`): its display, exposure, readout, "
+        "LED side and regions are used where the options above do not give them, each checked against the video "
+        "(a contradiction is a warning naming both)",
+    )
     parser.add_argument(
         "--board",
         type=Path,

@@ -8,25 +8,39 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
+from datetime import date
 from pathlib import Path
 
 from analysis import AnalysisError
 from analysis.shutter import ShutterOptions, ShutterResult
 from analysis.shutter.options import DISPLAY_GROUP
 from rig.cli import EXIT_WARNINGS
-from rig.commands import options
+from rig.commands import options, outputs
 from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.progress import ProgressBar
 from rig.service import CalibrationRequest, calibrate_camera
+from rig.service.bench_profile import read_profile, shutter_display, write_profile
+from rig.service.calibrate import bench_changes
 
 
 def _run(args: argparse.Namespace) -> int:
+    if args.bench is not None and args.bench.exists():
+        profile = read_profile(args.bench)
+        if args.source == "display" and args.display_hz is None:
+            vars(args).update(shutter_display(profile))
     options = config_from_args(ShutterOptions, args, AnalysisError)
     result = calibrate_camera(CalibrationRequest(args.film, args.flash_hz, options), ProgressBar("reading the film"))
     if args.json:
         print(json.dumps(result.to_dict()))
     else:
         print("\n".join(result_lines(result)))
+    if args.bench is not None:
+        write_profile(args.bench, bench_changes(result, args.film, date.today().isoformat()))
+        line = f"bench profile {args.bench}: wrote the camera's readout, exposure and frame rate" + (
+            " (the calibration came with warnings: read them)" if result.warnings else ""
+        )
+        print(line, file=sys.stderr if args.json else sys.stdout)
     return EXIT_WARNINGS if result.warnings else 0
 
 
@@ -74,5 +88,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("film", type=Path, metavar="FILM", help="video file (mp4, avi, mov, mkv) or folder of numbered images")
     parser.add_argument("--flash-hz", type=options.positive_float, required=True, metavar="F", help="the light's flash frequency (Hz)")
     add_declared_options(parser, ShutterOptions, {"display": DISPLAY_GROUP})
+    parser.add_argument(
+        "--bench",
+        type=outputs.output_file(".toml"),
+        metavar="FILE.toml",
+        help="write the readout, exposure and frame rate measured, with their 95%% intervals, into this bench profile "
+        "(made if there is none; what else it holds is kept); a flashing display without --display-hz takes its "
+        "refresh and scan-out from it",
+    )
     parser.add_argument("--json", action="store_true", help="print one JSON object, times in seconds")
     parser.set_defaults(func=_run)

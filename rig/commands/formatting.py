@@ -33,3 +33,13 @@ def board_line(board: BoardReference, result: LatencyResult) -> str:
     if lag is None:
         return line + "; the sphere's start of swing is not in the video, so the encoder's fixed nothing"
     return line + f"; the sphere left rest {lag * 1e3:.0f} ms after the encoder did"
+
+
+def hints_line(result: LatencyResult) -> str | None:
+    """What the analysis made of each value the bench profile gave (None without a profile)."""
+    if not result.hints:
+        return None
+    verdicts = [
+        f"{check.hint.name} {check.verdict}" + (f" ({check.used})" if check.verdict == "overruled" else "") for check in result.hints
+    ]
+    return "bench profile against the video: " + ", ".join(verdicts)

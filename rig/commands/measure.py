@@ -32,6 +32,7 @@ from rig.live.camera_recording import check_first_seconds, record_camera
 from rig.live.run import EXTERNAL, LiveConfig
 from rig.lsl import StreamNames
 from rig.progress import ProgressBar
+from rig.service.bench_profile import read_profile, with_profile
 
 CHECK_SECONDS = 3.0
 EXIT_DISAGREE = 1
@@ -84,14 +85,14 @@ def _self_test(args: argparse.Namespace) -> int:
         return _print(self_test(Path(scratch), duration, external=args.external, progress=bar), args.json, kept=False)
 
 
-def _guided_check(args: argparse.Namespace) -> None:
+def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:
     for step in GUIDE:
         print(step, file=sys.stderr)
     while True:
         folder = args.out / "check"
         record_camera(args.camera.removeprefix("camera:"), CHECK_SECONDS, folder, overwrite=True,
                       accept_refused=args.accept_camera_settings)  # fmt: skip
-        problems = check_first_seconds(folder / "video.avi", args.led_side)
+        problems = check_first_seconds(folder / "video.avi", led_side)
         if not problems:
             print(f"the first {CHECK_SECONDS:g} s look right: both blobs found, exposure not saturated", file=sys.stderr)
             return
@@ -116,12 +117,14 @@ def _run(args: argparse.Namespace) -> int:
         streams=None if args.no_lsl else StreamNames(args.pose_stream, args.tracker_stream, args.marker_stream),
         mirror=args.mirror, until_still=args.until_still,
     )  # fmt: skip
+    how = AnalysisOptions(led_roi=args.led_roi, sphere_roi=args.sphere_roi, led_side=args.led_side)
+    if args.bench is not None:
+        how = with_profile(how, read_profile(args.bench), args.bench)
     if args.guided:
-        _guided_check(args)
+        _guided_check(args, how.hinted().led_side)
         print("4. Filming: keep the pendulum swinging and the camera still.", file=sys.stderr)
     report = measure(
-        config, args.camera.removeprefix("camera:"), args.out, board_port=args.board,
-        options=AnalysisOptions(led_roi=args.led_roi, sphere_roi=args.sphere_roi, led_side=args.led_side),
+        config, args.camera.removeprefix("camera:"), args.out, board_port=args.board, options=how,
         accept_camera_settings=args.accept_camera_settings, overwrite=args.overwrite, progress=ProgressBar("measuring"),
     )  # fmt: skip
     return _print(report, args.json)
@@ -150,6 +153,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         help="what each frame's pose is predicted for (default: %(default)s)")  # fmt: skip
     parser.add_argument("--mirror", action="store_true", help="mirror the screen's x (when the camera sees the sphere move against the LED)")
     parser.add_argument("--led-side", choices=("left", "right"), help="which side of the video the LED is on")
+    parser.add_argument("--bench", type=Path, metavar="FILE.toml",
+                        help="the bench profile: its camera, display and layout are the video analysis's hints, each checked "
+                        "against the video (--led-side and the regions win over it)")  # fmt: skip
     parser.add_argument("--board", metavar="PORT",
                         help="the rig board's serial port or pyserial URL: it records beside the run (DIR/board), and the "
                         "photodiode's latency is given too")  # fmt: skip

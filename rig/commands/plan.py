@@ -11,9 +11,13 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from datetime import date
+from pathlib import Path
+from typing import Any
 
 from rig.commands import options, outputs
 from rig.service import Plan, PlanRequest, plan
+from rig.service.bench_profile import BenchProfile, read_profile, write_profile
 from rig.sim.pendulum import PendulumConfig
 
 EXIT_UNREACHABLE = 1
@@ -67,12 +71,27 @@ def _run(args: argparse.Namespace) -> int:
         amplitude_deg=args.amplitude_deg,
         accuracy_ms=args.accuracy_ms,
     )
+    current = read_profile(args.bench) if args.bench is not None and args.bench.exists() else BenchProfile()
     result = plan(request, _log, args.runs)
     if args.json:
         print(json.dumps(result.to_dict()))
     else:
         _print(result)
+    if args.bench is not None:
+        changes = result.bench_changes(current.camera, date.today().isoformat())
+        write_profile(args.bench, changes)
+        (_log if args.json else print)(profile_line(args.bench, changes))
     return 0 if result.recommended is not None else EXIT_UNREACHABLE
+
+
+def profile_line(path: Path, changes: dict[str, dict[str, Any]]) -> str:
+    """What the plan wrote into the bench profile."""
+    camera = changes.get("camera")
+    written = f"the display's {changes['display']['refresh_hz']:g} Hz"
+    if camera is not None:
+        written += f" and the camera's {camera['fps']:g} fps exposing {camera['exposure_ms']:.4g} ms"
+    removed = " (its readout, for another frame rate, removed: calibrate the camera at this setting)" if camera and "readout_ms" in camera else ""
+    return f"bench profile {path}: wrote {written}{removed}"
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -103,5 +122,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "--accuracy-ms", type=options.positive_float, default=1.0, help="the 95%% half-width wanted, in ms (default: %(default)s)"
     )
     parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the simulated films here (default: a temporary folder)")
+    parser.add_argument(
+        "--bench",
+        type=outputs.output_file(".toml"),
+        metavar="FILE.toml",
+        help="write the display and the recommended camera setting into this bench profile (made if there is none; "
+        "what else it holds is kept), which rig analyse --bench reads",
+    )
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=_run)

@@ -29,7 +29,9 @@ from typing import Any, Callable
 
 import analysis
 from analysis.sampling.model import bias_range_s, commensurate
+from analysis.timing import RATE_AGREEMENT
 from rig.errors import ConfigError
+from rig.service.bench_profile import CameraProfile
 from rig.service.simulate import SimulationResult, simulate
 from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
@@ -143,6 +145,28 @@ class Plan:
             f"--amplitude-deg {request.amplitude_deg:g}",
             f"rig analyse plan/video.avi --display-hz {request.display_hz:g} --exposure-ms {best.exposure_ms:.6g}",
         ]
+
+    def bench_changes(self, camera: CameraProfile, when: str) -> dict[str, dict[str, Any]]:
+        """What `rig plan --bench` writes into the bench profile (`rig.service.bench_profile`), whose
+        camera is now `camera`: the display's refresh and, where there is one, the recommended camera
+        setting (frame rate and exposure), each from this plan (`when`, a date). A readout the profile
+        holds for another frame rate (or one longer than the new frame interval) is removed: it may
+        not hold at this one, and the camera is to be calibrated again."""
+        source = f"rig plan {when}"
+        changes: dict[str, dict[str, Any]] = {"display": {"refresh_hz": self.request.display_hz, "refresh_source": source}}
+        best = self.recommended
+        if best is None:
+            return changes
+        why = f"{source}: recommended for a 95% half-width of {self.request.accuracy_ms:g} ms"
+        interval_ms = 1e3 / best.camera_fps
+        changes["camera"] = {
+            "fps": best.camera_fps, "fps_source": why,
+            "exposure_ms": float(f"{best.exposure_ms:.6g}"), "exposure_ci95_ms": None, "exposure_source": why,
+        }  # fmt: skip
+        other_rate = camera.fps is not None and abs(camera.fps - best.camera_fps) > RATE_AGREEMENT * best.camera_fps
+        if camera.readout_ms is not None and (other_rate or camera.readout_ms > interval_ms):
+            changes["camera"] |= dict.fromkeys(("readout_ms", "readout_ci95_ms", "readout_direction", "readout_source"))
+        return changes
 
     def to_dict(self) -> dict[str, Any]:
         return {

@@ -19,6 +19,7 @@ A sweep is a TOML file:
     [analysis]                   # how each video is analysed (analysis.AnalysisOptions' fields)
     method = "sinefit"
     simulated_rois = true        # the LED's and the sphere's regions the simulation knows
+    bench = "bench.toml"         # a bench profile, from the sweep's folder: its values are hints
 
 A sweep needs a [grid] or [[points]] or both; each point is the base with its settings over it.
 A cost (app_frame_ms, warp_ms) given as "measured" is this machine's GL time, as `rig simulate
@@ -32,7 +33,6 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import json
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -44,11 +44,16 @@ from rig.film_file import video_file_name
 from rig.executor import executor
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, analysed_row
+from rig.service.bench_profile import read_profile, with_profile
 from rig.service.simulate import SimulationResult, simulate
 from rig.sim.config import SimulationConfig
+from rig.toml_file import read_toml
 
 SIMULATED_ROIS = "simulated_rois"
 """The [analysis] option that analyses each video within its simulation's regions."""
+BENCH = "bench"
+"""The [analysis] option naming a bench profile (`rig.service.bench_profile`; a path from the sweep's
+folder), whose values are each video's hints, as `rig analyse --bench` takes them."""
 
 
 @dataclass(frozen=True)
@@ -108,11 +113,18 @@ class Sweep:
 
 
 def analysis_options(table: Mapping[str, Any]) -> AnalysisOptions:
-    """The analysis options a sweep's [analysis] table gives (besides SIMULATED_ROIS), every key and value checked."""
+    """The analysis options a sweep's [analysis] table gives (besides SIMULATED_ROIS), every key and
+    value checked, with the hints of the bench profile it names (BENCH)."""
     try:
-        return from_table(AnalysisOptions, {k: v for k, v in table.items() if k != SIMULATED_ROIS}, AnalysisError, "[analysis]")
+        options = from_table(
+            AnalysisOptions, {k: v for k, v in table.items() if k not in (SIMULATED_ROIS, BENCH)}, AnalysisError, "[analysis]"
+        )
     except AnalysisError as error:
         raise ConfigError(str(error)) from None
+    if BENCH not in table:
+        return options
+    path = Path(table[BENCH])
+    return with_profile(options, read_profile(path), path)
 
 
 def _dotted(mapping: Mapping[str, Any]) -> dict[str, Any]:
@@ -200,16 +212,6 @@ def write_sweep(sweep: Sweep, path: Path, comment: str = "") -> None:
         raise ConfigError(f"cannot write the sweep {path}: {error.strerror}") from None
 
 
-def read_toml(path: Path, what: str) -> dict[str, Any]:
-    """The tables of a TOML file (`what` it is, for the message); ConfigError if it cannot be read."""
-    try:
-        return tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except OSError as error:
-        raise ConfigError(f"cannot read the {what} {path}: {error.strerror}") from None
-    except tomllib.TOMLDecodeError as error:
-        raise ConfigError(f"{path} is not valid TOML: {error}") from None
-
-
 def read_sweep(path: Path) -> Sweep:
     """A sweep from its TOML file; ConfigError naming what is wrong."""
     spec = read_toml(path, "sweep")
@@ -229,6 +231,10 @@ def read_sweep(path: Path) -> Sweep:
         if "labels" in point and not isinstance(point["labels"], dict):
             raise ConfigError(f"{path}: point {number}'s labels must be a table of names and values")
     analysis = spec.get("analysis", {})
+    if BENCH in analysis:
+        if not isinstance(analysis[BENCH], str):
+            raise ConfigError(f"{path}: [analysis] {BENCH} is the path of a bench profile, not {analysis[BENCH]!r}")
+        analysis = {**analysis, BENCH: str(Path(path).parent / analysis[BENCH])}
     try:
         analysis_options(analysis)
     except ConfigError as error:

@@ -1,5 +1,5 @@
-"""`rig calibrate-camera FILM --flash-hz F`: the readout and exposure of a simulated camera, printed
-or as JSON; one line and exit status 2 where the film or the options cannot decide."""
+"""`rig calibrate-camera FILM --flash-hz F`: the readout and exposure of a simulated camera, printed,
+as JSON or into a bench profile; one line and exit status 2 where the film or the options cannot decide."""
 
 import json
 from pathlib import Path
@@ -8,6 +8,7 @@ import pytest
 
 from rig.cli import main
 from rig.service import SimulationConfig, simulate
+from rig.service.bench_profile import read_profile
 from rig.sim.camera import CameraConfig
 from rig.sim.flash import FlashTarget
 
@@ -70,3 +71,17 @@ def test_the_flash_frequency_is_required(light_film, capsys):
         main(["calibrate-camera", str(light_film)])
     assert exit_.value.code == 2
     assert "--flash-hz" in capsys.readouterr().err
+
+
+def test_bench_writes_the_measured_readout_exposure_and_frame_rate_into_the_profile(light_film, tmp_path, capsys):
+    profile = tmp_path / "bench.toml"
+    profile.write_text('# our phone\n[display]\nrefresh_hz = 60.0\n')
+    assert main(["calibrate-camera", str(light_film), "--flash-hz", str(FLASH_HZ), "--duty", "0.25", "--bench", str(profile)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == f"bench profile {profile}: wrote the camera's readout, exposure and frame rate"
+    camera = read_profile(profile).camera
+    assert camera.readout_ms == pytest.approx(READOUT_S * 1e3, rel=0.05)
+    assert camera.exposure_ms == pytest.approx(EXPOSURE_S * 1e3, rel=0.10)
+    assert camera.fps == pytest.approx(120.0, rel=1e-4) and camera.readout_direction == "top-down"
+    assert camera.readout_ci95_ms[0] <= READOUT_S * 1e3 <= camera.readout_ci95_ms[1]
+    assert camera.readout_source.startswith("rig calibrate-camera ") and camera.readout_source.endswith(f"from {light_film.name}")
+    assert profile.read_text().startswith("# our phone\n[display]\nrefresh_hz = 60.0\n")
