@@ -19,7 +19,7 @@ import cv2
 import numpy as np
 
 from analysis.errors import AnalysisError
-from analysis.tracking import BlobModel, Roi, calibrate_blob, find_moving_regions
+from analysis.blobs import BlobModel, Roi, calibrate_blob, find_moving_regions
 from analysis.video.frames import Frame
 
 # The first frames, up to this long, are held in memory to find the ROIs and their backgrounds

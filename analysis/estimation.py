@@ -33,7 +33,7 @@ from analysis.sampling.residuals import timing_residuals
 from analysis.readout import RollingShutter, rolling_shutter
 from analysis.swing import during, measure_swing
 from analysis.timing import implausible_period_warning
-from analysis.tracking import Track
+from analysis.blobs import Track
 from analysis.tracks import Tracks
 from analysis.windows import windowed_latency
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.sampling.exposure import SATURATED_LEVEL
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 DECISION_MARGIN = 3.0
 SMOOTHING_PERIODS = 0.08

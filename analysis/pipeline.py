@@ -14,7 +14,7 @@ from analysis.estimators.contract import Estimator
 from analysis.estimators.registry import estimators_for
 from analysis.options import AnalysisOptions
 from analysis.result import LatencyResult
-from analysis.tracking import Track
+from analysis.blobs import Track
 from analysis.tracks import track
 
 

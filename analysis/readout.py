@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.errors import AnalysisError
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 # A given readout may exceed the median frame interval by this fraction (a camera's nominal rate
 # against the timestamps) before it is refused.

@@ -9,7 +9,7 @@ from analysis.cycles import CycleResolution
 from analysis.misfit import MisfitReport
 from analysis.sampling import SamplingBias
 from analysis.readout import RollingShutter
-from analysis.tracking import Roi, Track
+from analysis.blobs import Roi, Track
 from analysis.windows import WindowedLatency
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.errors import AnalysisError
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 # A track whose displacement along its axis has a smaller standard deviation does not move.
 MIN_MOTION_PX = 0.5

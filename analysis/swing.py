@@ -19,7 +19,7 @@ import numpy as np
 from analysis.onset import departure_time, stop_time
 from analysis.phase import estimate_frequency
 from analysis.signals import SwingSignals, swing_signals
-from analysis.tracking import Track
+from analysis.blobs import Track
 from analysis.windows import WindowPhases, damping_rate, window_phases
 
 # The swing is analysed up to this long before the first blob stops (a hand slowing the pendulum

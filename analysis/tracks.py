@@ -40,7 +40,7 @@ from analysis.options import AnalysisOptions
 from analysis.phase import estimate_frequency
 from analysis.signals import swing_signals
 from analysis.timing import FrameTimes, check_count, frame_times, recorder_repeats
-from analysis.tracking import BlobTracker, Detection, Roi, Track
+from analysis.blobs import BlobTracker, Detection, Roi, Track
 from analysis.tracks_csv import TrackStream, write_tracks_csv
 from analysis.video.file import VideoFile
 from analysis.video.frames import Crop, Frame, FrameSource, Repeats

@@ -22,7 +22,7 @@ from typing import TextIO
 import numpy as np
 
 from analysis.errors import AnalysisError
-from analysis.tracking import Detection, Track
+from analysis.blobs import Detection, Track
 
 TRACKS_CSV_HEADER = (
     "frame", "stamp_s", "t",

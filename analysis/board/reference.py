@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from analysis.onset import departure_time
-from analysis.tracking import Track
+from analysis.blobs import Track
 from analysis.board.blink_code import BlinkAlignment, align_blink_code
 from analysis.board.photodiode_latency import EncoderTrajectory, encoder_trajectory
 from analysis.board.recording import ENCODER, LED, load_table

@@ -26,7 +26,7 @@ from analysis.sampling.model import commensurate
 from analysis.sampling.rates import RATE_TOLERANCE
 from analysis.sampling.residuals import TimingResiduals
 from analysis.sampling.rows import SphereRows
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 # Residuals may be correlated over this fraction of a swing period.
 CORRELATION_PERIODS = 0.1

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 # A pixel at this level or above is saturated (8-bit video).
 SATURATED_LEVEL = 254.5

@@ -18,7 +18,7 @@ import numpy as np
 
 from analysis.longrun import long_run_variance
 from analysis.signals import SwingSignals
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 
 @dataclass(frozen=True)

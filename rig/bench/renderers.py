@@ -2,7 +2,7 @@
 load sizes and display resolutions, measure the image error of warped frames against direct
 renders, and the latency `rig analyse` finds in simulated videos whose clock every frame's measured
 cost drives (--server-ms models the warp server instead, labelled). --seed-table sets this
-machine's latencies beside the seeds' Table 2; --variants plots image error against latency saved
+machine's latencies beside Smit et al.'s (2010, Table 2); --variants plots image error against latency saved
 for each warp variant; --photon-residual films each predictor aimed at the photons and at
 scan-out. The grid is a spec file, the grid's options override it; its latency films are written
 beside the runs as films.toml, which `rig sweep` films again. The default grid takes several
@@ -118,7 +118,7 @@ class BenchGrid:
     server_ms: float | None = setting(
         None, "ms", "the warp server's modelled cost in the latency films", POSITIVE, unset="measured here, as every other cost"
     )
-    predictor: str = setting("hold", "", "the latency films' predictor, both renderers alike (as the seeds' Table 2)")
+    predictor: str = setting("hold", "", "the latency films' predictor, both renderers alike (as in Smit et al. 2010, Table 2)")
     direct_predictor: str | None = setting(
         None, "", "the direct renderer's predictor in the latency films, where it differs", unset="the same"
     )
@@ -358,7 +358,7 @@ def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
     parser.add_argument("--warp", metavar="SPEC", help="the warp renderer and its options, e.g. warp:recon=grid,views=2 (default: warp)")
     parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants, --seed-table: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
-    parser.add_argument("--predictor", help="the predictor of every latency run, both renderers alike (default: the spec's, hold, as the seeds' Table 2)")
+    parser.add_argument("--predictor", help="the predictor of every latency run, both renderers alike (default: the spec's, hold, as in Smit et al. 2010, Table 2)")
     parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")
     parser.add_argument("--server-ms", type=options.positive_float, metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
 

@@ -231,7 +231,7 @@ def _options(parser: argparse.ArgumentParser) -> None:
 
 BENCH = Bench(
     name="seed-table",
-    help="the seeds' Table 2 beside this machine's (see rig.bench.seed_table)",
+    help="Smit et al.'s latencies (2010, Table 2) beside this machine's (see rig.bench.seed_table)",
     spec=spec, run=run, table=seed_table_text,
     record=lambda rows: plain(rows + seed_rows()),
     plot=_plot, options=_options,

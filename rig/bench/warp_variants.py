@@ -112,7 +112,7 @@ def variants_text(rows: list[dict[str, Any]]) -> str:
 
 def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--variant", action="append", metavar="SPEC",
-                        help="a warp variant for --variants; repeat for several (default: the seeds' features one by one)")  # fmt: skip
+                        help="a warp variant for --variants; repeat for several (default: each published warp feature in turn: reconstructions, two views, hole levels, low-pass fill, spin)")  # fmt: skip
 
 
 BENCH = Bench(

@@ -5,7 +5,7 @@ import pytest
 
 from analysis import AnalysisError, AnalysisOptions, analyse, track
 from analysis.identity import SATURATION_WEIGHT, decide, step_score
-from analysis.tracking import Roi
+from analysis.blobs import Roi
 from rig.cli import EXIT_USER_ERROR, main
 
 # 60 fps on a 60 Hz display (no steps to see), a dim LED (no saturation) the sphere's size, the LED

@@ -9,7 +9,7 @@ import pytest
 
 from analysis import AnalysisError, AnalysisOptions, analyse
 from analysis.plots import plot_tracks
-from analysis.tracking import Track
+from analysis.blobs import Track
 from analysis.tracks import check_track
 
 EVIDENCE_RULE = "auto: by physical evidence"

@@ -9,7 +9,7 @@ from analysis import AnalysisOptions, estimate, track
 from analysis.misfit import check_fit
 from analysis.sampling.residuals import TimingResiduals
 from analysis.swing import measure_swing
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 # The scene's camera: 240 fps exposing whole frames with a global shutter, filming a 60 Hz display.
 KNOWN = {"display_hz": 60.0, "exposure_ms": 1e3 / 240.0, "readout_ms": 0.0}

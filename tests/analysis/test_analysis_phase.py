@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from analysis.errors import AnalysisError
 from analysis.phase import estimate_frequency, fft_phase_latency, wrap_phase
 from analysis.signals import SwingSignals, axis_signal, binned, main_axis
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 
 def damped_sine(t: np.ndarray, period: float, phase: float, decay: float, duration: float) -> np.ndarray:

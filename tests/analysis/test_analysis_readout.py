@@ -17,7 +17,7 @@ import pytest
 
 from analysis import AnalysisError, AnalysisOptions, Tracks, estimate
 from analysis.timing import FrameTimes
-from analysis.tracking import Roi, Track
+from analysis.blobs import Roi, Track
 
 FPS = 240.0
 HEIGHT = 480

@@ -12,7 +12,7 @@ from analysis.board.blink_code import BlinkSchedule
 from analysis.board.reference import EVENT_NAME, BoardReference, lit_frames
 from analysis.errors import AnalysisError
 from analysis.onset import departure_time
-from analysis.tracking import Track
+from analysis.blobs import Track
 from rig.board.events import EncoderEdge, LedChange
 from rig.board.recorder import BoardRecorder
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from analysis.sampling.exposure import exposure_from_blur, given_exposure, saturation_excess
-from analysis.tracking import Track
+from analysis.blobs import Track
 
 FPS = 120.0
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from analysis.errors import AnalysisError
-from analysis.tracking import WINDOW_MARGIN_PX, BlobModel, BlobTracker, Roi, calibrate_blob, find_moving_regions
+from analysis.blobs import WINDOW_MARGIN_PX, BlobModel, BlobTracker, Roi, calibrate_blob, find_moving_regions
 
 WIDTH, HEIGHT = 64, 48
 
