@@ -26,20 +26,23 @@ import numpy as np
 
 from analysis.sampling.model import exposure_bias
 from analysis.sampling.residuals import TimingResiduals
-from analysis.sampling.rows import SphereRows, disc_kernel, shift_kernel, smeared
+from analysis.sampling.rows import SphereRows, disc_kernel, shift_kernel
 
 PHASE_BINS = 512
 
 
 class Folding:
     """The residuals' sums per phase bin at a refresh rate, the frames at ``times`` (their frame
-    times; residuals.t by default): W = sum v^2 and X = sum v r."""
+    times; residuals.t by default): W = sum v^2 and X = sum v r, and their spectra."""
 
     def __init__(self, residuals: TimingResiduals, refresh_hz: float, bins: int, times: np.ndarray | None = None) -> None:
         phase = refresh_hz * (residuals.t if times is None else times)
+        self.bins = bins
         self.index = ((phase - np.floor(phase)) * bins).astype(np.int64) % bins
         self.w = np.bincount(self.index, residuals.v**2, bins)
         self.x = np.bincount(self.index, residuals.v * residuals.r, bins)
+        self.w_spectrum = np.fft.rfft(self.w)
+        self.x_spectrum = np.fft.rfft(self.x)
 
     def explained(self) -> float:
         """The sum of squares a free timing offset per bin explains."""
@@ -47,35 +50,26 @@ class Folding:
         return float(np.sum(self.x[used] ** 2 / self.w[used]))
 
 
-@dataclass(frozen=True)
-class Kernels:
-    """How a slope smears the model (weights per phase bin, see ``analysis.sampling.rows``): over the
-    sphere's rows (rows), and over the frames' shifts weighted as the timing weighs them, by v^2
-    (shifts)."""
-
-    rows: np.ndarray
-    shifts: np.ndarray
-
-
-def point_kernels(bins: int = PHASE_BINS) -> Kernels:
-    """A point sphere on one row: no smearing."""
-    delta = np.zeros(bins)
-    delta[0] = 1.0
-    return Kernels(delta, delta)
-
-
-def kernels(residuals: TimingResiduals, rate: float, rows: SphereRows, slope: float, bins: int = PHASE_BINS) -> Kernels:
-    """The kernels of ``slope`` (s per row) at ``rate``."""
+def kernel_spectrum(residuals: TimingResiduals, rate: float, rows: SphereRows, slope: float, bins: int = PHASE_BINS) -> np.ndarray:
+    """The spectrum of what a slope (s per row) smears the model by at ``rate`` (see
+    ``analysis.sampling.rows``): the sphere's rows, and the frames' shifts weighted as the timing
+    weighs them, by v^2."""
     radius = rate * abs(slope) * rows.radius_px
-    return Kernels(disc_kernel(radius, bins), shift_kernel(rate * rows.shifts(slope), residuals.v**2, bins))
+    shifts = shift_kernel(rate * rows.shifts(slope), residuals.v**2, bins)
+    return np.fft.rfft(disc_kernel(radius, bins)) * np.fft.rfft(shifts)
 
 
-def bias_table(rate: float, exposures_s: np.ndarray, bins: int = PHASE_BINS, smear: Kernels | None = None) -> np.ndarray:
-    """The bias (s) of ``rate`` per exposure and phase bin, smeared by the kernels of a slope (none by default)."""
-    smear = point_kernels(bins) if smear is None else smear
+def bias_spectrum(rate: float, exposures_s: np.ndarray, bins: int = PHASE_BINS) -> np.ndarray:
+    """The spectrum along the phase bins of the bias (s) of ``rate`` per exposure, for a point."""
     centres = (np.arange(bins) + 0.5) / bins
-    g = exposure_bias(centres[None, :], exposures_s[:, None] * rate)
-    return smeared(smeared(g, smear.rows), smear.shifts) / rate
+    return np.fft.rfft(exposure_bias(centres[None, :], exposures_s[:, None] * rate) / rate, axis=1)
+
+
+def bias_table(rate: float, exposures_s: np.ndarray, bins: int = PHASE_BINS, kernel: np.ndarray | None = None) -> np.ndarray:
+    """The bias (s) of ``rate`` per exposure and phase bin, smeared by a slope's ``kernel`` spectrum
+    (none by default)."""
+    spectrum = bias_spectrum(rate, exposures_s, bins)
+    return np.fft.irfft(spectrum if kernel is None else spectrum * kernel, bins, axis=1)
 
 
 @dataclass(frozen=True)
@@ -90,19 +84,26 @@ class Fit:
     mean: np.ndarray
 
 
-def fit_one(residuals: TimingResiduals, table: np.ndarray, folding: Folding) -> tuple[np.ndarray, np.ndarray]:
-    """(misfit, mean bias) of the bias ``table`` (exposures, bins) for every exposure and phase
-    j / bins, the frames folded by ``folding``: each phase a circular shift of the per-bin model,
-    so a few FFTs."""
-    bins = table.shape[1]
+def fit_one(residuals: TimingResiduals, spectrum: np.ndarray, folding: Folding) -> tuple[np.ndarray, np.ndarray]:
+    """(misfit, mean bias) of the bias table whose ``spectrum`` (exposures, bins / 2 + 1) is given, for
+    every exposure and phase j / bins, the frames folded by ``folding``: each phase a circular shift
+    of the per-bin model, so a few FFTs."""
+    bins = folding.bins
 
     def correlate(values: np.ndarray, table: np.ndarray) -> np.ndarray:
-        return np.fft.irfft(np.conj(np.fft.rfft(values))[None, :] * np.fft.rfft(table, axis=1), bins, axis=1)
+        return np.fft.irfft(np.conj(values)[None, :] * table, bins, axis=1)
 
+    table = np.fft.irfft(spectrum, bins, axis=1)
     total_w, total_x = folding.w.sum(), folding.x.sum()
-    mean = correlate(folding.w, table) / max(total_w, 1e-300)
+    mean = correlate(folding.w_spectrum, spectrum) / max(total_w, 1e-300)
     squares = float(residuals.r @ residuals.r)
-    misfit = squares + 2 * correlate(folding.x, table) - 2 * mean * total_x + correlate(folding.w, table**2) - mean**2 * total_w
+    misfit = (
+        squares
+        + 2 * correlate(folding.x_spectrum, spectrum)
+        - 2 * mean * total_x
+        + correlate(folding.w_spectrum, np.fft.rfft(table**2, axis=1))
+        - mean**2 * total_w
+    )
     return misfit, mean
 
 
@@ -114,10 +115,11 @@ def fit(
     if slopes is None:
         slopes = rows.slopes(rate) if rows is not None else np.zeros(1)
     folding = Folding(residuals, rate, PHASE_BINS, rows.frame_times(residuals.t) if rows is not None else None)
+    point = bias_spectrum(rate, exposures_s)
     misfits, means = [], []
     for slope in slopes:
-        smear = kernels(residuals, rate, rows, float(slope)) if rows is not None else None
-        misfit, mean = fit_one(residuals, bias_table(rate, exposures_s, PHASE_BINS, smear), folding)
+        spectrum = point * kernel_spectrum(residuals, rate, rows, float(slope)) if rows is not None else point
+        misfit, mean = fit_one(residuals, spectrum, folding)
         misfits.append(misfit)
         means.append(mean)
     return Fit(rate, slopes, folding, np.stack(misfits), np.stack(means))
@@ -127,6 +129,6 @@ def frame_biases(residuals: TimingResiduals, fitted: Fit, rows: SphereRows | Non
     """Per frame, the bias (s) of the hypothesis ``at`` = (slope, exposure, phase) indices of
     ``fitted``, at ``exposure_s``: its phase bin's."""
     slope_index, _, phase_index = at
-    smear = kernels(residuals, fitted.rate, rows, float(fitted.slopes[slope_index])) if rows is not None else None
-    table = bias_table(fitted.rate, np.array([exposure_s]), PHASE_BINS, smear)
+    kernel = kernel_spectrum(residuals, fitted.rate, rows, float(fitted.slopes[slope_index])) if rows is not None else None
+    table = bias_table(fitted.rate, np.array([exposure_s]), PHASE_BINS, kernel)
     return table[0][(fitted.folding.index + phase_index) % PHASE_BINS]

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from analysis.sampling.folding import Folding, bias_table, fit_one
+from analysis.sampling.folding import Folding, bias_spectrum, fit_one
 from analysis.sampling.residuals import TimingResiduals
 
 COMMON_REFRESH_HZ = (50.0, 59.94, 60.0, 72.0, 75.0, 85.0, 90.0, 100.0, 119.88, 120.0, 144.0, 165.0, 240.0)
@@ -55,10 +55,10 @@ def tuned_rate(residuals: TimingResiduals, nominal_hz: float, exposures_s: np.nd
         return nominal_hz
 
     # Within the tolerance the model hardly changes: only the folding moves.
-    table = bias_table(nominal_hz, exposures_s, TUNING_BINS)
+    spectrum = bias_spectrum(nominal_hz, exposures_s, TUNING_BINS)
 
     def misfit(rate: float) -> float:
-        return float(fit_one(residuals, table, Folding(residuals, rate, TUNING_BINS, times))[0].min())
+        return float(fit_one(residuals, spectrum, Folding(residuals, rate, TUNING_BINS, times))[0].min())
 
     coarse = min(half, COARSE_STEPS * fine)
     rates = nominal_hz + coarse * np.arange(-math.floor(half / coarse), math.floor(half / coarse) + 1)

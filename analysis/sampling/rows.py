@@ -10,7 +10,7 @@ m = kappa - r.
 
 So each frame's bias is not g at one phase (``analysis.sampling.model``) but g averaged over the
 sphere's rows, each at its own phase: g smeared by the sphere's row profile scaled by f m
-(``disc_kernel``, ``smeared``), and the centroid's phase moves as the sphere moves up and down the
+(``disc_kernel``), and the centroid's phase moves as the sphere moves up and down the
 frame: its phase is frac(f t_k - f m dy + phi), t_k the frame's time and dy its row less its mean.
 Frames are compared with the model by the phase of their frame time alone (``frame_times``: a
 sample dated by its rows, a readout given, less what the dating added), so the centroid's moves are
@@ -131,12 +131,3 @@ def shift_kernel(shifts: np.ndarray, weights: np.ndarray, bins: int) -> np.ndarr
         kernel[0] = 1.0
         return kernel
     return kernel / total
-
-
-def smeared(tables: np.ndarray, kernel: np.ndarray) -> np.ndarray:
-    """Per-bin tables (..., bins) over the phase convolved with ``kernel`` (weights per bin, bin 0 at
-    a shift of 0): table(s) averaged over table(s - shift), the shifts distributed as the kernel."""
-    bins = tables.shape[-1]
-    if kernel[0] == 1.0:
-        return tables
-    return np.fft.irfft(np.fft.rfft(tables, axis=-1) * np.fft.rfft(kernel), bins, axis=-1)
