@@ -20,12 +20,16 @@ A sweep is a TOML file:
     method = "sinefit"
     simulated_rois = true        # the LED's and the sphere's regions the simulation knows
     bench = "bench.toml"         # a bench profile, from the sweep's folder: its values are hints
+    simulated_bench = true       # or each point's own bench: its camera, display and LED's side
 
 A sweep needs a [grid] or [[points]] or both; each point is the base with its settings over it.
 A cost (app_frame_ms, warp_ms) given as "measured" is this machine's GL time, as `rig simulate
 --app-frame-ms measured` takes it. With `simulated_rois`, each video is analysed within the regions
 where its simulation put the LED and the sphere (truth.json), as a lab marks them once for its
-camera, instead of the analyser finding them. `write_sweep` writes a sweep in this form.
+camera, instead of the analyser finding them. With `simulated_bench`, each video's hints are its own
+simulation's camera (frame rate, exposure, readout), display (refresh rate, scan-out top-down) and
+the LED's side, as a lab whose bench profile is right gives them, each checked against the film as
+any profile's are. `write_sweep` writes a sweep in this form.
 """
 
 from __future__ import annotations
@@ -44,12 +48,16 @@ from rig.film_file import video_file_name
 from rig.executor import executor
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, analysed_row
-from rig.service.bench_profile import read_profile, with_profile
+from rig.service.bench_profile import BenchProfile, CameraProfile, DisplayProfile, LayoutProfile, read_profile, with_profile
 from rig.service.simulate import SimulationResult, simulate
 from rig.sim.config import SimulationConfig
+from rig.sim.layout import placement
 from rig.toml_file import read_toml
 
 SIMULATED_ROIS = "simulated_rois"
+SIMULATED_BENCH = "simulated_bench"
+"""The [analysis] option that gives each video its own simulation's bench as hints."""
+FLAGS = (SIMULATED_ROIS, SIMULATED_BENCH)
 """The [analysis] option that analyses each video within its simulation's regions."""
 BENCH = "bench"
 """The [analysis] option naming a bench profile (`rig.service.bench_profile`; a path from the sweep's
@@ -59,7 +67,8 @@ folder), whose values are each video's hints, as `rig analyse --bench` takes the
 @dataclass(frozen=True)
 class SweepPoint:
     """One point of a sweep: its simulation, its labels (the grid's values, or an explicit point's),
-    its run folder, its analysis, and whether that takes the simulation's regions (SIMULATED_ROIS)."""
+    its run folder, its analysis, and whether that takes the simulation's regions (SIMULATED_ROIS)
+    and its bench (SIMULATED_BENCH)."""
 
     index: int
     config: SimulationConfig
@@ -67,13 +76,14 @@ class SweepPoint:
     out_dir: Path
     analysis: AnalysisRequest
     simulated_rois: bool = False
+    simulated_bench: bool = False
 
 
 @dataclass(frozen=True)
 class Sweep:
     """base: settings every point shares; grid: settings and the values each takes (every
     combination is a point); explicit: points given one by one (dotted settings, and optionally
-    their labels under "labels"); analysis: `AnalysisOptions` settings, and SIMULATED_ROIS."""
+    their labels under "labels"); analysis: `AnalysisOptions` settings, and the FLAGS."""
 
     base: dict[str, Any]
     grid: dict[str, list[Any]]
@@ -102,22 +112,22 @@ class Sweep:
 
     def points(self, out: Path) -> list[SweepPoint]:
         options = analysis_options(self.analysis)
-        rois = bool(self.analysis.get(SIMULATED_ROIS, False))
+        rois, bench = (bool(self.analysis.get(flag, False)) for flag in FLAGS)
         points = []
         for index, (settings, labels) in enumerate(self.settings()):
             folder = out / f"point{index:03d}"
             config = build(SimulationConfig, settings)
             request = AnalysisRequest(folder / video_file_name(config.camera.container), options)
-            points.append(SweepPoint(index, config, labels, folder, request, rois))
+            points.append(SweepPoint(index, config, labels, folder, request, rois, bench))
         return points
 
 
 def analysis_options(table: Mapping[str, Any]) -> AnalysisOptions:
-    """The analysis options a sweep's [analysis] table gives (besides SIMULATED_ROIS), every key and
+    """The analysis options a sweep's [analysis] table gives (besides FLAGS), every key and
     value checked, with the hints of the bench profile it names (BENCH)."""
     try:
         options = from_table(
-            AnalysisOptions, {k: v for k, v in table.items() if k not in (SIMULATED_ROIS, BENCH)}, AnalysisError, "[analysis]"
+            AnalysisOptions, {k: v for k, v in table.items() if k not in (*FLAGS, BENCH)}, AnalysisError, "[analysis]"
         )
     except AnalysisError as error:
         raise ConfigError(str(error)) from None
@@ -231,6 +241,8 @@ def read_sweep(path: Path) -> Sweep:
         if "labels" in point and not isinstance(point["labels"], dict):
             raise ConfigError(f"{path}: point {number}'s labels must be a table of names and values")
     analysis = spec.get("analysis", {})
+    if BENCH in analysis and analysis.get(SIMULATED_BENCH, False):
+        raise ConfigError(f"{path}: [analysis] gives both a {BENCH} profile and {SIMULATED_BENCH}: keep one")
     if BENCH in analysis:
         if not isinstance(analysis[BENCH], str):
             raise ConfigError(f"{path}: [analysis] {BENCH} is the path of a bench profile, not {analysis[BENCH]!r}")
@@ -239,8 +251,9 @@ def read_sweep(path: Path) -> Sweep:
         analysis_options(analysis)
     except ConfigError as error:
         raise ConfigError(f"{path}: {error}") from None
-    if not isinstance(analysis.get(SIMULATED_ROIS, False), bool):
-        raise ConfigError(f"{path}: [analysis] {SIMULATED_ROIS} is true or false, not {analysis[SIMULATED_ROIS]!r}")
+    for flag in FLAGS:
+        if not isinstance(analysis.get(flag, False), bool):
+            raise ConfigError(f"{path}: [analysis] {flag} is true or false, not {analysis[flag]!r}")
     return Sweep(spec.get("base", {}), grid, analysis, explicit)
 
 
@@ -263,11 +276,29 @@ def simulate_and_analyse(point: SweepPoint) -> PointRun:
     if point.simulated_rois:
         rois = dataclasses.replace(request.options, led_roi=tuple(truth.led_roi), sphere_roi=tuple(truth.sphere_roi))
         request = dataclasses.replace(request, options=rois)
+    if point.simulated_bench:
+        told = with_profile(request.options, simulated_bench(point.config), point.out_dir / "truth.json")
+        request = dataclasses.replace(request, options=told)
     row, result = analysed_row(BatchItem(request, point.labels))
     row["index"] = point.index
     row["truth_ms"] = truth.latency_ms
     row["error_ms"] = row["latency_ms"] - truth.latency_ms if row["latency_ms"] is not None else None
     return PointRun(row, simulation, result)
+
+
+def simulated_bench(config: SimulationConfig) -> BenchProfile:
+    """The bench profile of a simulated run, as a lab that knows its bench writes it."""
+    camera, source = config.camera, "the simulation"
+    place = placement(config.layout)
+    left = place.led[0] < place.display[0]
+    return BenchProfile(
+        CameraProfile(
+            fps=camera.film_fps, fps_source=source, exposure_ms=camera.exposure * 1e3, exposure_source=source,
+            readout_ms=camera.readout_s * 1e3, readout_source=source,
+        ),
+        DisplayProfile(refresh_hz=config.display.refresh_hz, refresh_source=source, scanout="top-down", scanout_source=source),
+        LayoutProfile(led_side="left" if left != camera.impairments.mirrored else "right", source=source),
+    )  # fmt: skip
 
 
 def run_point(point: SweepPoint) -> dict[str, Any]:

@@ -7,9 +7,10 @@ from pathlib import Path
 
 import pytest
 
+from analysis.hints.hint import CONTRADICTS
 from rig.errors import ConfigError
 from rig.service import sweep as sweep_service
-from rig.service.sweep import SIMULATED_ROIS, Sweep, build, read_sweep, run_sweep, settings_of, write_sweep
+from rig.service.sweep import SIMULATED_BENCH, SIMULATED_ROIS, Sweep, build, read_sweep, run_sweep, settings_of, simulated_bench, write_sweep
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
@@ -100,6 +101,8 @@ camera = { fps = 120.0, impairments = { dim_led = 0.35 } }
         ("points = [1]\n", "list of tables"),
         ("[[points]]\nlabels = 3\n", "labels must be a table"),
         ("[grid]\nseed = [1]\n[analysis]\nsimulated_rois = 1\n", "simulated_rois is true or false"),
+        ("[grid]\nseed = [1]\n[analysis]\nsimulated_bench = \"yes\"\n", "simulated_bench is true or false"),
+        ("[grid]\nseed = [1]\n[analysis]\nsimulated_bench = true\nbench = \"b.toml\"\n", "both a bench profile and simulated_bench"),
     ],
 )
 def test_a_bad_sweep_file_says_what_is_wrong(tmp_path: Path, text: str, message: str) -> None:
@@ -153,3 +156,31 @@ def test_a_sweep_with_simulated_rois_analyses_each_video_within_its_simulations_
     truth = json.loads((tmp_path / "out" / "point000" / "truth.json").read_text())
     assert [(r.options.led_roi, r.options.sphere_roi) for r in requests] == [(tuple(truth["led_roi"]), tuple(truth["sphere_roi"]))]
     assert abs(rows[0]["error_ms"]) < 1.0
+
+
+def test_a_simulated_bench_is_each_points_own_camera_display_and_led_side() -> None:
+    config = SimulationConfig(
+        camera=CameraConfig(fps=120.0, exposure_s=0.004, readout_s=0.006, impairments=FilmImpairments(mirrored=True)),
+        layout="led-above",
+    )
+    profile = simulated_bench(config)
+    assert (profile.camera.fps, profile.camera.exposure_ms, profile.camera.readout_ms) == (120.0, 4.0, 6.0)
+    assert profile.display.refresh_hz == config.display.refresh_hz and profile.layout.led_side == "right"
+    assert simulated_bench(SimulationConfig(layout="0.75,0.5,0.3/0.3,0.5,0.4")).layout.led_side == "right"
+
+
+def test_a_sweep_with_a_simulated_bench_analyses_each_video_told_its_own_bench(tmp_path: Path) -> None:
+    spec = tmp_path / "sweep.toml"
+    spec.write_text(
+        "[[points]]\nduration_s = 3.0\nlayout = \"led-above\"\n"
+        "camera = { fps = 120.0, readout_s = 0.006, width = 320, height = 240, subsamples = 4 }\n"
+        f"[analysis]\nmethod = \"sinefit\"\n{SIMULATED_BENCH} = true\n"
+    )
+    point = read_sweep(spec).points(tmp_path / "out")[0]
+    run = sweep_service.simulate_and_analyse(point)
+    told = {check.hint.name: check for check in run.result.hints}
+    assert told["readout_ms"].hint.value == 6.0 and told["readout_ms"].hint.source.endswith("truth.json [camera] readout_ms: the simulation")
+    assert CONTRADICTS not in (told["led_side"].verdict, told["display_hz"].verdict, told["exposure_ms"].verdict)
+    low, high = run.result.ci95_ms
+    assert run.result.to_dict()["rolling_shutter"]["readout_source"] != "bounded"
+    assert low <= run.simulation.truth.latency_ms <= high and abs(run.row["error_ms"]) < 0.3
