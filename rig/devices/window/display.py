@@ -35,6 +35,9 @@ from rig.errors import ConfigError, RigError
 CALIBRATION_SWAPS = 90
 """Swaps of a dark image at connect that measure the refresh (1.5 s at 60 Hz)."""
 KEEP_MEASURED = 512
+EARLY_SWAP_GUARD = 0.1
+"""An image held for a later refresh is swapped this share of a period after the blank before it:
+a vsync swap then lands at the blank it was held for, not the one before."""
 SWAP_COLUMNS = (
     "image", "aimed_refresh", "refresh", "late", "t_ready", "t_drawn", "t_swap_call", "t_swap", "t_blank_driver",
     "t_gpu_done",
@@ -182,12 +185,14 @@ class WindowDisplay:
         return self.vblank_time(k) + float(np.clip(row_fraction, 0.0, 1.0)) * self.scanout_fraction * self.period_s
 
     def present(self, image: np.ndarray, t_ready: float, image_id: int) -> int:
-        """Draw `image` and swap it in at the next refresh it can make (at most one new image a
-        refresh); returns once the swap is done, with the refresh it reached."""
+        """Draw `image` and swap it in at the next refresh it can make: at most one new image a
+        refresh, and never at a refresh whose content `shown` has already given (an image ready
+        early, for a refresh the run has already accounted for up to, waits for that refresh's
+        blank); returns once the swap is done, with the refresh it reached."""
         window, clock = self._window(), self._clock
         if window.closing():
             raise RigError("the display window was closed; the run ended there (everything recorded so far is kept)")
-        aimed = max(self.refresh_after(max(t_ready, clock.now())), self._last_present + 1)
+        aimed = max(self.refresh_after(max(t_ready, clock.now())), self._last_present + 1, self._next_shown)
         with window.current():
             window.draw(image)
             if self._gpu is not None:
@@ -195,6 +200,8 @@ class WindowDisplay:
             t_drawn = clock.now()
             if self._frame_clock is not None:
                 clock.wait_until(self._frame_clock.vblank(aimed))
+            else:
+                clock.wait_until(self._predicted(aimed - 1) + EARLY_SWAP_GUARD * self.period_s)
             t_call = clock.now()
             window.swap()
             t_swap = clock.now()

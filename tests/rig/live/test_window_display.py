@@ -1,6 +1,7 @@
 """The window display against a fake window on a virtual clock: images reach the refresh they were
-aimed at, swaps that overrun are late (the display repeated its image), every swap is logged, and a
-closed window ends the run. Measured refreshes come from the swaps' own times."""
+aimed at (never one already accounted for as shown), swaps that overrun are late (the display
+repeated its image), every swap is logged, and a closed window ends the run. Measured refreshes
+come from the swaps' own times."""
 
 from __future__ import annotations
 
@@ -89,6 +90,23 @@ def test_images_appear_at_the_refreshes_they_are_ready_for_and_stay() -> None:
     assert [s.refresh for s in swaps] == [first, second] and all(s.refresh == s.aimed_refresh for s in swaps)
     assert display.vblank_time(second) == swaps[1].t_swap
     assert display.photon_time(second, 0.5) == pytest.approx(swaps[1].t_swap + 0.5 * PERIOD)
+
+
+@pytest.mark.parametrize("paced", [True, False], ids=["frame-clock", "swap-return"])
+def test_an_image_ready_early_waits_for_the_first_refresh_not_yet_accounted_for(paced: bool) -> None:
+    """A compositor that planned for a slow composition (the first on a machine compiles its shaders)
+    has run the session's refreshes ahead of the clock; the next image, done sooner, must appear at
+    the first refresh the session has not yet counted as shown. Swapped at once it appeared at a
+    refresh already logged as dark, and the compositor, aiming past it, froze."""
+    clock, swaps = VirtualClock(10.0), []
+    window = FakeWindow(clock, swap_s=2e-4, vsync=not paced)
+    display = _display(clock, window, swaps, paced=paced)
+    ahead = display.refresh_after(clock.now()) + 5
+    assert [display.shown(k) for k in range(ahead)] == [NO_IMAGE] * ahead
+    assert display.present(_image(1), clock.now(), 1) == ahead
+    assert display.shown(ahead) == 1
+    assert swaps[0].refresh == swaps[0].aimed_refresh == ahead
+    assert display.vblank_time(ahead - 1) < swaps[0].t_swap <= display.vblank_time(ahead) + 1e-3
 
 
 def test_a_swap_that_overruns_its_refresh_is_late_and_logged_so() -> None:
