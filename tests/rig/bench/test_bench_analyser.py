@@ -4,6 +4,7 @@ sweep), and `rig sweep` on it giving the bench's rows."""
 import argparse
 import json
 import tomllib
+from collections import Counter
 from pathlib import Path
 
 import pytest
@@ -97,7 +98,10 @@ def test_the_hard_grid_has_every_rate_pair_exposure_impairment_and_decimation() 
     assert [(c.camera.fps, c.display.refresh_hz, c.display.phase) for c in table] == [(60.0, 60.0, 0.0), (144.0, 144.0, 0.0)]
 
 
-@pytest.mark.parametrize("spec", [analyser.SPEC, analyser.SPECS / "analyser-rolling.toml", analyser.SPECS / "analyser-rolling-told.toml"])
+ROLLING_SPECS = ("analyser-rolling.toml", "analyser-rolling-told.toml", "analyser-rolling-known.toml")
+
+
+@pytest.mark.parametrize("spec", [analyser.SPEC, *(analyser.SPECS / name for name in ROLLING_SPECS)])
 def test_the_rolling_shutter_films_read_out_within_a_frame_with_the_blobs_a_third_of_the_frame_apart(spec: Path) -> None:
     rolling = [p.config for p in _cases(spec) if p.labels["impairment"] == "rolling-shutter"]
     assert {c.camera.fps for c in rolling} == {30.0, 60.0, 120.0, 240.0}
@@ -106,6 +110,18 @@ def test_the_rolling_shutter_films_read_out_within_a_frame_with_the_blobs_a_thir
         led, display = placement(config.layout).led, placement(config.layout).display
         assert 0.30 <= abs(display[1] - led[1]) <= 0.40
     assert len(rolling) == (8 if spec == analyser.SPEC else 40)
+
+
+def test_the_display_sampling_films_pair_eleven_rates_and_exposures_with_ten_seeds_told_their_bench() -> None:
+    spec = analyser.SPECS / "analyser-sampling-told.toml"
+    points = _cases(spec)
+    assert read_sweep(spec).analysis == {"method": "sinefit", "simulated_bench": True}
+    films = Counter((p.config.camera.fps, p.config.display.refresh_hz, round(p.config.camera.exposure * p.config.camera.fps, 3))
+                    for p in points)  # fmt: skip
+    assert len(films) == 11 and set(films.values()) == {10}
+    assert (240.0, 60.0, 0.5) in films and (144.0, 144.0, 0.3) in films
+    assert {p.config.seed for p in points} == set(range(10, 20))
+    assert all(p.config.camera.readout_s == 0.0 for p in points)
 
 
 def test_the_specs_are_package_data() -> None:
