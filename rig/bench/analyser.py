@@ -42,10 +42,11 @@ from typing import Any
 import numpy as np
 
 import analysis
+from analysis import AnalysisOptions
 from analysis.sampling.model import commensurate
 from analysis.video.sources import open_frames
 from rig.bench.contract import Bench, Context, Log, SpecFile, cell
-from rig.service.sweep import Sweep, SweepPoint, read_sweep, run_point, run_sweep
+from rig.service.sweep import Sweep, SweepPoint, read_sweep, run_sweep, simulate_and_analyse
 from rig.sim.config import SimulationConfig
 
 SPECS = Path(__file__).parent / "specs"
@@ -109,11 +110,13 @@ def measure_point(point: SweepPoint, log: Log) -> dict[str, Any]:
     """A sweep job: the point's sweep row (simulated and analysed as `rig sweep` does), with the
     bench's record of the case under "bench": the film decoded and analysed with every method."""
     started = time.perf_counter()
-    row = run_point(point)
-    return row | {"bench": _case_record(point, row, log, started)}
+    run = simulate_and_analyse(point)
+    return run.row | {"bench": _case_record(point, run.options, run.row, log, started)}
 
 
-def _case_record(point: SweepPoint, row: dict[str, Any], log: Log, started: float) -> dict[str, Any]:
+def _case_record(point: SweepPoint, options: AnalysisOptions, row: dict[str, Any], log: Log, started: float) -> dict[str, Any]:
+    """The case's record: the film decoded, and analysed with every method and the `options` the
+    sweep's analysis was given."""
     config, video, truth_ms = point.config, point.analysis.video, float(row["truth_ms"])
     name = point.labels.get("case", point.out_dir.name)
     first_decode, frames = decode_seconds(video)
@@ -137,7 +140,7 @@ def _case_record(point: SweepPoint, row: dict[str, Any], log: Log, started: floa
     if refused is None:
         try:
             analysed_started = time.perf_counter()
-            result = analysis.analyse(video, replace(point.analysis.options, method="all", seed=config.seed))
+            result = analysis.analyse(video, replace(options, method="all", seed=config.seed))
             total_s = time.perf_counter() - analysed_started
             second_decode, _ = decode_seconds(video)
         except analysis.AnalysisError as error:

@@ -52,6 +52,7 @@ from rig.service.bench_profile import BenchProfile, CameraProfile, DisplayProfil
 from rig.service.simulate import SimulationResult, simulate
 from rig.sim.config import SimulationConfig
 from rig.sim.layout import placement
+from rig.sim.truth import Truth
 from rig.toml_file import read_toml
 
 SIMULATED_ROIS = "simulated_rois"
@@ -259,31 +260,37 @@ def read_sweep(path: Path) -> Sweep:
 
 @dataclass(frozen=True)
 class PointRun:
-    """A point simulated and analysed: its summary row, the simulation, and the analyser's whole
-    result (None where the row failed)."""
+    """A point simulated and analysed: its summary row, the simulation, the options its video was
+    analysed with, and the analyser's whole result (None where the row failed)."""
 
     row: dict[str, Any]
     simulation: SimulationResult
+    options: AnalysisOptions
     result: LatencyResult | None
 
 
+def told_options(point: SweepPoint, truth: Truth) -> AnalysisOptions:
+    """The options the point's video is analysed with: the spec's, and where the point says, the
+    simulation's regions and its own bench as hints."""
+    options = point.analysis.options
+    if point.simulated_rois:
+        options = dataclasses.replace(options, led_roi=tuple(truth.led_roi), sphere_roi=tuple(truth.sphere_roi))
+    if point.simulated_bench:
+        options = with_profile(options, simulated_bench(point.config), point.out_dir / "truth.json")
+    return options
+
+
 def simulate_and_analyse(point: SweepPoint) -> PointRun:
-    """Simulate one point and analyse its video (within the simulation's regions where the point
-    says): its summary row, with the truth and the error, and what made it."""
+    """Simulate one point and analyse its video (`told_options`): its summary row, with the truth
+    and the error, and what made it."""
     simulation = simulate(point.config, point.out_dir, overwrite=True)
     truth = simulation.truth
-    request = point.analysis
-    if point.simulated_rois:
-        rois = dataclasses.replace(request.options, led_roi=tuple(truth.led_roi), sphere_roi=tuple(truth.sphere_roi))
-        request = dataclasses.replace(request, options=rois)
-    if point.simulated_bench:
-        told = with_profile(request.options, simulated_bench(point.config), point.out_dir / "truth.json")
-        request = dataclasses.replace(request, options=told)
-    row, result = analysed_row(BatchItem(request, point.labels))
+    options = told_options(point, truth)
+    row, result = analysed_row(BatchItem(dataclasses.replace(point.analysis, options=options), point.labels))
     row["index"] = point.index
     row["truth_ms"] = truth.latency_ms
     row["error_ms"] = row["latency_ms"] - truth.latency_ms if row["latency_ms"] is not None else None
-    return PointRun(row, simulation, result)
+    return PointRun(row, simulation, options, result)
 
 
 def simulated_bench(config: SimulationConfig) -> BenchProfile:

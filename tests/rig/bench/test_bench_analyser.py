@@ -155,7 +155,7 @@ def test_rig_sweep_on_the_spec_gives_the_rows_of_the_bench(monkeypatch, tmp_path
     text = analyser.QUICK_SPEC.read_text()
     spec = tmp_path / "one.toml"
     spec.write_text(text[: text.index("[[points]]", text.index("[[points]]") + 1)])
-    monkeypatch.setattr(analyser, "_case_record", lambda point, row, log, started: {"case": point.labels["case"], "group": "mixed"})
+    monkeypatch.setattr(analyser, "_case_record", lambda point, options, row, log, started: {"case": point.labels["case"], "group": "mixed"})
     monkeypatch.setattr(analyser, "summarise", lambda cases: {})
     monkeypatch.setattr(analyser, "targets_met", lambda summaries: {})
     benched = analyser.run(read_sweep(spec), Context(tmp_path / "bench", log=lambda message: None))["sweep"]
@@ -170,6 +170,24 @@ def test_rig_sweep_on_the_spec_gives_the_rows_of_the_bench(monkeypatch, tmp_path
     assert comparable(benched) == comparable(swept)
     summary = (tmp_path / "bench" / "summary.csv").read_text().splitlines()[0]
     assert summary == (tmp_path / "sweep" / "summary.csv").read_text().splitlines()[0]
+
+
+def test_the_bench_analyses_each_film_with_every_method_told_what_the_sweep_was_told(tmp_path: Path) -> None:
+    """A rolling shutter told to the analysis as the film's own bench ([analysis] simulated_bench):
+    the bench's sinefit is the sweep's answer, dated by rows. Analysed with the spec's options
+    alone, the bench's methods were off by the rows' share of the readout (about 1 ms here)."""
+    spec = tmp_path / "rolling.toml"
+    spec.write_text(
+        "[[points]]\nduration_s = 3.0\nlayout = \"led-above\"\nlabels = { case = \"rolling\", group = \"hard\" }\n"
+        "camera = { fps = 120.0, readout_s = 0.006, width = 320, height = 240, subsamples = 4 }\n"
+        "[analysis]\nmethod = \"sinefit\"\nsimulated_bench = true\n"
+    )
+    point = read_sweep(spec).points(tmp_path / "out")[0]
+    row = analyser.measure_point(point, log=lambda message: None)
+    sinefit = row["bench"]["methods"]["sinefit"]
+    assert sinefit["latency_ms"] == pytest.approx(row["latency_ms"], abs=1e-9)
+    assert abs(sinefit["error_ms"]) < 0.3 and sinefit["covered"]
+    assert all(abs(method["error_ms"]) < 0.3 for method in row["bench"]["methods"].values())
 
 
 def test_grid_runs_the_points_of_its_group(monkeypatch, tmp_path: Path) -> None:
