@@ -111,9 +111,10 @@ class SamplingBias:
             return None
         low, high = self.range_s
         if self.refresh_source == "not seen":
+            rates = ", ".join(dict.fromkeys(f"{rate:.4g}" for rate in sorted(self.rates_hz)))
             cause = (
-                f"{camera} does not show the display's refresh (it is not faster than the display, or locked to "
-                f"it); for a {self.worst_hz:.4g} Hz display, the worst of the {len(self.rates_hz)} rates the video allows,"
+                f"{camera} does not show the display's refresh: no rate's steps stand out in the sphere's timing, "
+                f"which allows {rates} Hz; for a {self.worst_hz:.4g} Hz display, the one of them allowing the most,"
             )
             remedy = "pass --display-hz with the display's refresh rate, "
         else:
