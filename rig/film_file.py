@@ -106,6 +106,8 @@ class StampedVideoRecord:
         self._first: float | None = None
         self._last_pts = -1
         self.frames = 0
+        self.muxed = 0
+        """Frames in the file so far: the encoder holds a few frames back before it writes them."""
 
     def write(self, grey: np.ndarray, t_start: float | None = None) -> None:
         """Append a frame whose exposure started at `t_start` (s on the rig clock)."""
@@ -134,8 +136,12 @@ class StampedVideoRecord:
         try:
             for packet in self._stream.encode(frame):
                 self._file.mux(packet)
+                self.muxed += 1
         except (av.error.FFmpegError, OSError) as error:
-            raise RigError(f"{self.path} could not take frame {self.frames} ({error}); is the disk full?") from None
+            raise RigError(
+                f"{self.path} could not take a frame ({error}; is the disk full?): it holds {self.muxed} of the "
+                f"{self.frames} frames {FRAME_TIMES_FILE} lists"
+            ) from None
 
     def close(self) -> None:
         """Write what the encoder holds, close the files and count the film's frames back (RigError

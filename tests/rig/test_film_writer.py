@@ -5,6 +5,7 @@ table lists exactly the frames it holds."""
 from __future__ import annotations
 
 import csv
+import errno
 from pathlib import Path
 
 import av
@@ -168,6 +169,46 @@ def test_a_runs_film_that_fails_stops_with_its_table_listing_the_frames_it_holds
     numbers, _, stated_count = avi_numbers(film.video_path)
     assert [int(row["frame"]) for row in rows] == numbers == list(range(FailingWriter.room))
     assert stated_count == film.frames == FailingWriter.room
+
+
+class FullDiskContainer:
+    """A PyAV output container whose disk fills after `room` packets: later muxing fails as an
+    operating system's write does."""
+
+    room = 8
+
+    def __init__(self, container: av.container.OutputContainer) -> None:
+        self._container = container
+        self._muxed = 0
+
+    def add_stream(self, *args: object, **kwargs: object) -> av.VideoStream:
+        return self._container.add_stream(*args, **kwargs)
+
+    def mux(self, packet: av.Packet) -> None:
+        if self._muxed >= self.room:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        self._container.mux(packet)
+        self._muxed += 1
+
+    def close(self) -> None:
+        self._container.close()
+
+
+def test_a_stamped_film_that_fails_raises_and_leaves_a_readable_film_saying_what_it_holds(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    opened = av.open
+    monkeypatch.setattr(av, "open", lambda *args, **kwargs: FullDiskContainer(opened(*args, **kwargs)))
+    video = StampedVideoRecord(tmp_path / "film.mp4", "mp4", "h264", 240.0, WIDTH, HEIGHT)
+    with pytest.raises(RigError, match=f"holds {FullDiskContainer.room} of the") as failure:
+        with video:
+            for index in range(60):
+                video.write(numbered(index), index / 240.0)
+    assert "is the disk full?" in str(failure.value)
+    assert video.muxed == FullDiskContainer.room
+    monkeypatch.undo()
+    with av.open(str(tmp_path / "film.mp4")) as film:
+        assert film.streams.video[0].frames == FullDiskContainer.room
 
 
 @pytest.mark.slow
