@@ -6,6 +6,9 @@ A stamped film's times are on a 1/90000 s time base (that of MPEG streams): each
 presentation time is its exposure's start rounded to it, counted from the first frame's, and
 `frame_times.csv` beside the film lists both for every frame. The grey image is written as
 full-range luma (chroma neutral), so decoding the film to grey gives back the pixels the codec kept.
+A packet the file cannot take (a full disk) raises RigError, and closing counts the film's frames
+back: RigError unless it holds every frame written. Such a film holds any frame rate its time base
+resolves (4000 fps and more).
 """
 
 from __future__ import annotations
@@ -62,6 +65,18 @@ def video_file_name(container: str) -> str:
     return f"video.{container}"
 
 
+def stamped_frame_count(path: Path) -> int:
+    """The frames an MP4's or a MOV's video stream holds, as its index lists them (0 for a file
+    that does not open)."""
+    import av
+
+    try:
+        with av.open(str(path)) as film:
+            return film.streams.video[0].frames if film.streams.video else 0
+    except (av.error.FFmpegError, OSError):
+        return 0
+
+
 class StampedVideoRecord:
     """Writes 8-bit grey frames, each with its presentation time, as H.264 or HEVC in an MP4 or a
     MOV, and lists every frame's time in `frame_times.csv` beside it. Release it on any exit (use it
@@ -91,6 +106,8 @@ class StampedVideoRecord:
         self._first: float | None = None
         self._last_pts = -1
         self.frames = 0
+        self.muxed = 0
+        """Frames in the file so far: the encoder holds a few frames back before it writes them."""
 
     def write(self, grey: np.ndarray, t_start: float | None = None) -> None:
         """Append a frame whose exposure started at `t_start` (s on the rig clock)."""
@@ -107,22 +124,39 @@ class StampedVideoRecord:
         frame = self._frame_type.from_ndarray(planes, format="yuv420p")
         frame.color_range = _FULL_RANGE
         frame.pts, frame.time_base = pts, TIME_BASE
-        for packet in self._stream.encode(frame):
-            self._file.mux(packet)
+        self._mux(frame)
         self._times.write([self.frames, float(t_start), pts, float(pts * TIME_BASE)])
         self._last_pts = pts
         self.frames += 1
 
+    def _mux(self, frame: object) -> None:
+        """Encode `frame` (None: what the encoder still holds) and write its packets to the file."""
+        import av
+
+        try:
+            for packet in self._stream.encode(frame):
+                self._file.mux(packet)
+                self.muxed += 1
+        except (av.error.FFmpegError, OSError) as error:
+            raise RigError(
+                f"{self.path} could not take a frame ({error}; is the disk full?): it holds {self.muxed} of the "
+                f"{self.frames} frames {FRAME_TIMES_FILE} lists"
+            ) from None
+
     def close(self) -> None:
+        """Write what the encoder holds, close the files and count the film's frames back (RigError
+        unless it holds every frame written); safe to call more than once."""
         if self._file is None:
             return
         try:
-            for packet in self._stream.encode(None):
-                self._file.mux(packet)
+            self._mux(None)
         finally:
             self._file.close()
             self._file = None
             self._times.close()
+        held = stamped_frame_count(self.path)
+        if held != self.frames:
+            raise RigError(f"{self.path} holds {held} of the {self.frames} frames written to it; check the disk and film again")
 
     def __enter__(self) -> StampedVideoRecord:
         return self

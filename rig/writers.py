@@ -10,7 +10,9 @@ Floats are written with `repr`, so reading a file back gives the exact values; N
 cell. Lines end in a bare newline.
 
 A `VideoRecord` is released on any exit (use it as a context manager), so an interrupted run
-keeps a playable video of every frame written.
+keeps a playable video of every frame written. Each frame's write is checked, and the frames the
+file holds are counted back when it is closed: a frame the film does not hold raises RigError,
+never a film shorter than its frame table.
 """
 
 from __future__ import annotations
@@ -107,15 +109,48 @@ class CsvRecord:
         self.close()
 
 
+MJPEG_AVI_MAX_FPS = 1000.0
+"""The fastest MJPEG AVI written here: above it FFmpeg's AVI muxer (through OpenCV) keeps a coarser
+time base (1/600 s), puts frames on the same tick and refuses them."""
+
+
+def check_avi_rate(fps: float, advice: str = "") -> None:
+    """RigError unless an MJPEG AVI (`VideoRecord`) holds `fps` frames a second; `advice` says what
+    else the caller may film in."""
+    if not fps <= MJPEG_AVI_MAX_FPS:
+        raise RigError(
+            f"an MJPEG AVI film holds at most {MJPEG_AVI_MAX_FPS:g} frames a second, not {fps:g}: "
+            f"film at {MJPEG_AVI_MAX_FPS:g} fps or fewer{advice}"
+        )
+
+
+def avi_frame_count(path: Path) -> int:
+    """The frames an AVI's index holds, as a reader finds them."""
+    capture = cv2.VideoCapture(str(path))
+    try:
+        return max(int(capture.get(cv2.CAP_PROP_FRAME_COUNT)), 0) if capture.isOpened() else 0
+    finally:
+        capture.release()
+
+
 class VideoRecord:
-    """Writes 8-bit grey frames to an MJPEG AVI: a codec every OpenCV build reads back."""
+    """Writes 8-bit grey frames to an MJPEG AVI: a codec every OpenCV build reads back.
+
+    A rate the AVI cannot hold (`check_avi_rate`) is refused before the first frame. A frame that
+    cannot be written (a full disk) raises RigError; the film then holds, playable, the `frames`
+    written before it. Closing counts the file's frames back and raises RigError unless it holds
+    every frame written.
+    """
 
     FOURCC = "MJPG"
     QUALITY = 95
 
     def __init__(self, path: str | os.PathLike[str], fps: float, width: int, height: int) -> None:
+        check_avi_rate(fps)
         self.path = Path(path)
-        self._writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*self.FOURCC), fps, (width, height), True)
+        self._writer: cv2.VideoWriter | None = cv2.VideoWriter(
+            str(self.path), cv2.VideoWriter_fourcc(*self.FOURCC), fps, (width, height), True
+        )
         if not self._writer.isOpened():
             raise RigError(f"cannot write video {self.path}: OpenCV has no {self.FOURCC} writer here")
         self._writer.set(cv2.VIDEOWRITER_PROP_QUALITY, self.QUALITY)
@@ -124,11 +159,25 @@ class VideoRecord:
     def write(self, grey: np.ndarray, t_start: float | None = None) -> None:
         """Append a frame; an AVI places frame i at i / fps, so its start time is not stored (taken
         so that every film writer takes the same frames, `rig.film_file`)."""
-        self._writer.write(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR))
+        if self._writer is None:
+            raise RigError(f"the film {self.path} is closed; frame {self.frames} cannot be added")
+        if not self._writer.write(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR)):
+            raise RigError(
+                f"frame {self.frames} could not be written to {self.path} (is the disk full?); "
+                f"the film holds the {self.frames} before it"
+            )
         self.frames += 1
 
     def close(self) -> None:
-        self._writer.release()
+        """Release the file and count its frames back (RigError unless it holds every frame written);
+        safe to call more than once."""
+        writer, self._writer = self._writer, None
+        if writer is None:
+            return
+        writer.release()
+        held = avi_frame_count(self.path)
+        if held != self.frames:
+            raise RigError(f"{self.path} holds {held} of the {self.frames} frames written to it; check the disk and film again")
 
     def __enter__(self) -> VideoRecord:
         return self

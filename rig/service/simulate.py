@@ -16,6 +16,9 @@ from typing import Any
 import numpy as np
 
 import predictors
+from analysis.phase import MIN_CYCLES
+from analysis.shutter.estimate import MIN_FRAMES as MIN_FLASH_FRAMES
+from analysis.windows import MIN_SAMPLES
 from rig.clock import VirtualClock
 from rig.devices.registry import DeviceContext, make_camera, make_display, make_tracker
 from rig.errors import RigError
@@ -27,9 +30,14 @@ from rig.sim.board import BOARD_FOLDER, remove_recording
 from rig.sim.config import SimulationConfig
 from rig.sim.truth import FilmTruth, Truth, run_truth
 from rig.sim.world import SimulatedWorld
+from rig.writers import check_avi_rate
 
 TRUTH_FILE = "truth.json"
 SIMULATION_FILES = (*RUN_FILES, *map(video_file_name, STAMPED_CONTAINERS), FRAME_TIMES_FILE, TRUTH_FILE, BOARD_FOLDER)
+MIN_FILM_FRAMES = round(MIN_CYCLES * MIN_SAMPLES)
+"""The fewest frames of a pendulum film: the analyser fits each swing on at least MIN_SAMPLES frames,
+and at least MIN_CYCLES swings (`analysis.windows`, `analysis.phase`); a flashing light's film needs
+`analysis.shutter`'s MIN_FRAMES."""
 
 
 @dataclass(frozen=True)
@@ -92,6 +100,21 @@ def _prepare(out_dir: Path, overwrite: bool) -> None:
         remove_recording(out_dir / BOARD_FOLDER)
 
 
+def _check_film(config: SimulationConfig, frames: int) -> None:
+    """RigError, before the run, unless the film's container holds its rate and it holds enough
+    frames to analyse."""
+    camera = config.camera
+    if camera.container == "avi":
+        check_avi_rate(camera.film_fps, advice=", or in an MP4 or a MOV (--container mp4)")
+    least = MIN_FLASH_FRAMES if config.flash is not None else MIN_FILM_FRAMES
+    if frames < least:
+        kept = f" (every {camera.impairments.every_nth}-th exposure)" if camera.impairments.every_nth > 1 else ""
+        raise RigError(
+            f"the film would hold {frames} frame{'' if frames == 1 else 's'}{kept}, too few to analyse: "
+            f"a film needs at least {least}; film longer, or keep more of the exposures (a smaller --every-nth)"
+        )
+
+
 def _film_truth(config: SimulationConfig, world: SimulatedWorld, film_times: np.ndarray) -> FilmTruth:
     """How the camera filmed: its readout, where the blobs sit on average over the film, its file."""
     led_row, sphere_row = world.layout.mean_rows(world.pendulum.led_position(film_times))
@@ -144,9 +167,15 @@ def simulate(
         instruments=[board] if board is not None else [],
         target=PhotonTarget(config.photon_target, config.persistence),
     )
+    _check_film(config, len(camera.film_times))
     _prepare(out_dir, overwrite)
     with RunRecord(out_dir, overwrite=overwrite, film=config.camera.film) as record:
         log = Session(parts, world.t_begin, world.t_end, record, progress).run()
+    filmed = record.film.frames if record.film is not None else 0
+    if filmed != len(camera.film_times):
+        raise RigError(
+            f"{record.video_path} holds {filmed} of the camera's {len(camera.film_times)} frames; the run's truth is not written"
+        )
     impairments = config.camera.impairments
     truth = run_truth(
         config,

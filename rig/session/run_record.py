@@ -23,6 +23,8 @@ of the last frame (`filled` 1) so that frame i of an AVI stays at i intervals fr
 which is all the time such a file holds. The typical interval is the median of the latest ones: a camera that
 runs slower than it said is not dropping. Frames are encoded on a thread of the film's own, in the
 order given: encoding one takes milliseconds, which a live run's render loop cannot spare.
+A frame the video cannot take stops the film (RigError, from the next `write` or from `close`):
+its row is not written, so `camera_frames.csv` lists exactly the frames the video holds.
 """
 
 from __future__ import annotations
@@ -164,8 +166,10 @@ class FilmRecord:
             return
         self._queue.put(None)
         thread.join()
-        self._video.close()
-        self._table.close()
+        try:
+            self._video.close()
+        finally:
+            self._table.close()
         if self._failure is not None:
             raise RigError(f"cannot write the film {self.video_path}: {self._failure}")
 
