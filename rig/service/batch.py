@@ -24,6 +24,7 @@ from analysis.errors import AnalysisError
 from predictors import PredictorError
 from rig.errors import ConfigError, RigError
 from rig.executor import executor
+from rig.fresh_outputs import removed_unless_recorded
 from rig.writers import CsvRecord
 from rig.service.analyse import AnalysisRequest, analyse
 
@@ -190,18 +191,20 @@ def run_batch(
     in input order. The summary CSV and JSON are written as rows come (see the module docstring)."""
     labels = list(dict.fromkeys(key for item in items for key in item.labels))
     run = BatchRun(summary, (*SUMMARY_COLUMNS, *labels))
-    run.open()
-    try:
-        with executor(workers, scheduler) as jobs:
-            if progress is not None:
-                progress(0, len(items))
-            for _, row in jobs(_indexed, list(enumerate(items))):
-                run.add(row)
+    outputs = () if summary is None else (summary, summary.with_suffix(".json"))
+    with removed_unless_recorded(*outputs):
+        run.open()
+        try:
+            with executor(workers, scheduler) as jobs:
                 if progress is not None:
-                    progress(len(run.rows), len(items))
-        return run.finish()
-    finally:
-        run.close()
+                    progress(0, len(items))
+                for _, row in jobs(_indexed, list(enumerate(items))):
+                    run.add(row)
+                    if progress is not None:
+                        progress(len(run.rows), len(items))
+            return run.finish()
+        finally:
+            run.close()
 
 
 def requests_for(videos: Sequence[Path], template: AnalysisRequest) -> list[AnalysisRequest]:
