@@ -21,6 +21,7 @@ from typing import Any, Callable, Sequence
 
 from analysis import LatencyResult
 from analysis.errors import AnalysisError
+from analysis.video.native_path import shown_path
 from predictors import PredictorError
 from rig.errors import ConfigError, RigError
 from rig.executor import executor
@@ -65,7 +66,7 @@ def labels_from(path: Path | None, videos: Sequence[Path]) -> dict[Path, dict[st
     """Labels per video from a CSV whose first column is `video` (a path as given, or a file name)
     and whose other columns are labels; without one, each video is labelled by its folder."""
     if path is None:
-        return {video: {"folder": video.parent.name or "."} for video in videos}
+        return {video: {"folder": shown_path(video.parent.name) or "."} for video in videos}
     import csv
 
     try:
@@ -88,7 +89,7 @@ def analysed_row(item: BatchItem) -> tuple[dict[str, Any], LatencyResult | None]
     """`summary_row`, and the analyser's whole result (None where the row failed)."""
     started = time.perf_counter()
     row: dict[str, Any] = dict.fromkeys(SUMMARY_COLUMNS)
-    row["video"] = str(item.request.video)
+    row["video"] = shown_path(item.request.video)
     result = None
     try:
         result = analyse(item.request).result

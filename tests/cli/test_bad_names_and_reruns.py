@@ -135,6 +135,38 @@ def silent_port() -> Iterator[str]:
             connection.close()
 
 
+# (id, argv with {lab} for the lab folder and {bad} for the name in bytes that are not UTF-8, a word the message must hold)
+NAME_CASES = [
+    ("analyse-video-named-in-latin-1", "analyse {lab}/{bad}.avi", "caf\\xe9.avi: the name is not valid UTF-8"),
+    ("analyse-image-folder-named-in-latin-1", "analyse {lab}/{bad}-images --fps 30", "caf\\xe9-images"),
+    ("analyse-image-named-in-latin-1", "analyse {lab}/frames --fps 30", "caf\\xe9_001.png"),
+    ("calibrate-camera-video-named-in-latin-1", "calibrate-camera {lab}/{bad}.avi --flash-hz 80", "not valid UTF-8"),
+    ("simulate-out-named-in-latin-1", "simulate --out {lab}/{bad}-run --duration 1", "caf\\xe9-run"),
+    ("simulate-out-below-a-folder-named-in-latin-1", "simulate --out {lab}/{bad}-new/run --duration 1", "caf\\xe9-new"),
+    ("simulate-out-an-existing-folder-named-in-latin-1", "simulate --out {lab}/{bad}-empty --duration 1", "caf\\xe9-empty"),
+]
+
+
+@pytest.mark.parametrize("argv, word", [pytest.param(argv, word, id=name) for name, argv, word in NAME_CASES])
+def test_a_name_that_is_not_utf8_is_refused_in_one_line(argv: str, word: str, lab: Path) -> None:
+    before, listing = _snapshot(lab), _listing(lab)
+    code, _, err = _rig_process(argv.format(lab=lab, bad=NOT_UTF8).split(), lab)
+    _assert_one_line_error(code, err, word)
+    assert _snapshot(lab) == before
+    assert _listing(lab) == listing, "a refused run left something behind"
+
+
+def test_a_batch_goes_on_past_a_video_named_in_latin_1(lab: Path, tmp_path: Path) -> None:
+    summary = tmp_path / "summary.csv"
+    code, _, err = _rig_process(["analyse", str(lab / f"{NOT_UTF8}.avi"), str(lab / "blob.avi"), "--summary", str(summary)], lab)
+    assert code >= 0, f"killed by signal {-code}:\n{err}"
+    with summary.open(encoding="utf-8", newline="") as stream:
+        rows = list(csv.DictReader(stream))
+    assert [Path(row["video"]).name for row in rows] == ["caf\\xe9.avi", "blob.avi"]
+    assert "not valid UTF-8" in rows[0]["error"]
+    assert "not valid UTF-8" not in rows[1]["error"] and rows[1]["status"] in {"ok", "warning", "failed"}
+
+
 # (id, argv with {lab}, {new} a folder that does not exist yet, {scheduler} an address nobody
 # listens at and {port} a device that says nothing; a word the message must hold; the output)
 RERUN_CASES = [
