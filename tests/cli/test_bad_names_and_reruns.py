@@ -167,6 +167,26 @@ def test_a_batch_goes_on_past_a_video_named_in_latin_1(lab: Path, tmp_path: Path
     assert "not valid UTF-8" not in rows[1]["error"] and rows[1]["status"] in {"ok", "warning", "failed"}
 
 
+# (id, argv, a word the message must hold)
+EMULATOR_CASES = [
+    ("emulate-pty-over-a-file", "emulate-tracker serial --pty {lab}/a-file --duration 1", "already exists"),
+    ("emulate-pty-over-a-link", "emulate-tracker serial --pty {lab}/a-link --duration 1", "already exists"),
+    ("emulate-pty-over-a-folder", "emulate-tracker serial --pty {lab}/empty-folder --duration 1", "already exists"),
+    ("emulate-pty-in-a-missing-folder", "emulate-tracker serial --pty {lab}/nowhere/tty --duration 1", "does not exist"),
+    ("emulate-tcp-port-out-of-range", "emulate-tracker serial --tcp 99999 --duration 1", "65535"),
+    ("emulate-tcp-port-negative", "emulate-tracker serial --tcp=-1 --duration 1", "--tcp"),
+]
+
+
+@pytest.mark.parametrize("argv, word", [pytest.param(argv, word, id=name) for name, argv, word in EMULATOR_CASES])
+def test_the_emulator_never_takes_a_path_over(argv: str, word: str, lab: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    before, listing, link = _snapshot(lab), _listing(lab), os.readlink(lab / "a-link")
+    code, _, err = _rig(argv.format(lab=lab).split(), capsys)
+    _assert_one_line_error(code, err, word)
+    assert _snapshot(lab) == before and _listing(lab) == listing
+    assert (lab / "a-file").read_text() == "precious" and os.readlink(lab / "a-link") == link
+
+
 # (id, argv with {lab}, {new} a folder that does not exist yet, {scheduler} an address nobody
 # listens at and {port} a device that says nothing; a word the message must hold; the output)
 RERUN_CASES = [
