@@ -288,3 +288,33 @@ def test_a_failed_file_output_that_recorded_nothing_is_removed(tmp_path: Path) -
     _fail_after([summary, summary.with_suffix(".json")], lambda: _csv(summary, 0))
     assert not summary.exists()
     assert list(tmp_path.iterdir()) == []
+
+
+def _wait_for_library(process: subprocess.Popen, library: str) -> None:
+    """Until `process` has loaded `library`: it is past its imports and into the work that uses it."""
+    deadline = time.monotonic() + COMMAND_LIMIT_S
+    maps = Path(f"/proc/{process.pid}/maps")
+    while library not in maps.read_text():
+        assert process.poll() is None, "the command ended before it waited"
+        assert time.monotonic() < deadline, f"the command did not load {library}"
+        time.sleep(0.05)
+
+
+@pytest.mark.skipif(not Path("/proc/self/maps").exists(), reason="finds when the wait starts in /proc")
+@pytest.mark.parametrize("signum, status", [pytest.param(signal.SIGINT, EXIT_INTERRUPTED, id="sigint"),
+                                            pytest.param(signal.SIGTERM, EXIT_TERMINATED, id="sigterm")])  # fmt: skip
+def test_devices_listening_for_lsl_streams_stops_on_a_signal(signum: int, status: int, tmp_path: Path) -> None:
+    process = subprocess.Popen([str(RIG), "devices", "--lsl-wait", "600"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        _wait_for_library(process, "liblsl")
+        signalled = time.monotonic()
+        process.send_signal(signum)
+        _, err = process.communicate(timeout=COMMAND_LIMIT_S)
+        took = time.monotonic() - signalled
+    finally:
+        process.kill()
+        process.wait(timeout=COMMAND_LIMIT_S)
+    assert process.returncode == status, err.decode()
+    assert took < STOP_LIMIT_S, f"stopped {took:.1f} s after the signal"
+    assert err.decode().strip().splitlines() == [f"rig devices: {'interrupted' if signum == signal.SIGINT else 'terminated'}; "
+                                                 "everything recorded so far is on disk"]  # fmt: skip
