@@ -141,6 +141,7 @@ NAME_CASES = [
     ("analyse-image-folder-named-in-latin-1", "analyse {lab}/{bad}-images --fps 30", "caf\\xe9-images"),
     ("analyse-image-named-in-latin-1", "analyse {lab}/frames --fps 30", "caf\\xe9_001.png"),
     ("calibrate-camera-video-named-in-latin-1", "calibrate-camera {lab}/{bad}.avi --flash-hz 80", "not valid UTF-8"),
+    ("record-camera-file-named-in-latin-1", "record --camera camera:{lab}/{bad}.avi --duration 1 --out {lab}/film", "caf\\xe9.avi"),
     ("simulate-out-named-in-latin-1", "simulate --out {lab}/{bad}-run --duration 1", "caf\\xe9-run"),
     ("simulate-out-below-a-folder-named-in-latin-1", "simulate --out {lab}/{bad}-new/run --duration 1", "caf\\xe9-new"),
     ("simulate-out-an-existing-folder-named-in-latin-1", "simulate --out {lab}/{bad}-empty --duration 1", "caf\\xe9-empty"),
