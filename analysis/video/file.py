@@ -23,6 +23,7 @@ import numpy as np
 from analysis.errors import AnalysisError
 from analysis.video.decoding import REGION_DECODER_MISSING, decode_jpeg, decodes_regions, ordered_map
 from analysis.video.frames import Crop, Frame, Repeats, checked_every, checked_fps, cut_frames, noted_repeats, same_image
+from analysis.video.native_path import native_path
 
 # Frame rates outside this range are not believed when a container states them.
 PLAUSIBLE_FPS = (1.0, 10_000.0)
@@ -37,7 +38,8 @@ class VideoFile:
         self._path = Path(path)
         if not self._path.is_file():
             raise AnalysisError(f"video file {self._path} does not exist; check the path")
-        capture = cv2.VideoCapture(str(self._path))
+        self._native_path = native_path(self._path)
+        capture = cv2.VideoCapture(self._native_path)
         try:
             if not capture.isOpened():
                 raise AnalysisError(
@@ -87,7 +89,7 @@ class VideoFile:
 
     def _raw_packets_decode(self) -> bool:
         """Whether this file's packets are whole JPEG images of the frame size (see module docstring)."""
-        capture = cv2.VideoCapture(str(self._path))
+        capture = cv2.VideoCapture(self._native_path)
         try:
             if not capture.set(cv2.CAP_PROP_FORMAT, -1):
                 return False
@@ -115,7 +117,7 @@ class VideoFile:
         return cut_frames(noted_repeats(self._decoded_frames(every), repeats, every), crop)
 
     def _jpeg_frames(self, crop: Crop | None, every: int, repeats: Repeats | None) -> Generator[Frame, None, None]:
-        capture = cv2.VideoCapture(str(self._path))
+        capture = cv2.VideoCapture(self._native_path)
         try:
             if not capture.set(cv2.CAP_PROP_FORMAT, -1):
                 raise AnalysisError(f"{self._path} no longer reads as Motion-JPEG packets; check that the file is not being written")
@@ -160,7 +162,7 @@ class VideoFile:
         import av  # here: reading Motion-JPEG, the rig's own films, need not load FFmpeg
 
         try:
-            container = av.open(str(self._path))
+            container = av.open(self._native_path)
         except av.FFmpegError as error:
             raise AnalysisError(f"{self._path} cannot be decoded: {error}; re-record it or convert it to MP4") from None
         index = 0

@@ -11,6 +11,7 @@ import cv2
 from analysis.errors import AnalysisError
 from analysis.video.decoding import ordered_map
 from analysis.video.frames import Crop, Frame, Repeats, checked_every, checked_fps, cut_frames, noted_repeats
+from analysis.video.native_path import native_path
 
 IMAGE_SUFFIXES = frozenset({".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm", ".webp"})
 
@@ -43,14 +44,14 @@ class ImageFolder:
         if repeated:
             raise AnalysisError(f"{folder} holds two images numbered {repeated[0]}; keep one image per frame number")
         self._numbers = [n for n, _ in numbered]
-        self._paths = [p for _, p in numbered]
+        self._paths = [native_path(p) for _, p in numbered]
         checked = checked_fps(fps)
         if checked is None:
             raise AnalysisError(
                 f"no frame rate is known for the images in {folder}; pass --fps (fps=) with the camera's frame rate"
             )
         self._fps = checked
-        first = cv2.imread(str(self._paths[0]), cv2.IMREAD_GRAYSCALE)
+        first = cv2.imread(self._paths[0], cv2.IMREAD_GRAYSCALE)
         if first is None:
             raise AnalysisError(f"{self._paths[0]} cannot be read as an image")
         self._frame_size = int(first.shape[1]), int(first.shape[0])
@@ -91,7 +92,7 @@ class ImageFolder:
     def _grey_frames(self, every: int) -> Generator[Frame, None, None]:
         paths = self._paths[::every]
         decoded = ordered_map(
-            lambda path: cv2.imread(str(path), cv2.IMREAD_GRAYSCALE),
+            lambda path: cv2.imread(path, cv2.IMREAD_GRAYSCALE),
             paths,
             lambda index: f"image {paths[index]}",
         )

@@ -22,6 +22,7 @@ from rig.board.microcontroller import Microcontroller
 from rig.board.recorder import BoardRecorder
 from rig.clock import Clock
 from rig.errors import RigError
+from rig.fresh_outputs import removed_unless_recorded
 
 DEFAULT_RISE = 512
 DEFAULT_FALL = 256
@@ -59,20 +60,22 @@ class BoardInstrument:
         self.recorder: BoardRecorder | None = None
 
     def connect(self, clock: Clock) -> None:
-        self.recorder = BoardRecorder(self.out_dir)
-        self._clock = clock
-        s = self.settings
-        self.board = Microcontroller(self.url, open_port=self._open_port, clock=clock.now, resync_every_s=s.resync_every_s)
-        self.board.add_listener(self.recorder)
-        try:
-            self.board.connect()
-            self.board.configure_encoder(s.encoder_rate_hz)
-            self.board.configure_photodiode(s.rise, s.fall, s.raw_every)
-            self.board.stream(encoder=True, photodiode=True, samples=s.raw_every > 0)
-            self._started = clock.now()
-        except BaseException:
-            self.close()
-            raise
+        """Open the recording and the board; a board that does not answer leaves no recording behind."""
+        with removed_unless_recorded(self.out_dir):
+            self.recorder = BoardRecorder(self.out_dir)
+            self._clock = clock
+            s = self.settings
+            self.board = Microcontroller(self.url, open_port=self._open_port, clock=clock.now, resync_every_s=s.resync_every_s)
+            self.board.add_listener(self.recorder)
+            try:
+                self.board.connect()
+                self.board.configure_encoder(s.encoder_rate_hz)
+                self.board.configure_photodiode(s.rise, s.fall, s.raw_every)
+                self.board.stream(encoder=True, photodiode=True, samples=s.raw_every > 0)
+                self._started = clock.now()
+            except BaseException:
+                self.close()
+                raise
 
     def poll(self) -> None:
         self._connected().check()

@@ -14,6 +14,7 @@ import json
 from rig.commands import choices, options, outputs
 from rig.progress import ProgressBar
 from rig.errors import RigError
+from rig.fresh_outputs import removed_unless_recorded
 from rig.service.tracker_recording import record_tracker
 
 
@@ -35,17 +36,19 @@ def _summary(sidecar: dict) -> str:
 
 def _run(args: argparse.Namespace) -> int:
     bar = ProgressBar("recording") if args.duration is not None else (lambda done, total: None)
-    recording = record_tracker(args.tracker, args.duration, args.out, overwrite=args.overwrite, progress=bar)
-    if args.json:
-        print(json.dumps(recording.sidecar))
-    else:
-        print(_summary(recording.sidecar))
+    with removed_unless_recorded(args.out):
+        recording = record_tracker(args.tracker, args.duration, args.out, overwrite=args.overwrite, progress=bar)
+        if args.json:
+            print(json.dumps(recording.sidecar))
+        else:
+            print(_summary(recording.sidecar))
+        if recording.sidecar["samples"] == 0:
+            raise RigError(
+                f"no sample arrived from {args.tracker} in {recording.sidecar['duration_s']:.1f} s: is the tracker on and "
+                "streaming, and does the profile match its records? (its link counters are above; nothing was written)"
+            )
+    if not args.json:
         print(f"wrote {args.out}")
-    if recording.sidecar["samples"] == 0:
-        raise RigError(
-            f"no sample arrived from {args.tracker} in {recording.sidecar['duration_s']:.1f} s: is the tracker on and "
-            "streaming, and does the profile match its records? (the empty recording is in the folder, for its link log)"
-        )
     return 0
 
 

@@ -27,6 +27,7 @@ from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import Motion, TrackerConfig, TrackerSamples, measure
 from rig.sim.tracker_faults import ByteFaults, FaultPlan
 
+MAX_PORT = 65535  # the largest TCP port
 # The emulated device's clock starts here (s) when it starts sending, and runs `drift_ppm` fast.
 DEVICE_EPOCH_S = 100.0
 
@@ -104,6 +105,8 @@ def make_sink(config: EmulatorConfig) -> Sink:
         port = int(config.address)
     except ValueError:
         raise ConfigError(f"--tcp {config.address!r}: expected a port number (0: any free port)") from None
+    if not 0 <= port <= MAX_PORT:
+        raise ConfigError(f"--tcp {port}: a TCP port is 0 to {MAX_PORT} (0: any free port)")
     return TcpSink(port, RecordEncoder(profile), faults)
 
 

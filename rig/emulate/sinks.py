@@ -36,6 +36,7 @@ class PtySink:
         self._encoder = encoder
         self._faults = faults
         self._master = -1
+        self._terminal = ""
         self._open()
 
     def _open(self) -> None:
@@ -43,11 +44,29 @@ class PtySink:
         tty.setraw(slave)
         name = os.ttyname(slave)
         os.close(slave)
-        staged = self.link.with_name(self.link.name + ".new")
-        staged.unlink(missing_ok=True)
-        os.symlink(name, staged)
-        os.replace(staged, self.link)
+        try:
+            self._link_to(name)
+        except OSError as error:
+            os.close(master)
+            raise RigError(f"--pty {self.link}: {_why_not(error, self.link)}") from None
         self._master = master
+        self._terminal = name
+
+    def _link_to(self, terminal: str) -> None:
+        """Point the link at `terminal`: made where nothing is the first time (never replacing a
+        file of the user's), swapped in at once when the port comes back."""
+        if not self._terminal:
+            os.symlink(terminal, self.link)
+            return
+        staged = self.link.with_name(self.link.name + ".new")
+        os.symlink(terminal, staged)
+        os.replace(staged, self.link)
+
+    def _our_link(self) -> bool:
+        try:
+            return os.readlink(self.link) == self._terminal
+        except OSError:
+            return False
 
     def _reader_present(self) -> bool:
         poller = select.poll()
@@ -84,7 +103,17 @@ class PtySink:
         if self._master >= 0:
             os.close(self._master)
             self._master = -1
-        self.link.unlink(missing_ok=True)
+        if self._our_link():  # never what someone put there meanwhile
+            self.link.unlink()
+
+
+def _why_not(error: OSError, link: Path) -> str:
+    """Why the link could not be made at `link`, and what to do."""
+    if isinstance(error, FileExistsError):
+        return "something already exists there; name a path where nothing is (the link is made there and removed at the end)"
+    if not link.parent.is_dir():
+        return f"the folder {link.parent} does not exist; name a path in an existing folder"
+    return f"cannot make a link there ({error.strerror}); name a path in a folder you can write"
 
 
 class TcpSink:

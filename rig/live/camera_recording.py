@@ -28,6 +28,7 @@ from rig.devices.camera.opencv_camera import opencv_camera
 from rig.devices.protocols import CameraFrame
 from rig.devices.window.gl_window import GlWindow, WindowSettings
 from rig.errors import RigError
+from rig.fresh_outputs import removed_unless_recorded
 from rig.session.run_record import FilmRecord
 
 PREVIEW_EVERY_S = 1.0 / 30.0
@@ -99,27 +100,29 @@ def record_camera(
     clock = MonotonicClock()
     film: FilmRecord | None = None
     report: dict[str, Any] = {"partial": True}
-    try:
-        camera.connect(clock)
-        out_dir.mkdir(parents=True, exist_ok=True)
-        film = FilmRecord(out_dir, camera.fps, camera.width, camera.height, overwrite=overwrite)
-        end = clock.now() + duration_s
-        while (now := clock.now()) < end and not camera.finished and camera.fault() is None:
-            _film(camera.poll(), film, window)
-            progress(min(now, end), end)
-            clock.wait_until(min(end, clock.now() + PREVIEW_EVERY_S))
-        report["partial"] = False
-    finally:
-        camera.close()
-        if window is not None:
-            window.close()
-        if film is not None:
-            _film(camera.poll(), film, None)
-            film.close()
-            report = {**camera.report(), **film.report(), **report}
-            (out_dir / SETTINGS_FILE).write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
-    if (fault := camera.fault()) is not None:
-        raise RigError(f"{fault.reason} at {fault.since:.3f} s; everything captured before is in {out_dir}")
+    with removed_unless_recorded(out_dir):
+        try:
+            camera.connect(clock)
+            out_dir.mkdir(parents=True, exist_ok=True)
+            film = FilmRecord(out_dir, camera.fps, camera.width, camera.height, overwrite=overwrite)
+            end = clock.now() + duration_s
+            while (now := clock.now()) < end and not camera.finished and camera.fault() is None:
+                _film(camera.poll(), film, window)
+                progress(min(now, end), end)
+                clock.wait_until(min(end, clock.now() + PREVIEW_EVERY_S))
+            report["partial"] = False
+        finally:
+            camera.close()
+            if window is not None:
+                window.close()
+            if film is not None:
+                _film(camera.poll(), film, None)
+                film.close()
+                report = {**camera.report(), **film.report(), **report}
+                (out_dir / SETTINGS_FILE).write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
+        if (fault := camera.fault()) is not None:
+            kept = f"everything captured before is in {out_dir}" if film is not None and film.frames else "nothing was captured"
+            raise RigError(f"{fault.reason} at {fault.since:.3f} s; {kept}")
     return CameraRecording(out_dir, report)
 
 

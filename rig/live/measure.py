@@ -24,6 +24,7 @@ from analysis.board.photodiode_latency import estimate_from_recording
 from rig.board.instrument import BoardInstrument
 from rig.devices.camera.opencv_camera import opencv_camera
 from rig.errors import RigError
+from rig.fresh_outputs import removed_unless_recorded
 from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
 from rig.live.run import EXTERNAL, LiveConfig, run_live
 from rig.live.view import View
@@ -146,8 +147,9 @@ def measure(
     then analyse (see the module docstring)."""
     camera = opencv_camera(camera_spec, accept_refused=accept_camera_settings)
     board = [BoardInstrument(board_port, out_dir / BOARD_FOLDER)] if board_port else []
-    result = run_live(config, out_dir, view=view, camera=camera, instruments=board, overwrite=overwrite, progress=progress)
-    film = result.summary["film"]
-    if film is None or film["frames"] < 2:
-        raise RigError(f"the camera {camera_spec} recorded no video; check it films while the run goes")
+    with removed_unless_recorded(out_dir):
+        result = run_live(config, out_dir, view=view, camera=camera, instruments=board, overwrite=overwrite, progress=progress)
+        film = result.summary["film"]
+        if film is None or film["frames"] < 2:
+            raise RigError(f"the camera {camera_spec} recorded no video; check it films while the run goes")
     return analyse_run(out_dir, film["measured_fps"], options, out_dir / BOARD_FOLDER if board else None, result.summary)

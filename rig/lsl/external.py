@@ -23,7 +23,7 @@ import numpy as np
 
 from rig.clock import Clock
 from rig.devices.protocols import NO_IMAGE
-from rig.devices.trackers.lsl_tracker import lsl_origin, pylsl, time_correction
+from rig.devices.trackers.lsl_tracker import lsl_origin, pylsl, resolve_streams, time_correction
 from rig.devices.window.refresh import RefreshModel
 from rig.errors import RigError
 from rig.lsl.streams import MARKER_CHANNELS, StreamNames
@@ -84,7 +84,7 @@ class MarkerDisplay:
     def connect(self, clock: Clock) -> None:
         """Find the renderer's marker stream and fit its refreshes (RigError if it is not there)."""
         lsl = pylsl()
-        streams = lsl.resolve_byprop("name", self.names.markers, timeout=RESOLVE_TIMEOUT_S)
+        streams = resolve_streams(RESOLVE_TIMEOUT_S, self.names.markers)
         if not streams:
             raise RigError(
                 f"no renderer publishes the marker stream {self.names.markers!r} (waited {RESOLVE_TIMEOUT_S:g} s): start "

@@ -21,9 +21,11 @@ from typing import Any, Callable, Sequence
 
 from analysis import LatencyResult
 from analysis.errors import AnalysisError
+from analysis.video.native_path import shown_path
 from predictors import PredictorError
 from rig.errors import ConfigError, RigError
 from rig.executor import executor
+from rig.fresh_outputs import removed_unless_recorded
 from rig.writers import CsvRecord
 from rig.service.analyse import AnalysisRequest, analyse
 
@@ -64,7 +66,7 @@ def labels_from(path: Path | None, videos: Sequence[Path]) -> dict[Path, dict[st
     """Labels per video from a CSV whose first column is `video` (a path as given, or a file name)
     and whose other columns are labels; without one, each video is labelled by its folder."""
     if path is None:
-        return {video: {"folder": video.parent.name or "."} for video in videos}
+        return {video: {"folder": shown_path(video.parent.name) or "."} for video in videos}
     import csv
 
     try:
@@ -87,7 +89,7 @@ def analysed_row(item: BatchItem) -> tuple[dict[str, Any], LatencyResult | None]
     """`summary_row`, and the analyser's whole result (None where the row failed)."""
     started = time.perf_counter()
     row: dict[str, Any] = dict.fromkeys(SUMMARY_COLUMNS)
-    row["video"] = str(item.request.video)
+    row["video"] = shown_path(item.request.video)
     result = None
     try:
         result = analyse(item.request).result
@@ -190,18 +192,20 @@ def run_batch(
     in input order. The summary CSV and JSON are written as rows come (see the module docstring)."""
     labels = list(dict.fromkeys(key for item in items for key in item.labels))
     run = BatchRun(summary, (*SUMMARY_COLUMNS, *labels))
-    run.open()
-    try:
-        with executor(workers, scheduler) as jobs:
-            if progress is not None:
-                progress(0, len(items))
-            for _, row in jobs(_indexed, list(enumerate(items))):
-                run.add(row)
+    outputs = () if summary is None else (summary, summary.with_suffix(".json"))
+    with removed_unless_recorded(*outputs):
+        run.open()
+        try:
+            with executor(workers, scheduler) as jobs:
                 if progress is not None:
-                    progress(len(run.rows), len(items))
-        return run.finish()
-    finally:
-        run.close()
+                    progress(0, len(items))
+                for _, row in jobs(_indexed, list(enumerate(items))):
+                    run.add(row)
+                    if progress is not None:
+                        progress(len(run.rows), len(items))
+            return run.finish()
+        finally:
+            run.close()
 
 
 def requests_for(videos: Sequence[Path], template: AnalysisRequest) -> list[AnalysisRequest]:

@@ -23,6 +23,7 @@ from rig.clock import VirtualClock
 from rig.devices.registry import DeviceContext, make_camera, make_display, make_tracker
 from rig.errors import RigError
 from rig.film_file import FRAME_TIMES_FILE, STAMPED_CONTAINERS, video_file_name
+from rig.fresh_outputs import removed_unless_recorded
 from rig.render import RenderSetup, make_renderer
 from rig.session import RUN_FILES, PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
 from rig.session.session import Progress
@@ -168,26 +169,27 @@ def simulate(
         target=PhotonTarget(config.photon_target, config.persistence),
     )
     _check_film(config, len(camera.film_times))
-    _prepare(out_dir, overwrite)
-    with RunRecord(out_dir, overwrite=overwrite, film=config.camera.film) as record:
-        log = Session(parts, world.t_begin, world.t_end, record, progress).run()
-    filmed = record.film.frames if record.film is not None else 0
-    if filmed != len(camera.film_times):
-        raise RigError(
-            f"{record.video_path} holds {filmed} of the camera's {len(camera.film_times)} frames; the run's truth is not written"
+    with removed_unless_recorded(out_dir):
+        _prepare(out_dir, overwrite)
+        with RunRecord(out_dir, overwrite=overwrite, film=config.camera.film) as record:
+            log = Session(parts, world.t_begin, world.t_end, record, progress).run()
+        filmed = record.film.frames if record.film is not None else 0
+        if filmed != len(camera.film_times):
+            raise RigError(
+                f"{record.video_path} holds {filmed} of the camera's {len(camera.film_times)} frames; the run's truth is not written"
+            )
+        impairments = config.camera.impairments
+        truth = run_truth(
+            config,
+            world.pendulum,
+            display,
+            log,
+            camera_span=(0.0, float(camera.frame_times[-1] + camera.frame_span_s)),
+            frames=len(camera.film_times),
+            rois=(list(impairments.film_rect(world.layout.led_roi, camera.width)), list(impairments.film_rect(world.layout.sphere_roi, camera.width))),
+            costs=(app_cost.describe(log.app_costs_s), timing.display_frame_cost()),
+            board=board.truth() if board is not None else None,
+            film=None if config.films_by_default() else _film_truth(config, world, camera.film_times),
         )
-    impairments = config.camera.impairments
-    truth = run_truth(
-        config,
-        world.pendulum,
-        display,
-        log,
-        camera_span=(0.0, float(camera.frame_times[-1] + camera.frame_span_s)),
-        frames=len(camera.film_times),
-        rois=(list(impairments.film_rect(world.layout.led_roi, camera.width)), list(impairments.film_rect(world.layout.sphere_roi, camera.width))),
-        costs=(app_cost.describe(log.app_costs_s), timing.display_frame_cost()),
-        board=board.truth() if board is not None else None,
-        film=None if config.films_by_default() else _film_truth(config, world, camera.film_times),
-    )
-    truth.write(out_dir / TRUTH_FILE)
+        truth.write(out_dir / TRUTH_FILE)
     return SimulationResult(out_dir, record.video_path, truth)

@@ -46,6 +46,7 @@ from declared import from_table, setting_of
 from rig.errors import ConfigError
 from rig.film_file import video_file_name
 from rig.executor import executor
+from rig.fresh_outputs import removed_unless_recorded
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, analysed_row
 from rig.service.bench_profile import BenchProfile, CameraProfile, DisplayProfile, LayoutProfile, read_profile, with_profile
@@ -331,15 +332,16 @@ def run_sweep(
     if held and not overwrite:
         raise ConfigError(f"{out} already holds a sweep ({', '.join(held[:3])}{', ...' if len(held) > 3 else ''}); "
                           "choose another folder or pass --overwrite")  # fmt: skip
-    Path(out).mkdir(parents=True, exist_ok=True)
     run = BatchRun(summary, (*SUMMARY_COLUMNS, "truth_ms", "error_ms", *sweep.labels))
-    run.open()
-    try:
-        with executor(workers, scheduler) as jobs:
-            for _, row in jobs(job, points):
-                run.add(row)
-                if progress is not None:
-                    progress(len(run.rows), len(points))
-        return run.finish(), summary
-    finally:
-        run.close()
+    with removed_unless_recorded(Path(out)):
+        Path(out).mkdir(parents=True, exist_ok=True)
+        run.open()
+        try:
+            with executor(workers, scheduler) as jobs:
+                for _, row in jobs(job, points):
+                    run.add(row)
+                    if progress is not None:
+                        progress(len(run.rows), len(points))
+            return run.finish(), summary
+        finally:
+            run.close()

@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from analysis.video.native_path import native_path
 from predictors import SAMPLE_COLUMNS
 from rig.devices.protocols import CameraFrame
 from rig.errors import RigError
@@ -80,6 +81,7 @@ class FilmRecord:
         self, out_dir: Path, fps: float, width: int, height: int, *, film: Film = MJPEG_AVI, overwrite: bool = False
     ) -> None:
         self.video_path = Path(out_dir) / video_file_name(film[0])
+        native_path(self.video_path)  # OpenCV would crash on a name that is not UTF-8: refused here
         self.fps = fps
         self._table = CsvRecord(Path(out_dir) / FRAMES_FILE, FRAME_COLUMNS, overwrite=overwrite)
         try:

@@ -30,6 +30,7 @@ from urllib.parse import parse_qsl
 
 import cv2
 
+from analysis.video.native_path import native_path
 from rig.clock import Clock
 from rig.devices.protocols import CameraFrame, Fault
 from rig.errors import ConfigError, RigError
@@ -63,7 +64,7 @@ class CameraSource:
 
     @property
     def target(self) -> int | str:
-        return int(self.address) if self.kind == "device" else self.address
+        return int(self.address) if self.kind == "device" else native_path(self.address)
 
 
 def parse_camera_address(address: str) -> tuple[CameraSource, CameraSettings]:

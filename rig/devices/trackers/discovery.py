@@ -7,7 +7,7 @@ from typing import Any
 
 from serial.tools import list_ports
 
-from rig.devices.trackers.lsl_tracker import pylsl
+from rig.devices.trackers.lsl_tracker import resolve_streams
 
 
 def serial_ports() -> list[dict[str, Any]]:
@@ -47,5 +47,5 @@ def lsl_streams(wait_s: float) -> list[dict[str, Any]]:
             "source_id": info.source_id(),
             "host": info.hostname(),
         }
-        for info in pylsl().resolve_streams(wait_time=wait_s)
+        for info in resolve_streams(wait_s)
     ]

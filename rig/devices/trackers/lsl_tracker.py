@@ -38,6 +38,7 @@ except ImportError:
 CHANNELS = ("px", "py", "pz", "qw", "qx", "qy", "qz")
 _STAMP, _POSITION, _ORIENTATION = itemgetter(0), itemgetter(1, 2, 3), itemgetter(4, 5, 6, 7)
 RESOLVE_TIMEOUT_S = 2.0
+RESOLVE_POLL_S = 0.1
 OPEN_TIMEOUT_S = 2.0
 CORRECTION_INTERVAL_S = 1.0
 CORRECTION_TIMEOUT_S = 2.0
@@ -57,6 +58,22 @@ def pylsl() -> ModuleType:
         module.set_config_content(_LIBLSL_CONFIG)
         _pylsl = module
     return _pylsl
+
+
+def resolve_streams(wait_s: float, name: str | None = None) -> list[Any]:
+    """The LSL streams (pylsl StreamInfo) seen within `wait_s` seconds; with `name`, those of that
+    name, returned as soon as one answers. pylsl's own resolve waits inside liblsl, deaf to Ctrl-C
+    and SIGTERM for the whole wait; this one listens in steps of RESOLVE_POLL_S, so a signal stops
+    it at once."""
+    lsl = pylsl()
+    resolver = lsl.ContinuousResolver() if name is None else lsl.ContinuousResolver(prop="name", value=name)
+    deadline = time.monotonic() + wait_s
+    while True:
+        found = resolver.results()
+        left = deadline - time.monotonic()
+        if left <= 0 or (found and name is not None):
+            return found
+        time.sleep(min(RESOLVE_POLL_S, left))
 
 
 def time_correction(inlet: Any, timeout_s: float) -> tuple[float, float]:
@@ -111,7 +128,7 @@ class LslTransport:
         if LslReader is None:
             raise RigError(READER_MISSING)
         lsl = pylsl()
-        streams = lsl.resolve_byprop("name", self.name, timeout=RESOLVE_TIMEOUT_S)
+        streams = resolve_streams(RESOLVE_TIMEOUT_S, self.name)
         if not streams:
             raise RigError(f"no LSL stream named {self.name!r} answered within {RESOLVE_TIMEOUT_S:g} s; `rig devices` lists the streams it sees")
         info = streams[0]
