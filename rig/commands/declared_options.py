@@ -28,6 +28,13 @@ def add_declared_options(parser: argparse.ArgumentParser, kind: type, groups: di
     return sections
 
 
+def add_declared_option(parser: argparse.ArgumentParser, kind: type, path: str) -> None:
+    """The option of the setting `path` (dotted) of `kind` alone, as `add_declared_options` makes it:
+    a command that takes one setting of a config, checked against the same range."""
+    entry = next(entry for entry in walk(kind) if entry.path == path)
+    parser.add_argument(entry.setting.flag.name, dest=_dest(entry), **_argument(entry))
+
+
 def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception], **given: Any) -> Config:
     """The `kind` the options given make (every setting without an option at its default, and the
     fields in `given` as given), each value in its setting's unit; `error` is what `kind` raises

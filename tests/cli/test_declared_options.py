@@ -108,9 +108,9 @@ def test_the_simulation_options_given_make_the_config_and_the_rest_keep_their_de
     ("argv", "message"),
     [
         (["--exposure", "1.5"], "argument --exposure: must be a positive number of frame intervals at most 1, got 1.5"),
-        (["--transport-delay-ms", "-1"], "argument --transport-delay-ms: must be zero or a positive number of ms, got -1"),
+        (["--transport-delay-ms", "-1"], "argument --transport-delay-ms: must be a number of ms from 0 to 1000, got -1"),
         (["--display-hz", "2000"], "argument --display-hz: must be a positive number of Hz from 1 to 1000, got 2000"),
-        (["--release-s=-1"], "argument --release-s: must be zero or a positive number of seconds, got -1"),
+        (["--release-s=-1"], "argument --release-s: must be a number of seconds from 0 to 3600, got -1"),
         (["--app-frame-ms", "fast"], "argument --app-frame-ms: expected a number or 'measured', got 'fast'"),
         (["--occluded", "lamp"], "argument --occluded: invalid choice: 'lamp'"),
     ],

@@ -1,0 +1,65 @@
+"""Limits before work, one schema per input: a number outside its physically meaningful range, a run
+whose estimate cannot finish, or an input of the wrong shape ends in one line on stderr naming the
+option or the key, the value and what is allowed, exit status 2, before any work and with nothing
+written. Commands run in this process through `rig.cli.main`."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import pytest
+
+from rig.cli import EXIT_USER_ERROR, main
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """What a user has lying about: specs, summaries and traces of the wrong shape."""
+    lab = tmp_path_factory.mktemp("lab")
+    (lab / "a-file").write_text("precious")
+    return lab
+
+
+def _snapshot(folder: Path) -> dict[Path, str]:
+    return {path: hashlib.sha256(path.read_bytes()).hexdigest() for path in sorted(folder.rglob("*")) if path.is_file()}
+
+
+# (id, argv with {lab} for the lab folder, words the message must hold)
+CASES = [
+    # simulate: each number within what a lab's rig can be
+    ("simulate-negative-seed", "simulate --out {lab}/new --seed=-1", ("--seed", "from 0 to 1e+09", "-1")),
+    ("simulate-tracker-rate-beyond-any-tracker", "simulate --out {lab}/new --tracker-hz 1e9", ("--tracker-hz", "from 1 to 5000", "1e9")),
+    ("simulate-scene-beyond-any-gpu", "simulate --out {lab}/new --scene-triangles 1000000000000", ("--scene-triangles", "from 0 to 1e+08")),
+    ("simulate-app-frame-beyond-a-second", "simulate --out {lab}/new --app-frame-ms 1e9", ("--app-frame-ms", "at most 1000", "1e9")),
+    ("simulate-period-too-short", "simulate --out {lab}/new --period-s 1e-9", ("--period-s", "from 0.2 to 20", "1e-9")),
+    ("simulate-period-too-long", "simulate --out {lab}/new --period-s 1000", ("--period-s", "from 0.2 to 20", "1000")),
+    ("simulate-camera-beyond-any-camera", "simulate --out {lab}/new --camera-fps 1e6", ("--camera-fps", "from 1 to 10000")),
+    # simulate: every number in range, their product days of work
+    ("simulate-film-that-cannot-finish", "simulate --out {lab}/new --duration 3600 --camera-fps 10000", ("about 24.6 hours", "24 hours")),
+    # plan: the pendulum it simulates
+    ("plan-period-too-short", "plan --display-hz 60 --camera-fps 120 --period-s 1e-9", ("--period-s", "from 0.2 to 20")),
+    ("plan-amplitude-out-of-range", "plan --display-hz 60 --camera-fps 120 --amplitude-deg 90", ("--amplitude-deg", "at most 45")),
+]
+
+
+def _rig(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    try:
+        code = main(argv)
+    except SystemExit as exit_:
+        code = exit_.code
+    return code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, words", [pytest.param(argv, words, id=name) for name, argv, words in CASES])
+def test_out_of_bounds_is_one_line_before_any_work(argv: str, words: tuple[str, ...], lab: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    before = _snapshot(lab)
+    code, err = _rig(argv.format(lab=lab).split(), capsys)
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert code == EXIT_USER_ERROR, err
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert _snapshot(lab) == before
+    assert not (lab / "new").exists()
