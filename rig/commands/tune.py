@@ -20,7 +20,7 @@ from predictors import Trace, read_trace
 from rig.commands import choices, options, outputs
 from rig.progress import ProgressBar
 from rig.service import TuneReport, split_traces, tune
-from rig.service.tune import PARTS, in_time_order
+from rig.service.tune import PARTS, check_scorable, in_time_order
 
 EXIT_NOT_WRITTEN = 1
 
@@ -49,6 +49,7 @@ def _run(args: argparse.Namespace) -> int:
     traces, repaired = _read(args.trace, args.repair)
     held_out, repaired_held_out = _read(args.held_out or [], args.repair)
     train, validation = split_traces(traces, held_out, args.split)
+    check_scorable([*train, *validation], args.horizon_ms / 1e3)
     name, start = args.predictor
     say = (lambda line: print(line, file=sys.stderr)) if args.json else print
     for note in repaired + repaired_held_out:

@@ -34,6 +34,8 @@ COMPARED_WITH = "slerp"
 """The baseline: constant velocity from the last two samples."""
 
 PARTS = ("training", "validation")
+MIN_SAMPLES = 10
+"""The fewest samples a trace (or a part of one) is scored on: fewer give an error of no meaning."""
 
 
 def in_time_order(trace: Trace, repair: bool) -> tuple[Trace, str | None]:
@@ -52,6 +54,18 @@ def in_time_order(trace: Trace, repair: bool) -> tuple[Trace, str | None]:
         )
     repaired = trace.in_time_order()
     return repaired, f"{trace.name}: {what}; sorted by time, {len(trace) - len(repaired)} repeated time(s) dropped"
+
+
+def check_scorable(traces: Sequence[Trace], horizon_s: float) -> None:
+    """ConfigError naming the first trace too short to score a prediction `horizon_s` ahead: fewer
+    than MIN_SAMPLES samples, or no longer than the horizon (no prediction would land on its truth)."""
+    for trace in traces:
+        if len(trace) < MIN_SAMPLES or not trace.duration > horizon_s:
+            raise ConfigError(
+                f"trace {trace.name!r} has {len(trace)} sample(s) over {trace.duration:.6g} s: scoring a prediction "
+                f"{horizon_s * 1e3:g} ms ahead needs at least {MIN_SAMPLES} samples over more than {horizon_s * 1e3:g} ms; "
+                "record longer (or, tuning, give a larger --split or a --held-out trace)"
+            )
 
 
 def split_traces(traces: Sequence[Trace], held_out: Sequence[Trace], split: float) -> tuple[list[Trace], list[Trace]]:

@@ -6,6 +6,7 @@ written. Commands run in this process through `rig.cli.main`."""
 from __future__ import annotations
 
 import hashlib
+import math
 from pathlib import Path
 
 import pytest
@@ -18,7 +19,16 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """What a user has lying about: specs, summaries and traces of the wrong shape."""
     lab = tmp_path_factory.mktemp("lab")
     (lab / "a-file").write_text("precious")
+    _trace(lab / "two-samples.csv", [0.0, 0.01])
+    times = [i * 0.01 for i in range(300)]
+    times[10], times[20] = times[20], times[10]
+    _trace(lab / "unsorted.csv", times)
     return lab
+
+
+def _trace(path: Path, times: list[float]) -> None:
+    rows = "".join(f"{t!r},{math.sin(t)},0,0,1,0,0,0\n" for t in times)
+    path.write_text(f"t,px,py,pz,qw,qx,qy,qz\n{rows}")
 
 
 def _snapshot(folder: Path) -> dict[Path, str]:
@@ -40,6 +50,18 @@ CASES = [
     # plan: the pendulum it simulates
     ("plan-period-too-short", "plan --display-hz 60 --camera-fps 120 --period-s 1e-9", ("--period-s", "from 0.2 to 20")),
     ("plan-amplitude-out-of-range", "plan --display-hz 60 --camera-fps 120 --amplitude-deg 90", ("--amplitude-deg", "at most 45")),
+    # bench: each option within a lab's reach, a batch within a day
+    ("bench-predictors-duration-beyond-ten-minutes", "bench predictors --duration 1e12", ("--duration", "from 1 to 600", "1e12")),
+    ("bench-predictors-horizon-beyond-a-second", "bench predictors --horizons-ms 10,5000", ("--horizons-ms", "from 0 to 1000")),
+    ("bench-predictors-negative-seed", "bench predictors --seed=-3", ("--seed", "from 0 to 1e+09")),
+    ("bench-batch-videos-beyond-a-lab", "bench batch --videos 1000000000", ("--videos", "from 1 to 1000")),
+    ("bench-batch-that-cannot-finish", "bench batch --videos 1000 --duration 3600 --rounds 100", ("about 1.53e+04 hours", "24 hours")),
+    ("bench-trackers-duration-beyond-ten-minutes", "bench trackers --duration 1e12", ("--duration", "from 0.5 to 600")),
+    ("bench-trackers-rate-beyond-any-tracker", "bench trackers --rate 1e9", ("--rate", "from 1 to 10000")),
+    # traces: scored only where a prediction can land on the truth, in time order
+    ("bench-predictors-two-sample-trace", "bench predictors --trace {lab}/two-samples.csv", ("'two-samples'", "at least 10 samples")),
+    ("bench-predictors-unsorted-trace", "bench predictors --trace {lab}/unsorted.csv", ("not in time order", "--repair")),
+    ("tune-two-sample-trace", "tune kalman-cv --trace {lab}/two-samples.csv --horizon-ms 20 --out {lab}/p.json", ("at least 10 samples",)),
 ]
 
 
