@@ -23,6 +23,21 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
     times = [i * 0.01 for i in range(300)]
     times[10], times[20] = times[20], times[10]
     _trace(lab / "unsorted.csv", times)
+    (lab / "base-a-number.toml").write_text('base = 5\n[grid]\n"camera.fps" = [120]\n')
+    (lab / "grid-a-number.toml").write_text("grid = 5\n")
+    (lab / "renderers-camera-a-number.toml").write_text("latency_camera = 5\n")
+    (lab / "analysis-a-number.toml").write_text('analysis = 3\n[grid]\n"camera.fps" = [120]\n')
+    (lab / "camera-a-number.toml").write_text('[base]\ncamera = 5\n[grid]\n"pendulum.period_s" = [1.0]\n')
+    values = ", ".join(str(120 + i) for i in range(1000))
+    (lab / "billion-points.toml").write_text(f'[grid]\n"camera.fps" = [{values}]\n"seed" = [{values}]\n"scene_triangles" = [{values}]\n')
+    (lab / "summary-a-list.json").write_text("[1, 2]")
+    (lab / "summary-rows-a-number.json").write_text('{"rows": 5}')
+    (lab / "summary-rows-of-numbers.json").write_text('{"rows": [1, 2]}')
+    (lab / "summary-latency-a-table.json").write_text('{"rows": [{"video": "a.avi", "latency_ms": {"ms": 1}}]}')
+    for name, truth in (("truncated-truth", '{"latency_ms": 31.2, "con'), ("truth-of-another-shape", '{"latency_ms": "31.2", "config": {}}')):
+        (lab / name).mkdir()
+        (lab / name / "video.avi").write_text("a film")
+        (lab / name / "truth.json").write_text(truth)
     return lab
 
 
@@ -61,6 +76,21 @@ CASES = [
     # traces: scored only where a prediction can land on the truth, in time order
     ("bench-predictors-two-sample-trace", "bench predictors --trace {lab}/two-samples.csv", ("'two-samples'", "at least 10 samples")),
     ("bench-predictors-unsorted-trace", "bench predictors --trace {lab}/unsorted.csv", ("not in time order", "--repair")),
+    # sweep and bench specs: a table where a table belongs, a grid counted before it is made
+    ("sweep-base-a-number", "sweep {lab}/base-a-number.toml --out {lab}/sweep", ("base must be a table", "5")),
+    ("sweep-grid-a-number", "sweep {lab}/grid-a-number.toml --out {lab}/sweep", ("grid must be a table", "5")),
+    ("sweep-analysis-a-number", "sweep {lab}/analysis-a-number.toml --out {lab}/sweep", ("analysis must be a table", "3")),
+    ("sweep-camera-a-number", "sweep {lab}/camera-a-number.toml --out {lab}/sweep", ("camera",)),
+    ("sweep-billion-points", "sweep {lab}/billion-points.toml --out {lab}/sweep", ("1000000000 points", "1000 x 1000 x 1000", "10000")),
+    ("bench-analyser-base-a-number", "bench analyser --spec {lab}/base-a-number.toml", ("base must be a table",)),
+    ("bench-renderers-camera-a-number", "bench renderers --spec {lab}/renderers-camera-a-number.toml", ("latency_camera must be a table", "5")),
+    # summaries and truths: the shape the rig writes
+    ("report-summary-a-list", "report {lab}/summary-a-list.json --out {lab}/r.html", ('"rows" is a list',)),
+    ("report-summary-rows-a-number", "report {lab}/summary-rows-a-number.json --out {lab}/r.html", ('"rows" is a list',)),
+    ("report-summary-rows-of-numbers", "report {lab}/summary-rows-of-numbers.json --out {lab}/r.html", ("video column",)),
+    ("report-summary-latency-a-table", "report {lab}/summary-latency-a-table.json --out {lab}/r.html", ("summary-latency-a-table.json",)),
+    ("report-truncated-truth", "report {lab}/truncated-truth --out {lab}/r.html", ("truth.json", "simulate the run again")),
+    ("report-truth-of-another-shape", "report {lab}/truth-of-another-shape --out {lab}/r.html", ("latency_ms (a number)",)),
     ("tune-two-sample-trace", "tune kalman-cv --trace {lab}/two-samples.csv --horizon-ms 20 --out {lab}/p.json", ("at least 10 samples",)),
 ]
 
