@@ -9,6 +9,8 @@ import hashlib
 import math
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 
 from rig.cli import EXIT_USER_ERROR, main
@@ -115,3 +117,40 @@ def test_out_of_bounds_is_one_line_before_any_work(argv: str, words: tuple[str, 
         assert word in lines[0], lines[0]
     assert _snapshot(lab) == before
     assert not (lab / "new").exists()
+
+
+SHORT_FILM = "[base]\nduration_s = 0.5\ncamera.fps = 30.0\ncamera.width = 160\ncamera.height = 120\ncamera.subsamples = 1\n"
+"""Half a pendulum period, filmed small: simulated in a moment, refused by the analyser (too few periods)."""
+
+
+def _every_one_failed(code: int, err: str, what: str) -> None:
+    """Exit status 2, and the last line of stderr says every one of `what` failed."""
+    assert "Traceback" not in err
+    assert code == EXIT_USER_ERROR, err
+    assert f"every one of the {what}" in err.strip().splitlines()[-1], err
+
+
+def test_a_sweep_whose_every_point_failed_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "short.toml"
+    spec.write_text(SHORT_FILM + "[grid]\nseed = [1, 2]\n")
+    code, err = _rig(["sweep", str(spec), "--out", str(tmp_path / "sweep")], capsys)
+    _every_one_failed(code, err, "2 points failed")
+    assert "pendulum periods" in err
+    assert (tmp_path / "sweep" / "summary.csv").exists()
+
+
+def test_a_bench_whose_every_case_was_refused_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "short.toml"
+    spec.write_text(SHORT_FILM + '[[points]]\nlabels = { case = "short", group = "mixed", impairment = "none" }\nseed = 1\n')
+    code, err = _rig(["bench", "analyser", "--spec", str(spec)], capsys)
+    _every_one_failed(code, err, "1 cases")
+
+
+def test_a_batch_whose_every_video_failed_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    for name in ("black.avi", "grey.avi"):
+        writer = cv2.VideoWriter(str(tmp_path / name), cv2.VideoWriter_fourcc(*"MJPG"), 60.0, (64, 48))
+        for _ in range(40):
+            writer.write(np.full((48, 64, 3), 0 if name == "black.avi" else 128, np.uint8))
+        writer.release()
+    code, err = _rig(["analyse", str(tmp_path / "black.avi"), str(tmp_path / "grey.avi")], capsys)
+    _every_one_failed(code, err, "2 videos failed")
