@@ -244,7 +244,7 @@ class PredictorBenchOptions:
                                    flag="--tune-iterations")  # fmt: skip
     duration_s: float = setting(
         30.0, "seconds", "simulated pendulum, synthetic head and stress streams, each (a minute of motion scores a "
-        "predictor; ten is the most the bench simulates)", Range(1.0, 600.0, True, True), flag="--duration",
+        "predictor; ten minutes is the most the bench simulates)", Range(1.0, 600.0, True, True), flag="--duration",
     )  # fmt: skip
     seed: int = setting(0, "", "seed of the simulated traces", Range(0.0, 1e9, True, True), flag="--seed")
     timing_repeats: int = setting(3, "", "timed replays per predictor and trace; the best counts", Range(0.0, 100.0, True, True),

@@ -66,10 +66,10 @@ def test_the_options_given_make_the_config_and_the_rest_keep_their_defaults() ->
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--display-hz", "0"], "argument --display-hz: must be a positive number of Hz, got 0"),
-        (["--seed", "-1"], "argument --seed: must be zero or a positive whole number, got -1"),
+        (["--display-hz", "0"], "argument --display-hz: must be a positive number of Hz from 1 to 1000, got 0"),
+        (["--seed", "-1"], "argument --seed: must be a whole number from 0 to 1e+09, got -1"),
         (["--seed", "1.5"], "argument --seed: expected a whole number, got '1.5'"),
-        (["--led-roi=-1,0,10,10"], "argument --led-roi: must have each item zero or a positive whole number of pixels, got -1,0,10,10"),
+        (["--led-roi=-1,0,10,10"], "argument --led-roi: must have each item a whole number of pixels from 0 to 65535, got -1,0,10,10"),
         (["--led-roi", "1,2,3"], "argument --led-roi: expected X,Y,W,H, 4 whole numbers, got '1,2,3'"),
         (["--latency-range", "50,1"], "argument --latency-range: LOW must be below HIGH, got 50,1"),
     ],

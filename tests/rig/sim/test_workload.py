@@ -1,5 +1,5 @@
-"""A simulated run's settings are each bounded (a finite range declared on every number) and their
-product is bounded too: a run whose estimate is past `MAX_HOURS` is refused before it starts."""
+"""Every number a user sets is bounded (a finite range declared on it), and a simulated run's
+settings' product is bounded too: a run whose estimate is past `MAX_HOURS` is refused before it starts."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from declared import walk
 from declared.settings import optional
 from rig.errors import ConfigError
+from rig.option_tables import SECTIONS
 from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
 from rig.sim.display import DisplayConfig
@@ -31,7 +32,13 @@ def _bounded(end: float, included: bool) -> bool:
     return math.isfinite(end) or included
 
 
-@pytest.mark.parametrize("entry", [e for e in walk(SimulationConfig) if _numeric(e.hint)], ids=lambda e: e.path)
+DECLARING = tuple(kind for _, kind, _, _ in SECTIONS)
+"""Every config whose settings a user gives: the docs' tables' (`rig.option_tables`)."""
+
+
+@pytest.mark.parametrize(
+    "entry", [e for kind in DECLARING for e in walk(kind) if _numeric(e.hint)], ids=lambda e: f"{e.path}"
+)
 def test_every_numeric_setting_has_a_finite_range(entry: object) -> None:
     declared = entry.setting
     assert declared.range is not None, entry.path
