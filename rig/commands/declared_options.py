@@ -28,11 +28,15 @@ def add_declared_options(parser: argparse.ArgumentParser, kind: type, groups: di
     return sections
 
 
-def add_declared_option(parser: argparse.ArgumentParser, kind: type, path: str) -> None:
-    """The option of the setting `path` (dotted) of `kind` alone, as `add_declared_options` makes it:
-    a command that takes one setting of a config, checked against the same range."""
+def add_declared_option(parser: argparse.ArgumentParser, kind: type, path: str, required: bool = False) -> None:
+    """The option of the setting `path` (dotted) of `kind` alone, as `add_declared_options` makes it
+    (`required`: with no default): a command that takes one setting of a config, checked against
+    the same range."""
     entry = next(entry for entry in walk(kind) if entry.path == path)
-    parser.add_argument(entry.setting.flag.name, dest=_dest(entry), **_argument(entry))
+    argument = _argument(entry)
+    if required:
+        argument |= {"required": True, "default": None, "help": argument["help"].rpartition(" (")[0] + f" ({entry.setting.unit})"}
+    parser.add_argument(entry.setting.flag.name, dest=_dest(entry), **argument)
 
 
 def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception], **given: Any) -> Config:

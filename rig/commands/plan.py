@@ -19,6 +19,7 @@ from rig.commands import options, outputs
 from rig.commands.declared_options import add_declared_option
 from rig.service import Plan, PlanRequest, plan
 from rig.service.bench_profile import BenchProfile, read_profile, write_profile
+from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
 
 EXIT_UNREACHABLE = 1
@@ -104,7 +105,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "shortest film, checked by a simulation; print every setting's expected half-width and the bias a "
         "phase-locked camera could have. Exit status 0 with a recommendation, 1 when none reaches the accuracy.",
     )
-    parser.add_argument("--display-hz", type=options.positive_float, required=True, help="the display's refresh rate")
+    add_declared_option(parser, DisplayConfig, "refresh_hz", required=True)
     parser.add_argument(
         "--camera-fps", type=_numbers, required=True, metavar="F,F,...", help="the camera's frame rates on offer (20-2000)"
     )

@@ -66,6 +66,7 @@ CASES = [
     ("simulate-film-that-cannot-finish", "simulate --out {lab}/new --duration 3600 --camera-fps 10000", ("about 24.6 hours", "24 hours")),
     # plan: the pendulum it simulates
     ("plan-period-too-short", "plan --display-hz 60 --camera-fps 120 --period-s 1e-9", ("--period-s", "from 0.2 to 20")),
+    ("plan-display-beyond-any-display", "plan --display-hz 1e9 --camera-fps 120", ("--display-hz", "from 1 to 1000", "1e9")),
     ("plan-amplitude-out-of-range", "plan --display-hz 60 --camera-fps 120 --amplitude-deg 90", ("--amplitude-deg", "at most 45")),
     # bench: each option within a lab's reach, a batch within a day
     ("bench-predictors-duration-beyond-ten-minutes", "bench predictors --duration 1e12", ("--duration", "from 1 to 600", "1e12")),
