@@ -116,7 +116,7 @@ def _parser(entry: Entry) -> Callable[[str], Any]:
         try:
             if len(parts) != len(items):
                 raise ValueError
-            values = tuple(kind(part) for kind, part in zip(items, parts))
+            values = tuple((_whole if kind is int else kind)(part) for kind, part in zip(items, parts))
         except ValueError:
             raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}") from None
         value = values if listed else values[0]
@@ -126,6 +126,17 @@ def _parser(entry: Entry) -> Callable[[str], Any]:
         return value
 
     return parse
+
+
+def _whole(text: str) -> int:
+    """A whole number, written as one or in exponent form ("1e6"); ValueError for anything else."""
+    try:
+        return int(text)
+    except ValueError:
+        value = float(text)
+        if not value.is_integer():
+            raise
+        return int(value)
 
 
 def _expected(kinds: tuple[Any, ...], metavar: str | None, none: str) -> str:
