@@ -16,10 +16,16 @@ from rig.sim.display import DisplayConfig
 from rig.sim.flash import FlashTarget
 from rig.sim.pendulum import PendulumConfig
 from rig.sim.tracker import TrackerConfig
-from rig.sim.workload import problem as workload_problem
 
 MEASURED = "measured"
 """A cost given as this (on the command line, in a spec) is what this machine's GL takes."""
+PIXEL_INSTANTS_PER_S = 1e9
+"""Sensor pixels the simulated camera films per second, one exposure instant each: a generous rate
+(this machine films about 8e8)."""
+TRIANGLES_PER_S = 1e9
+"""Load triangles the renderer draws per second: a generous rate for a GPU."""
+MAX_HOURS = 24.0
+"""The longest simulation the rig starts: longer is a mistake in the settings, not a lab's run."""
 # (section, field) of settings a run's record leaves out at their defaults (`SimulationConfig.to_dict`).
 FILM_DEFAULTS = (
     ("camera", "readout_s"), ("camera", "frame_jitter_s"), ("camera", "container"), ("camera", "codec"), ("", "layout"), ("", "flash"),
@@ -105,9 +111,26 @@ class SimulationConfig:
                 f"the blink ({self.board.blink_start_s:g} s to {self.board.blink_end_s:g} s) must fall within the "
                 f"filmed span (0 to {self.duration_s:g} s): start it after 0 s and film at least until it ends"
             )
-        too_much = workload_problem(self)
-        if too_much is not None:
-            raise ConfigError(too_much)
+        hours = self.estimated_hours()
+        if hours > MAX_HOURS:
+            raise ConfigError(
+                f"this run would take about {hours:.3g} hours ({self.duration_s:g} s filmed at {self.camera.fps:g} fps, "
+                f"{self.camera.width}x{self.camera.height} pixels, {self.camera.subsamples} instants an exposure, "
+                f"{self.scene_triangles} load triangles), more than the {MAX_HOURS:g} hours the rig starts: film "
+                "shorter, slower, smaller or with fewer triangles"
+            )
+
+    def estimated_hours(self) -> float:
+        """Hours the run takes at generous rates (PIXEL_INSTANTS_PER_S, TRIANGLES_PER_S): its film's
+        pixel-instants and its scene's triangles, drawn at most once a refresh and at least once an
+        application frame. Every setting may be within its range while their product (a long film at
+        a high rate, a heavy scene drawn many times) is days of work: such a run is refused."""
+        camera = self.camera
+        filming_s = self.duration_s * camera.fps * camera.width * camera.height * camera.subsamples / PIXEL_INSTANTS_PER_S
+        frame_s = (self.app_frame_ms or 0.0) / 1e3
+        frames_per_s = self.display.refresh_hz if frame_s == 0.0 else min(self.display.refresh_hz, 1.0 / frame_s)
+        drawing_s = (self.duration_s + self.warmup_s) * frames_per_s * self.scene_triangles / TRIANGLES_PER_S
+        return (filming_s + drawing_s) / 3600.0
 
     def to_dict(self) -> dict[str, Any]:
         """The config as plain values; the camera's rolling shutter, frame timing and film file and

@@ -14,9 +14,8 @@ from declared.settings import optional
 from rig.errors import ConfigError
 from rig.option_tables import SECTIONS
 from rig.sim.camera import CameraConfig
-from rig.sim.config import SimulationConfig
+from rig.sim.config import MAX_HOURS, PIXEL_INSTANTS_PER_S, SimulationConfig
 from rig.sim.display import DisplayConfig
-from rig.sim.workload import MAX_HOURS, PIXEL_INSTANTS_PER_S, estimated_hours
 
 NUMBERS = (int, float)
 
@@ -47,14 +46,14 @@ def test_every_numeric_setting_has_a_finite_range(entry: object) -> None:
 
 
 def test_the_default_run_is_far_inside_the_limit() -> None:
-    assert estimated_hours(SimulationConfig()) < 0.01 * MAX_HOURS
+    assert SimulationConfig().estimated_hours() < 0.01 * MAX_HOURS
 
 
 @given(st.floats(0.5, 1800.0), st.floats(1.0, 5000.0))
 def test_filming_hours_are_frames_times_pixel_instants(duration_s: float, fps: float) -> None:
     camera = CameraConfig(fps=fps, width=64, height=48, subsamples=1)
     config = SimulationConfig(duration_s=duration_s, camera=camera)
-    assert estimated_hours(config) == pytest.approx(duration_s * fps * 64 * 48 / PIXEL_INSTANTS_PER_S / 3600.0)
+    assert config.estimated_hours() == pytest.approx(duration_s * fps * 64 * 48 / PIXEL_INSTANTS_PER_S / 3600.0)
 
 
 def test_a_run_that_cannot_finish_is_refused_with_its_estimate() -> None:
