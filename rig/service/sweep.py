@@ -167,7 +167,7 @@ def build(kind: type, settings: Mapping[str, Any]) -> Any:
         for depth, parent in enumerate(parents):
             level = level.setdefault(parent, {})
             if not isinstance(level, dict):
-                raise ConfigError(f"the sweep sets {'.'.join(parents[: depth + 1])} to a value and {key} as well")
+                raise ConfigError(f"the sweep's {'.'.join(parents[: depth + 1])} must be a table of settings ({key} among them), not {level!r}")
         level[name] = value
     return from_table(kind, table, ConfigError, "the sweep")
 

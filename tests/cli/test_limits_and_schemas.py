@@ -83,7 +83,7 @@ CASES = [
     ("sweep-base-a-number", "sweep {lab}/base-a-number.toml --out {lab}/sweep", ("base must be a table", "5")),
     ("sweep-grid-a-number", "sweep {lab}/grid-a-number.toml --out {lab}/sweep", ("grid must be a table", "5")),
     ("sweep-analysis-a-number", "sweep {lab}/analysis-a-number.toml --out {lab}/sweep", ("analysis must be a table", "3")),
-    ("sweep-camera-a-number", "sweep {lab}/camera-a-number.toml --out {lab}/sweep", ("camera",)),
+    ("sweep-camera-a-number", "sweep {lab}/camera-a-number.toml --out {lab}/sweep", ("camera must be a table", "5")),
     ("sweep-billion-points", "sweep {lab}/billion-points.toml --out {lab}/sweep", ("1000000000 points", "1000 x 1000 x 1000", "10000")),
     ("bench-analyser-base-a-number", "bench analyser --spec {lab}/base-a-number.toml", ("base must be a table",)),
     ("bench-renderers-camera-a-number", "bench renderers --spec {lab}/renderers-camera-a-number.toml", ("latency_camera must be a table", "5")),
