@@ -56,7 +56,10 @@ class CameraConfig:
     constant rate), size, sensor and film; `container` and `codec` are the film's file
     (`rig.film_file`: an MJPEG AVI, or H.264 or HEVC in an MP4 or a MOV)."""
 
-    fps: float = setting(240.0, "frames per second", "camera frame rate", Range(1.0, 10000.0, True, True), flag="--camera-fps")
+    fps: float = setting(
+        240.0, "frames per second", "camera frame rate: a webcam films tens of frames a second, a high-speed camera "
+        "several thousand", Range(1.0, 10000.0, True, True), flag="--camera-fps",
+    )  # fmt: skip
     exposure_s: float | None = setting(
         None, "seconds", "camera exposure, at most one frame interval", Range(0.0, 1.0, includes_high=True), unset="the whole frame interval",
         flag=Flag(

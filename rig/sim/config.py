@@ -57,7 +57,10 @@ class SimulationConfig:
     None.
     """
 
-    duration_s: float = setting(10.0, "seconds", "length of the film", Range(0.5, 3600.0, True, True), flag="--duration")
+    duration_s: float = setting(
+        10.0, "seconds", "length of the film (a lab films seconds to minutes; an hour at most)", Range(0.5, 3600.0, True, True),
+        flag="--duration",
+    )  # fmt: skip
     seed: int = setting(0, "", "random seed; the same seed gives the same video", Range(0.0, 1e9, True, True), flag="--seed")
     pendulum: PendulumConfig = field(default_factory=PendulumConfig)
     tracker: TrackerConfig = field(default_factory=TrackerConfig)

@@ -33,7 +33,10 @@ _KEEP_REFRESHES = 4
 
 @dataclass(frozen=True)
 class DisplayConfig:
-    refresh_hz: float = setting(60.0, "Hz", "display refresh rate", Range(1.0, 1000.0, True, True), flag="--display-hz")
+    refresh_hz: float = setting(
+        60.0, "Hz", "display refresh rate: headsets and monitors refresh at 60 to 240 Hz, none at 1000",
+        Range(1.0, 1000.0, True, True), flag="--display-hz",
+    )  # fmt: skip
     width: int = setting(320, "pixels", "display width", Range(16.0, 4096.0, True, True))
     height: int = setting(240, "pixels", "display height", Range(16.0, 4096.0, True, True))
     scanout_fraction: float = setting(1.0, "", "share of a refresh period that scan-out takes", Range(0.0, 1.0, includes_high=True))
