@@ -44,7 +44,7 @@ from rig.bench.predictor_scores import BASELINE, HeldOut, Ratios, cost_ratios, l
 from rig.commands import choices, options
 from rig.commands.declared_options import add_declared_options
 from rig.errors import ConfigError
-from rig.service.tune import check_scorable, in_time_order
+from rig.service.tune import HORIZONS, check_scorable, in_time_order
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import TrackerConfig, simulate_tracker
 
@@ -222,11 +222,6 @@ def record(scores: Scores) -> dict[str, Any]:
         "leave_one_out": [h.to_dict() for h in scores.held],
         "results": [r.to_dict() for r in scores.results],
     }
-
-
-HORIZONS = Range(0.0, 1000.0, True, True)
-"""A prediction horizon: a display's photons come tens of ms after a sample, a cloud-rendered one's
-a few hundred; past a second no motion is predictable."""
 
 
 @dataclass(frozen=True)

@@ -94,6 +94,9 @@ CASES = [
     ("report-summary-latency-a-table", "report {lab}/summary-latency-a-table.json --out {lab}/r.html", ("summary-latency-a-table.json",)),
     ("report-truncated-truth", "report {lab}/truncated-truth --out {lab}/r.html", ("truth.json", "simulate the run again")),
     ("report-truth-of-another-shape", "report {lab}/truth-of-another-shape --out {lab}/r.html", ("latency_ms (a number)",)),
+    ("tune-horizon-beyond-a-second", "tune kalman-cv --trace {lab}/unsorted.csv --horizon-ms 1e12 --out {lab}/p.json", ("--horizon-ms", "from 0 to 1000")),
+    ("tune-iterations-beyond-any-fit", "tune kalman-cv --trace {lab}/unsorted.csv --horizon-ms 20 --max-iterations 1e12 --out {lab}/p.json",
+     ("--max-iterations", "from 0 to 10000")),
     ("tune-two-sample-trace", "tune kalman-cv --trace {lab}/two-samples.csv --horizon-ms 20 --out {lab}/p.json", ("at least 10 samples",)),
 ]
 
