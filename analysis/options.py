@@ -15,11 +15,17 @@ from analysis.cycles import DEFAULT_LATENCY_RANGE_S
 from analysis.errors import AnalysisError
 from analysis.estimators.registry import ALL, DEFAULT_METHOD, methods
 from analysis.hints.hint import APPLIED, CHECKED, IDENTITY, Hint, HintedFacts, in_words
-from declared import ANY, NON_NEGATIVE, POSITIVE, Flag, check, setting, setting_of
+from declared import Flag, Range, check, setting, setting_of
 from declared.settings import hints as field_types
 from declared.settings import whole_numbers
 
 ROI = tuple[int, int, int, int]
+CAMERA_RATES = Range(1.0, 10000.0, True, True)
+"""Frames per second a camera films at: a webcam's tens to a high-speed camera's several thousand."""
+DISPLAY_RATES = Range(1.0, 1000.0, True, True)
+"""Refreshes per second of a display: tens (a headset, a monitor) to a few hundred (a gaming panel)."""
+PIXELS = Range(0.0, 65535.0, True, True)
+"""A position or size in a frame: no sensor is wider than this."""
 
 
 def _methods() -> tuple[str, ...]:
@@ -37,15 +43,15 @@ class AnalysisOptions:
     """How to analyse a video (see `analysis.analyse`); every field is checked when the options are made."""
 
     fps: float | None = setting(
-        None, "frames per second", "camera frame rate, overriding the file's; needed for image folders", POSITIVE,
+        None, "frames per second", "camera frame rate, overriding the file's; needed for image folders", CAMERA_RATES,
         unset="the file's", flag="--fps",
     )  # fmt: skip
     led_roi: ROI | None = setting(
-        None, "pixels", "region the LED swings in, X,Y,W,H; give both regions or neither", NON_NEGATIVE,
+        None, "pixels", "region the LED swings in, X,Y,W,H; give both regions or neither", PIXELS,
         unset="found in the video", flag=Flag("--led-roi", metavar="X,Y,W,H"),
     )  # fmt: skip
     sphere_roi: ROI | None = setting(
-        None, "pixels", "region the sphere moves in, X,Y,W,H", NON_NEGATIVE, unset="found in the video",
+        None, "pixels", "region the sphere moves in, X,Y,W,H", PIXELS, unset="found in the video",
         flag=Flag("--sphere-roi", metavar="X,Y,W,H"),
     )  # fmt: skip
     led_side: str | None = setting(
@@ -54,21 +60,21 @@ class AnalysisOptions:
     )  # fmt: skip
     method: str = setting(DEFAULT_METHOD, "", "estimator, as listed below", choices=_methods, flag="--method")
     latency_range_ms: tuple[float, float] = setting(
-        tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S), "ms", "latencies considered, to fix the whole number of swing periods",
-        ANY, rule=increasing, flag=Flag("--latency-range", metavar="LOW,HIGH"),
+        tuple(v * 1e3 for v in DEFAULT_LATENCY_RANGE_S), "ms", "latencies considered, to fix the whole number of swing periods (a "
+        "display's tens of ms to a streamed one's seconds)", Range(-10000.0, 10000.0, True, True), rule=increasing, flag=Flag("--latency-range", metavar="LOW,HIGH"),
     )  # fmt: skip
-    seed: int = setting(0, "", "random seed of the bayes sampler", NON_NEGATIVE, flag="--seed")
+    seed: int = setting(0, "", "random seed of the bayes sampler", Range(0.0, 1e9, True, True), flag="--seed")
     display_hz: float | None = setting(
-        None, "Hz", "the display's refresh rate, if known; it fixes how the camera samples it", POSITIVE,
+        None, "Hz", "the display's refresh rate, if known; it fixes how the camera samples it", DISPLAY_RATES,
         unset="looked for in the video", flag="--display-hz",
     )  # fmt: skip
     exposure_ms: float | None = setting(
-        None, "ms", "the camera's exposure, if known", POSITIVE, unset="estimated from the LED's motion blur",
+        None, "ms", "the camera's exposure, if known (at most a second)", Range(0.0, 1000.0, includes_high=True), unset="estimated from the LED's motion blur",
         flag="--exposure-ms",
     )  # fmt: skip
     readout_ms: float | None = setting(
         None, "ms", "the camera's rolling-shutter readout, top row to bottom row (0 for a global shutter), if known: "
-        "each blob is then timed by its rows", NON_NEGATIVE, unset="any readout up to the frame interval is allowed for",
+        "each blob is then timed by its rows", Range(0.0, 1000.0, True, True), unset="any readout up to the frame interval is allowed for",
         flag="--readout-ms",
     )  # fmt: skip
 

@@ -24,13 +24,14 @@ class Range:
 
     def describe(self, unit: str) -> str:
         """The range in words, for messages and help: "a positive number of seconds from 0.5 to 3600"."""
+        closed = self.includes_low and self.includes_high and math.isfinite(self.low) and math.isfinite(self.high)
         if self.low == 0.0 and self.includes_low:
-            kind = "zero or a positive number"
+            kind = "a number" if closed else "zero or a positive number"
         else:
             kind = "a positive number" if self.low >= 0.0 else "a number"
         lower = f"{'at least' if self.includes_low else 'above'} {self.low:g}" if self.low not in (0.0, -math.inf) else ""
         upper = f"{'at most' if self.includes_high else 'below'} {self.high:g}" if self.high != math.inf else ""
-        if lower and upper and self.includes_low and self.includes_high:
+        if closed:
             bounds = f"from {self.low:g} to {self.high:g}"
         else:
             bounds = " and ".join(part for part in (lower, upper) if part)

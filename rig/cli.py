@@ -11,7 +11,9 @@ frames; the number stands, with its caveats printed); EXIT_USER_ERROR (2) bad in
 that cannot be measured; EXIT_INTERRUPTED (130) and EXIT_TERMINATED (143) a run stopped, its
 records kept; EXIT_FAULT (1) a fault of the rig's own, printed with its traceback. A few commands
 give 1 a meaning of their own: `rig demo` and `rig measure` a disagreement, `rig tune` parameters
-not written, `rig plan` no setting that reaches the accuracy.
+not written, `rig plan` no setting that reaches the accuracy. A sweep, a batch (`rig analyse` of many
+videos) or a bench whose every item failed exits EXIT_USER_ERROR, after writing its summary with
+why each failed: there is no number to read.
 """
 
 from __future__ import annotations

@@ -7,7 +7,11 @@ from __future__ import annotations
 from analysis import AnalysisOptions
 from analysis.shutter import ShutterOptions
 from declared.docs import markdown_table
+from rig.bench.batch import BatchBenchOptions
+from rig.bench.predictors import PredictorBenchOptions
 from rig.bench.renderers import BenchGrid
+from rig.bench.trackers import TrackerBenchOptions
+from rig.service.tune import TuneSettings
 from rig.service.bench_profile import BenchProfile
 from rig.sim.config import SimulationConfig
 
@@ -38,6 +42,10 @@ SECTIONS = (
         "`rig bench renderers --spec FILE.toml` (its `--triangles`, `--resolutions`, `--ratios`, `--warp`, `--server-ms`, "
         "`--predictor` and `--direct-predictor` override the file).",
     ),
+    ("Tuning a predictor", TuneSettings, True, "`rig tune`'s numeric options."),
+    ("The predictor bench", PredictorBenchOptions, True, "`rig bench predictors`'s numeric options."),
+    ("The tracker bench", TrackerBenchOptions, True, "`rig bench trackers`'s options."),
+    ("The batch bench", BatchBenchOptions, True, "`rig bench batch`'s options; a batch that would take more than a day is refused with its estimate."),
 )
 
 

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 from analysis.errors import AnalysisError
 from analysis.hints.hint import HintedFacts
-from analysis.options import AnalysisOptions
-from declared import NON_NEGATIVE, OPEN_UNIT, POSITIVE, Flag, Range, check, like, setting
+from analysis.options import DISPLAY_RATES, PIXELS, AnalysisOptions
+from declared import OPEN_UNIT, Flag, Range, check, like, setting
 
 ROI = tuple[int, int, int, int]
 SOURCES = ("light", "display")
@@ -29,7 +29,7 @@ class ShutterOptions:
     )  # fmt: skip
     source: str = setting("light", "", "what flashes: a light, or a display whose rows scan out", choices=SOURCES, flag="--source")
     display_hz: float | None = setting(
-        None, "Hz", "the flashing display's refresh rate", POSITIVE, unset="no display", flag=Flag("--display-hz", metavar="HZ", group="display"),
+        None, "Hz", "the flashing display's refresh rate", DISPLAY_RATES, unset="no display", flag=Flag("--display-hz", metavar="HZ", group="display"),
     )  # fmt: skip
     scanout: str = like(HintedFacts, "scanout", flag=Flag("--scanout", group="display"))
     scanout_share: float | None = setting(
@@ -37,12 +37,12 @@ class ShutterOptions:
         Range(0.0, 1.0, includes_high=True), unset="0.88 to 1 allowed for", flag=Flag("--scanout-share", metavar="S", group="display"),
     )  # fmt: skip
     roi: ROI | None = setting(
-        None, "pixels", "look for the flashing light only here, X,Y,W,H (a display: its whole height)", NON_NEGATIVE,
+        None, "pixels", "look for the flashing light only here, X,Y,W,H (a display: its whole height)", PIXELS,
         unset="the whole frame", flag=Flag("--roi", metavar="X,Y,W,H"),
     )  # fmt: skip
     fps: float | None = like(AnalysisOptions, "fps")
     max_exposure_s: float | None = setting(
-        None, "seconds", "the longest the camera's exposure can be", POSITIVE, unset="a frame interval",
+        None, "seconds", "the longest the camera's exposure can be, at most a second", Range(0.0, 1.0, includes_high=True), unset="a frame interval",
         flag=Flag("--max-exposure-ms", unit="ms", factor=1e3, metavar="MS"),
     )  # fmt: skip
 

@@ -322,6 +322,13 @@ def run(sweep: Sweep, context: Context) -> dict[str, Any]:
             "sweep": rows, "seconds": time.perf_counter() - started}  # fmt: skip
 
 
+def every_case_refused(cases: list[dict[str, Any]]) -> str | None:
+    """Where the analyser refused every case: how many, and the first refusal."""
+    if not cases or any(case["refused"] is None for case in cases):
+        return None
+    return f"the analyser refused every one of the {len(cases)} cases (the first: {cases[0]['refused']})"
+
+
 def tables(report: dict[str, Any]) -> str:
     """Each group's summary as a table under its name and count."""
     return "\n".join(f"{group} ({summary['sinefit']['cases']} cases):\n{table(summary)}" for group, summary in report["summaries"].items())
@@ -337,6 +344,7 @@ BENCH = Bench(
     spec=lambda args: of_groups(args.spec, args.grid),
     run=run, table=tables,
     targets=lambda report: report["targets_met"],
+    all_failed=lambda report: every_case_refused(report["cases"]),
     notes=lambda report: f"{len(report['cases'])} cases in {report['seconds'] / 60:.1f} minutes",
     plot=lambda report, path: plot(report["summary"], report["cases"], path),
     options=_options,

@@ -25,12 +25,14 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from declared import Flag, Range, check, like, setting
 from rig.bench.contract import Bench, Context, Log
-from rig.commands import options
+from rig.commands.declared_options import add_declared_options, config_from_args
+from rig.errors import ConfigError
 from rig.executor import worker_environment
 from rig.service.simulate import simulate
 from rig.sim.config import SimulationConfig
@@ -47,6 +49,47 @@ def _process_seconds(arguments: list[str], environment: dict[str, str], allowed:
     if done.returncode not in allowed:
         raise RuntimeError(f"{' '.join(arguments)} exited {done.returncode}: {done.stderr.strip()[-500:]}")
     return time.perf_counter() - started
+
+
+SIMULATING_S_PER_FILM_S = 0.25
+"""Seconds simulating a second of film takes: a generous rate (this machine takes about 0.75)."""
+ANALYSING_S_PER_FILM_S = 0.05
+"""Seconds analysing a second of film takes: a generous rate."""
+MAX_HOURS = 24.0
+"""The longest batch bench it starts: longer is a mistake in the options."""
+
+
+@dataclass(frozen=True)
+class BatchBenchOptions:
+    """The batch bench's options, each declared on its field; a bench that could not finish in
+    MAX_HOURS at generous rates is refused with its estimate."""
+
+    videos: int = setting(24, "videos", "videos in the batch (a lab's day of films is tens to hundreds)", Range(1.0, 1000.0, True, True),
+                          flag="--videos")  # fmt: skip
+    duration_s: float = like(SimulationConfig, "duration_s", default=6.0, help="seconds per batch video", flag=Flag("--duration"))
+    clip_duration_s: float = like(SimulationConfig, "duration_s", default=20.0, help="seconds of the fixed-cost clip",
+                                  flag=Flag("--clip-duration"))  # fmt: skip
+    workers: int = setting(2, "processes", "Dask worker processes", Range(1.0, 256.0, True, True), flag="--workers")
+    rounds: int = setting(3, "", "times the batch runs serially and on Dask, alternately", Range(1.0, 100.0, True, True),
+                          flag="--rounds")  # fmt: skip
+
+    def __post_init__(self) -> None:
+        check(self, ConfigError)
+        hours = self.estimated_hours()
+        if hours > MAX_HOURS:
+            raise ConfigError(
+                f"this bench would take about {hours:.3g} hours ({self.videos} videos of {self.duration_s:g} s, each "
+                f"analysed {3 * self.rounds} times), more than the {MAX_HOURS:g} hours the rig starts: fewer videos, "
+                "shorter ones or fewer rounds"
+            )
+
+    def estimated_hours(self) -> float:
+        """Hours at the generous rates above: every film simulated once, each batch video analysed
+        three times a round (serially, serially as a worker, on Dask), the clip three times."""
+        batch_s = self.videos * self.duration_s
+        simulating = (batch_s + self.clip_duration_s) * SIMULATING_S_PER_FILM_S
+        analysing = (3 * self.rounds * batch_s + 3 * self.clip_duration_s) * ANALYSING_S_PER_FILM_S
+        return (simulating + analysing) / 3600.0
 
 
 def videos(folder: Path, count: int, duration_s: float, log: Log) -> list[Path]:
@@ -122,11 +165,11 @@ def fixed_cost(clip: Path, log: Log) -> dict[str, Any]:
     }
 
 
-def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
+def run(spec: BatchBenchOptions, context: Context) -> dict[str, Any]:
     """The batch's scale-out and a clip's fixed cost (see the module docstring)."""
-    paths = videos(context.folder / "batch", args.videos, args.duration, context.log)
-    clip = simulate(replace(SimulationConfig(duration_s=args.clip_duration), seed=99), context.folder / "clip", overwrite=True).video_path
-    return {"scale_out": scale_out(paths, args.workers, args.rounds, context.log), "fixed_cost": fixed_cost(clip, context.log)}
+    paths = videos(context.folder / "batch", spec.videos, spec.duration_s, context.log)
+    clip = simulate(replace(SimulationConfig(duration_s=spec.clip_duration_s), seed=99), context.folder / "clip", overwrite=True).video_path
+    return {"scale_out": scale_out(paths, spec.workers, spec.rounds, context.log), "fixed_cost": fixed_cost(clip, context.log)}
 
 
 def table(report: dict[str, Any]) -> str:
@@ -166,17 +209,13 @@ def plot(report: dict[str, Any], path: Path) -> None:
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--videos", type=options.positive_int, default=24, help="videos in the batch (default: %(default)s)")
-    parser.add_argument("--duration", type=options.positive_float, default=6.0, help="seconds per batch video (default: %(default)s)")
-    parser.add_argument("--clip-duration", type=options.positive_float, default=20.0, help="seconds of the fixed-cost clip (default: %(default)s)")
-    parser.add_argument("--workers", type=options.positive_int, default=2, help="Dask worker processes (default: %(default)s)")
-    parser.add_argument("--rounds", type=options.positive_int, default=3,
-                        help="times the batch runs serially and on Dask, alternately (default: %(default)s)")  # fmt: skip
+    add_declared_options(parser, BatchBenchOptions)
 
 
 BENCH = Bench(
     name="batch",
     help="what many measurements cost: a batch serially and on Dask, and the fixed cost per video",
     run=run, table=table, plot=plot, options=_options,
+    spec=lambda args: config_from_args(BatchBenchOptions, args, ConfigError),
     outputs={"json": "write the figures as JSON", "plot": "draw the wall times"},
 )

@@ -79,6 +79,9 @@ class Bench:
     """each target and whether this run met it (None: not measured)"""
     notes: Callable[[Any], str] | None = None
     """what else the figures carry (machine noise, time taken), printed last"""
+    all_failed: Callable[[Any], str | None] | None = None
+    """a sentence where every item the bench measured failed (its figures are of nothing), else
+    None: `rig bench` then exits with status 2 once it has written and printed what it has"""
     options: Callable[[argparse.ArgumentParser], object] = lambda parser: None
     """adds the bench's own options (a mode's join its subject's)"""
     outputs: dict[str, str] = field(default_factory=dict)

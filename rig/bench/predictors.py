@@ -38,10 +38,13 @@ import predictors
 from predictors import Evaluation, Trace, evaluate, read_trace
 from predictors.stress import stress_streams
 from predictors.synthetic import head_motion
+from declared import Flag, Range, setting
 from rig.bench.contract import Bench, Context
 from rig.bench.predictor_scores import BASELINE, HeldOut, Ratios, cost_ratios, label, leave_one_out, ratios
 from rig.commands import choices, options
+from rig.commands.declared_options import add_declared_options
 from rig.errors import ConfigError
+from rig.service.tune import HORIZONS, check_scorable, in_time_order
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import TrackerConfig, simulate_tracker
 
@@ -173,7 +176,14 @@ def run(args: argparse.Namespace, context: Context) -> Scores:
     horizons, plot_horizon = args.horizons_ms, args.plot_horizon_ms
     if plot_horizon not in horizons:
         raise ConfigError(f"--plot-horizon-ms {plot_horizon:g} must be one of --horizons-ms {','.join(f'{h:g}' for h in horizons)}")
-    traces = [read_trace(path) for path in args.trace or []] + (stress_streams(args.duration, args.seed) if args.stress else [])
+    given = []
+    for path in args.trace or []:
+        trace, repaired = in_time_order(read_trace(path), args.repair)
+        given.append(trace)
+        if repaired is not None:
+            context.log(f"repaired {repaired}")
+    check_scorable(given, max(horizons) / 1e3)
+    traces = given + (stress_streams(args.duration, args.seed) if args.stress else [])
     traces = traces or default_traces(args.duration, args.seed)
     if args.leave_one_out and len(traces) < 2:
         raise ConfigError("--leave-one-out needs at least two traces: it tunes on all but one")
@@ -214,15 +224,26 @@ def record(scores: Scores) -> dict[str, Any]:
     }
 
 
-def _horizons_ms(text: str) -> tuple[float, ...]:
-    """A comma-separated list of horizons in ms, each >= 0."""
-    try:
-        values = tuple(float(part) for part in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected horizons in ms separated by commas, got {text!r}") from None
-    if not all(math.isfinite(v) and v >= 0.0 for v in values):
-        raise argparse.ArgumentTypeError(f"horizons must be zero or positive milliseconds, got {text!r}")
-    return values
+@dataclass(frozen=True)
+class PredictorBenchOptions:
+    """The predictor bench's numeric options, each declared on its field (the command line's are
+    made from them and checked against their ranges as they are read)."""
+
+    horizons_ms: tuple[float, ...] = setting(
+        DEFAULT_HORIZONS_MS, "ms", "prediction horizons after each sample's arrival", HORIZONS,
+        flag=Flag("--horizons-ms", metavar="H,H,..."),
+    )  # fmt: skip
+    plot_horizon_ms: float = setting(50.0, "ms", "the horizon the plot shows and --leave-one-out tunes for", HORIZONS,
+                                     flag="--plot-horizon-ms")  # fmt: skip
+    tune_iterations: int = setting(40, "", "optimiser iterations per --leave-one-out fit", Range(0.0, 10000.0, True, True),
+                                   flag="--tune-iterations")  # fmt: skip
+    duration_s: float = setting(
+        30.0, "seconds", "simulated pendulum, synthetic head and stress streams, each (a minute of motion scores a "
+        "predictor; ten minutes is the most the bench simulates)", Range(1.0, 600.0, True, True), flag="--duration",
+    )  # fmt: skip
+    seed: int = setting(0, "", "seed of the simulated traces", Range(0.0, 1e9, True, True), flag="--seed")
+    timing_repeats: int = setting(3, "", "timed replays per predictor and trace; the best counts", Range(0.0, 100.0, True, True),
+                                  flag="--timing-repeats")  # fmt: skip
 
 
 def _tunable(name: str) -> str:
@@ -238,24 +259,16 @@ def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--trace", type=Path, action="append", metavar="FILE",
                         help="trace CSV (t_sensor,t_arrival,px,py,pz,qw,qx,qy,qz, or t instead of t_sensor); repeat "
                         "for several (default: the built-in four)")  # fmt: skip
+    parser.add_argument("--repair", action="store_true",
+                        help="sort a --trace that is out of time order and drop repeated times, instead of refusing it")  # fmt: skip
     parser.add_argument("--stress", action="store_true",
                         help="run the synthetic stress streams (30-1000 Hz, noise, jitter, repeats, sudden stops) too")  # fmt: skip
     parser.add_argument("--predictor", type=options.predictor_spec, action="append", metavar="NAME[:key=value,...]",
                         help="predictor (listed below) and parameters, or NAME:FILE.json; repeat for several (default: every "
                         f"predictor); {BASELINE}, the baseline, is always run")  # fmt: skip
-    parser.add_argument("--horizons-ms", type=_horizons_ms, default=DEFAULT_HORIZONS_MS, metavar="H,H,...",
-                        help="prediction horizons after each sample's arrival (default: 0,10,20,50,100)")  # fmt: skip
-    parser.add_argument("--plot-horizon-ms", type=options.non_negative_float, default=50.0,
-                        help="the horizon the plot shows and --leave-one-out tunes for (default: %(default)s)")  # fmt: skip
     parser.add_argument("--leave-one-out", type=_tunable, action="append", metavar="NAME",
                         help="tune NAME on all traces but one and score it on that one, for each trace; repeat for several")  # fmt: skip
-    parser.add_argument("--tune-iterations", type=options.non_negative_int, default=40,
-                        help="optimiser iterations per --leave-one-out fit (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--duration", type=options.positive_float, default=30.0,
-                        help="seconds of simulated pendulum, synthetic head and stress streams (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--seed", type=int, default=0, help="seed of the simulated traces (default: %(default)s)")
-    parser.add_argument("--timing-repeats", type=options.non_negative_int, default=3,
-                        help="timed replays per predictor and trace; the best counts (default: %(default)s)")  # fmt: skip
+    add_declared_options(parser, PredictorBenchOptions)
 
 
 BENCH = Bench(

@@ -49,7 +49,7 @@ from typing import Any
 
 import numpy as np
 
-from declared import NON_NEGATIVE, POSITIVE, Range, check, like, setting
+from declared import Range, check, like, setting
 from predictors import Pose
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, SpecFile, cell, given
@@ -81,6 +81,10 @@ LATENCY_FIELDS = (
 """The fields a latency run fills in a row."""
 
 
+TRIANGLES = Range(0.0, 1e8, True, True)
+"""A load's triangles: a heavy VR scene draws a few million a frame, 100 million is past any GPU's budget."""
+
+
 @dataclass(frozen=True)
 class BenchGrid:
     """What `rig bench renderers` measures, and how much of it: each setting declared on its field
@@ -89,34 +93,36 @@ class BenchGrid:
 
     triangles: tuple[int, ...] = setting(
         (10_000, 100_000, 1_000_000, 5_000_000), "triangles",
-        "load sizes (a soup of small random triangles), each timed at every resolution", NON_NEGATIVE,
+        "load sizes (a soup of small random triangles), each timed at every resolution", TRIANGLES,
     )  # fmt: skip
     resolutions: tuple[tuple[int, int], ...] = setting(
         ((320, 240), (640, 480), (1280, 720)), "pixels", "display sizes, [width, height]; the first is the latency films' display too"
     )
     ratios: tuple[int, ...] = setting(
         (1, 5, 10), "", "client:display rate ratios 1:r whose image error is measured (display frames per client frame)",
-        Range(1.0, includes_low=True),
+        Range(1.0, 100.0, True, True),
     )  # fmt: skip
     warp: str = setting("warp", "", "the warp renderer and its options, a renderer spec such as warp:recon=grid,views=2")
-    phases: int = setting(4, "", "client poses per load and resolution for the image error, spread over a swing", Range(1.0, includes_low=True))
+    phases: int = setting(4, "", "client poses per load and resolution for the image error, spread over a swing",
+                          Range(1.0, 1000.0, True, True))  # fmt: skip
     warp_rounds: int = setting(
-        16, "", "rounds of warp timing; each round times one display frame of every load in turn", Range(1.0, includes_low=True)
+        16, "", "rounds of warp timing; each round times one display frame of every load in turn", Range(1.0, 10000.0, True, True)
     )
-    direct_frames: int = setting(4, "", "direct frames timed at most (the first is always timed)", Range(1.0, includes_low=True))
-    direct_budget_s: float = setting(6.0, "seconds", "no more direct frames are timed after this long", POSITIVE)
+    direct_frames: int = setting(4, "", "direct frames timed at most (the first is always timed)", Range(1.0, 10000.0, True, True))
+    direct_budget_s: float = setting(6.0, "seconds", "no more direct frames are timed after this long", Range(0.0, 3600.0, includes_high=True))
     latency_triangles: tuple[int, ...] | None = setting(
-        None, "triangles", "the load sizes whose latency is filmed", NON_NEGATIVE, unset="all of them"
+        None, "triangles", "the load sizes whose latency is filmed", TRIANGLES, unset="all of them"
     )
     latency_camera: CameraConfig = CameraConfig()
     """the latency films' camera; its frame rate follows the pendulum's period"""
-    latency_duration_s: float = setting(6.0, "seconds", "the latency films' shortest length", POSITIVE)
+    latency_duration_s: float = setting(6.0, "seconds", "the latency films' shortest length", Range(0.5, 3600.0, True, True))
     max_period_s: float = setting(
-        8.0, "seconds", "the longest pendulum period filmed: a latency that would need a longer one is beyond range", POSITIVE
+        8.0, "seconds", "the longest pendulum period filmed: a latency that would need a longer one is beyond range",
+        Range(0.2, 20.0, True, True),
     )
     refresh_hz: float = like(DisplayConfig, "refresh_hz", flag=None)
     server_ms: float | None = setting(
-        None, "ms", "the warp server's modelled cost in the latency films", POSITIVE, unset="measured here, as every other cost"
+        None, "ms", "the warp server's modelled cost in the latency films", Range(0.0, 1000.0, includes_high=True), unset="measured here, as every other cost"
     )
     predictor: str = setting("hold", "", "the latency films' predictor, both renderers alike (as in Smit et al. 2010, Table 2)")
     direct_predictor: str | None = setting(

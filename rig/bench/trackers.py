@@ -48,9 +48,10 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from declared import Range, setting
 from rig.bench.contract import Bench, Context, Log
 from rig.clock import MonotonicClock
-from rig.commands import options
+from rig.commands.declared_options import add_declared_options
 from rig.devices.trackers.decoders import BinaryDecoder
 from rig.devices.trackers.profile import load_profile
 from rig.devices.trackers.stream import TrackerRecord
@@ -313,9 +314,21 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
     figure.savefig(path, dpi=100)
 
 
+@dataclass(frozen=True)
+class TrackerBenchOptions:
+    """The tracker bench's options, each declared on its field; each case runs in real time, so its
+    duration is the bench's time."""
+
+    rate_hz: float = setting(
+        1000.0, "Hz", "records a second: trackers send up to a few kHz, 10 kHz stresses the reader beyond any",
+        Range(1.0, 10000.0, True, True), flag="--rate",
+    )  # fmt: skip
+    duration_s: float = setting(10.0, "seconds", "seconds per case, run in real time (at most ten minutes)",
+                                Range(0.5, 600.0, True, True), flag="--duration")  # fmt: skip
+
+
 def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--rate", type=options.positive_float, default=1000.0, help="records a second (default: %(default)s)")
-    parser.add_argument("--duration", type=options.positive_float, default=10.0, help="seconds per case (default: %(default)s)")
+    add_declared_options(parser, TrackerBenchOptions)
     parser.add_argument("--quick", dest="duration", action="store_const", const=2.0, help="2 s per case (a smoke test)")
 
 

@@ -9,7 +9,9 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from rig.cli import EXIT_WARNINGS
+import sys
+
+from rig.cli import EXIT_USER_ERROR, EXIT_WARNINGS
 from rig.commands import outputs
 from rig.errors import ConfigError
 from rig.progress import ProgressBar
@@ -42,7 +44,8 @@ def _line(row: dict[str, Any]) -> str:
 
 
 def run_batch_command(args: argparse.Namespace, template: AnalysisRequest, videos: list[Path]) -> int:
-    """Exit 0 when every video measured cleanly, 3 when any failed or came with warnings."""
+    """Exit 0 when every video measured cleanly, 3 when any failed or came with warnings, 2 when every
+    one failed (its summary written, with why)."""
     labels = labels_from(args.labels, videos)
     names = list(dict.fromkeys(name for values in labels.values() for name in values))
     if args.group is not None and args.group not in names:
@@ -65,4 +68,7 @@ def run_batch_command(args: argparse.Namespace, template: AnalysisRequest, video
         writes = outputs.LateWrites()
         writes.write(plot, lambda: write_summary_plot(rows, plot, group))
         writes.check()
+    if rows and all(row["status"] == "failed" for row in rows):
+        print(f"rig analyse: error: every one of the {len(rows)} videos failed (the first: {rows[0]['error']})", file=sys.stderr)
+        return EXIT_USER_ERROR
     return 0 if all(row["status"] == "ok" for row in rows) else EXIT_WARNINGS

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import sys
 import tempfile
 from contextlib import contextmanager
 from functools import partial
@@ -14,6 +15,7 @@ from typing import Any, Iterator
 
 from rig.bench import SUBJECTS
 from rig.bench.contract import Bench, Context
+from rig.cli import EXIT_USER_ERROR
 from rig.commands import options, outputs
 
 OUTPUT_TYPES = {"json": (outputs.json_file, "OUT.json"), "csv": (outputs.csv_file, "OUT.csv"), "plot": (outputs.plot_file, "OUT.png")}
@@ -60,6 +62,10 @@ def run(subject: Bench, args: argparse.Namespace) -> int:
     if bench.notes is not None:
         print(bench.notes(rows))
     writes.check()
+    failed = bench.all_failed(rows) if bench.all_failed is not None else None
+    if failed is not None:
+        print(f"rig bench {subject.name}: error: {failed}", file=sys.stderr)
+        return EXIT_USER_ERROR
     return 0
 
 

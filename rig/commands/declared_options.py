@@ -28,6 +28,17 @@ def add_declared_options(parser: argparse.ArgumentParser, kind: type, groups: di
     return sections
 
 
+def add_declared_option(parser: argparse.ArgumentParser, kind: type, path: str, required: bool = False) -> None:
+    """The option of the setting `path` (dotted) of `kind` alone, as `add_declared_options` makes it
+    (`required`: with no default): a command that takes one setting of a config, checked against
+    the same range."""
+    entry = next(entry for entry in walk(kind) if entry.path == path)
+    argument = _argument(entry)
+    if required:
+        argument |= {"required": True, "default": None, "help": argument["help"].rpartition(" (")[0] + f" ({entry.setting.unit})"}
+    parser.add_argument(entry.setting.flag.name, dest=_dest(entry), **argument)
+
+
 def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception], **given: Any) -> Config:
     """The `kind` the options given make (every setting without an option at its default, and the
     fields in `given` as given), each value in its setting's unit; `error` is what `kind` raises
@@ -105,7 +116,7 @@ def _parser(entry: Entry) -> Callable[[str], Any]:
         try:
             if len(parts) != len(items):
                 raise ValueError
-            values = tuple(kind(part) for kind, part in zip(items, parts))
+            values = tuple((_whole if kind is int else kind)(part) for kind, part in zip(items, parts))
         except ValueError:
             raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}") from None
         value = values if listed else values[0]
@@ -115,6 +126,17 @@ def _parser(entry: Entry) -> Callable[[str], Any]:
         return value
 
     return parse
+
+
+def _whole(text: str) -> int:
+    """A whole number, written as one or in exponent form ("1e6"); ValueError for anything else."""
+    try:
+        return int(text)
+    except ValueError:
+        value = float(text)
+        if not value.is_integer():
+            raise
+        return int(value)
 
 
 def _expected(kinds: tuple[Any, ...], metavar: str | None, none: str) -> str:

@@ -16,8 +16,10 @@ from pathlib import Path
 from typing import Any
 
 from rig.commands import options, outputs
+from rig.commands.declared_options import add_declared_option
 from rig.service import Plan, PlanRequest, plan
 from rig.service.bench_profile import BenchProfile, read_profile, write_profile
+from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
 
 EXIT_UNREACHABLE = 1
@@ -103,7 +105,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "shortest film, checked by a simulation; print every setting's expected half-width and the bias a "
         "phase-locked camera could have. Exit status 0 with a recommendation, 1 when none reaches the accuracy.",
     )
-    parser.add_argument("--display-hz", type=options.positive_float, required=True, help="the display's refresh rate")
+    add_declared_option(parser, DisplayConfig, "refresh_hz", required=True)
     parser.add_argument(
         "--camera-fps", type=_numbers, required=True, metavar="F,F,...", help="the camera's frame rates on offer (20-2000)"
     )
@@ -114,10 +116,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         metavar="E,E,...",
         help="exposures on offer, as fractions of the frame interval in (0, 1] (default: 1, the whole interval)",
     )
-    parser.add_argument("--period-s", type=options.positive_float, default=1.0, help="the pendulum's period (default: %(default)s)")
-    parser.add_argument(
-        "--amplitude-deg", type=options.positive_float, default=PendulumConfig().amplitude_deg, help="its swing (default: %(default)s)"
-    )
+    add_declared_option(parser, PendulumConfig, "period_s")
+    add_declared_option(parser, PendulumConfig, "amplitude_deg")
     parser.add_argument(
         "--accuracy-ms", type=options.positive_float, default=1.0, help="the 95%% half-width wanted, in ms (default: %(default)s)"
     )

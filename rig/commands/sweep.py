@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
+from rig.cli import EXIT_USER_ERROR
 from rig.commands import options, outputs
 from rig.progress import ProgressBar
 from rig.service.sweep import read_sweep, run_sweep
@@ -23,6 +25,11 @@ def _run(args: argparse.Namespace) -> int:
             measured = f"{row['latency_ms']:.2f} ms (true {row['truth_ms']:.2f}, error {row['error_ms']:+.3f})" if row["latency_ms"] is not None else f"failed: {row['error']}"
             print(f"{settings}: {measured}")
         print(f"summary: {summary} and {summary.with_suffix('.json')}")
+    failed = [row for row in rows if row["status"] == "failed"]
+    if rows and len(failed) == len(rows):
+        print(f"rig sweep: error: every one of the {len(rows)} points failed (the first: {failed[0]['error']}); "
+              f"{summary} says why each did", file=sys.stderr)  # fmt: skip
+        return EXIT_USER_ERROR
     return 0
 
 
@@ -36,7 +43,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "latency_range_ms, display_hz...; and simulated_rois = true to analyse within the regions the simulation put the LED and the sphere in). A cost "
         "(app_frame_ms, warp_ms) may be \"measured\". "
         "Each point is simulated into DIR/pointNNN and analysed; DIR/summary.csv (and .json) gets one row per point "
-        "as it finishes, with the truth and the error beside the measured latency.",
+        "as it finishes, with the truth and the error beside the measured latency. Exit status 2 when every point "
+        "failed (the summary says why each did).",
     )
     parser.add_argument("spec", type=Path, metavar="SPEC.toml", help="the sweep")
     parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder for the runs and the summary")

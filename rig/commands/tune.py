@@ -18,9 +18,10 @@ from pathlib import Path
 
 from predictors import Trace, read_trace
 from rig.commands import choices, options, outputs
+from rig.commands.declared_options import add_declared_option
 from rig.progress import ProgressBar
 from rig.service import TuneReport, split_traces, tune
-from rig.service.tune import PARTS, in_time_order
+from rig.service.tune import PARTS, TuneSettings, check_scorable, in_time_order
 
 EXIT_NOT_WRITTEN = 1
 
@@ -49,6 +50,7 @@ def _run(args: argparse.Namespace) -> int:
     traces, repaired = _read(args.trace, args.repair)
     held_out, repaired_held_out = _read(args.held_out or [], args.repair)
     train, validation = split_traces(traces, held_out, args.split)
+    check_scorable([*train, *validation], args.horizon_ms / 1e3)
     name, start = args.predictor
     say = (lambda line: print(line, file=sys.stderr)) if args.json else print
     for note in repaired + repaired_held_out:
@@ -92,12 +94,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         help="trace CSV; repeat for several")
     parser.add_argument("--held-out", type=Path, action="append", metavar="FILE",
                         help="validation trace CSV; repeat for several (default: the end of each --trace)")
-    parser.add_argument("--split", type=options.positive_float, default=0.6,
-                        help="fraction of each trace's duration to train on when no --held-out is given (default: %(default)s)")
-    parser.add_argument("--horizon-ms", type=options.non_negative_float, required=True,
-                        help="prediction horizon after each sample's arrival to tune for")
-    parser.add_argument("--max-iterations", type=options.non_negative_int, default=40,
-                        help="optimiser iterations at most (default: %(default)s)")
+    add_declared_option(parser, TuneSettings, "split")
+    add_declared_option(parser, TuneSettings, "horizon_ms", required=True)
+    add_declared_option(parser, TuneSettings, "max_iterations")
     parser.add_argument("--out", type=outputs.json_file, required=True, metavar="FILE.json", help="parameter file to write")
     parser.add_argument("--force", action="store_true", help="write the parameters even if they lose to the defaults on validation")
     parser.add_argument("--repair", action="store_true",

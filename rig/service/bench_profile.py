@@ -46,7 +46,7 @@ from analysis.hints import Hint
 from analysis.hints.hint import HintedFacts
 from analysis.options import increasing
 from analysis.readout import READOUT_TOLERANCE
-from declared import NON_NEGATIVE, check, from_table, like, setting
+from declared import Range, check, from_table, like, setting
 from rig.errors import ConfigError
 from rig.toml_file import read_toml
 
@@ -58,7 +58,7 @@ def _source(what: str, examples: str = "a datasheet, rig plan, rig calibrate-cam
 
 
 def _interval(what: str) -> Any:
-    return setting(None, "ms", f"the {what}'s 95 % interval, where it was measured", NON_NEGATIVE, rule=increasing, unset="not measured")
+    return setting(None, "ms", f"the {what}'s 95 % interval, where it was measured", Range(0.0, 1000.0, True, True), rule=increasing, unset="not measured")
 
 
 @dataclass(frozen=True)

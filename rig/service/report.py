@@ -96,13 +96,30 @@ def _run_verdict(result: LatencyResult, truth: dict[str, Any] | None) -> str:
     return verdict
 
 
+def read_truth(path: Path) -> dict[str, Any]:
+    """A simulated run's truth.json (`rig simulate` writes it): an object with its latency_ms (a
+    number) and its config (an object); ConfigError naming the file for anything else, before any
+    work is done."""
+    try:
+        truth = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        raise ConfigError(f"cannot read the simulation's truth {path}: {error}; simulate the run again, or move the file away") from None
+    latency = truth.get("latency_ms") if isinstance(truth, dict) else None
+    if not (isinstance(latency, (int, float)) and not isinstance(latency, bool) and isinstance(truth.get("config"), dict)):
+        raise ConfigError(
+            f"{path} is not a simulation's truth: it must be an object with latency_ms (a number) and config (an object), "
+            "as rig simulate writes it; simulate the run again, or move the file away"
+        )
+    return truth
+
+
 def run_report(path: Path) -> tuple[Report, Measurement]:
     """The report of a video, or of a run folder holding video.avi (and maybe truth.json, board/)."""
     path = Path(path)
     folder = path if path.is_dir() and (path / RUN_VIDEO).exists() else None
     video = folder / RUN_VIDEO if folder is not None else path
     truth_path = (folder or video.parent) / TRUTH
-    truth = json.loads(truth_path.read_text()) if truth_path.exists() else None
+    truth = read_truth(truth_path) if truth_path.exists() else None
     board = (folder or video.parent) / BOARD_FOLDER
     request = AnalysisRequest(video, board=board if (board / METADATA).exists() else None)
     measurement = analyse(request)
@@ -133,10 +150,14 @@ def read_summary(path: Path) -> list[dict[str, Any]]:
     path = Path(path)
     try:
         if path.suffix.lower() == ".json":
-            return json.loads(path.read_text())["rows"]
-        with open(path, newline="", encoding="utf-8") as stream:
-            rows = list(csv.DictReader(stream))
-        if not isinstance(rows, list) or not all(isinstance(row, dict) and "video" in row for row in rows):
+            document = json.loads(path.read_text(encoding="utf-8"))
+            rows = document.get("rows") if isinstance(document, dict) else None
+            if not isinstance(rows, list):
+                raise ValueError('a summary JSON is an object whose "rows" is a list, as `rig analyse --summary` and `rig sweep` write')
+        else:
+            with open(path, newline="", encoding="utf-8") as stream:
+                rows = list(csv.DictReader(stream))
+        if not all(isinstance(row, dict) and "video" in row for row in rows):
             raise ValueError("every row needs a video column, as `rig analyse --summary` and `rig sweep` write")
         numeric = ("latency_ms", "ci95_low_ms", "ci95_high_ms", "period_s", "frequency_hz", "seconds")
         for row in rows:

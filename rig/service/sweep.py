@@ -37,6 +37,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -61,6 +62,9 @@ SIMULATED_BENCH = "simulated_bench"
 """The [analysis] option that gives each video its own simulation's bench as hints."""
 FLAGS = (SIMULATED_ROIS, SIMULATED_BENCH)
 """The [analysis] option that analyses each video within its simulation's regions."""
+MAX_POINTS = 10_000
+"""The most points a sweep runs: more is a grid written by mistake (each point is a film simulated
+and analysed, seconds to minutes each), counted before any point is made."""
 BENCH = "bench"
 """The [analysis] option naming a bench profile (`rig.service.bench_profile`; a path from the sweep's
 folder), whose values are each video's hints, as `rig analyse --bench` takes them."""
@@ -164,7 +168,7 @@ def build(kind: type, settings: Mapping[str, Any]) -> Any:
         for depth, parent in enumerate(parents):
             level = level.setdefault(parent, {})
             if not isinstance(level, dict):
-                raise ConfigError(f"the sweep sets {'.'.join(parents[: depth + 1])} to a value and {key} as well")
+                raise ConfigError(f"the sweep's {'.'.join(parents[: depth + 1])} must be a table of settings ({key} among them), not {level!r}")
         level[name] = value
     return from_table(kind, table, ConfigError, "the sweep")
 
@@ -230,6 +234,9 @@ def read_sweep(path: Path) -> Sweep:
     unknown = set(spec) - {"base", "grid", "points", "analysis"}
     if unknown:
         raise ConfigError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}; a sweep has [base], [grid], [[points]] and [analysis]")
+    for table in ("base", "grid", "analysis"):
+        if not isinstance(spec.get(table, {}), dict):
+            raise ConfigError(f"{path}: {table} must be a table ([{table}]) of settings, not {spec[table]!r}")
     grid = _dotted(spec.get("grid", {}))
     explicit = spec.get("points", [])
     if not grid and not explicit:
@@ -239,6 +246,13 @@ def read_sweep(path: Path) -> Sweep:
             raise ConfigError(f"{path}: grid.{name} must be a non-empty list of values")
     if not isinstance(explicit, list) or not all(isinstance(point, dict) for point in explicit):
         raise ConfigError(f"{path}: points must be a list of tables ([[points]]), each a point's settings")
+    count = math.prod(len(values) for values in grid.values()) * bool(grid) + len(explicit)
+    if count > MAX_POINTS:
+        sizes = " x ".join(str(len(values)) for values in grid.values())
+        raise ConfigError(
+            f"{path} has {count} points ({sizes} in the grid, {len(explicit)} given one by one), more than the "
+            f"{MAX_POINTS} a sweep runs: sweep fewer values, or split it into sweeps of its own"
+        )
     for number, point in enumerate(explicit, 1):
         if "labels" in point and not isinstance(point["labels"], dict):
             raise ConfigError(f"{path}: point {number}'s labels must be a table of names and values")

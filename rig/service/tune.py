@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 
 from predictors import DEFAULT, Trace, evaluate, resolve, write_params
+from declared import Range, setting
 from rig.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -34,6 +35,25 @@ COMPARED_WITH = "slerp"
 """The baseline: constant velocity from the last two samples."""
 
 PARTS = ("training", "validation")
+HORIZONS = Range(0.0, 1000.0, True, True)
+"""A prediction horizon: a display's photons come tens of ms after a sample, a cloud-rendered one's
+a few hundred; past a second no motion is predictable."""
+
+
+@dataclass(frozen=True)
+class TuneSettings:
+    """`rig tune`'s numbers, each declared on its field (its options are made from them and checked
+    against their ranges as the command line is read)."""
+
+    split: float = setting(0.6, "", "fraction of each trace's duration to train on when no --held-out is given",
+                           Range(0.0, 1.0), flag="--split")  # fmt: skip
+    horizon_ms: float | None = setting(None, "ms", "prediction horizon after each sample's arrival to tune for", HORIZONS,
+                                       unset="always given", flag="--horizon-ms")  # fmt: skip
+    max_iterations: int = setting(40, "", "optimiser iterations at most", Range(0.0, 10000.0, True, True), flag="--max-iterations")
+
+
+MIN_SAMPLES = 10
+"""The fewest samples a trace (or a part of one) is scored on: fewer give an error of no meaning."""
 
 
 def in_time_order(trace: Trace, repair: bool) -> tuple[Trace, str | None]:
@@ -52,6 +72,18 @@ def in_time_order(trace: Trace, repair: bool) -> tuple[Trace, str | None]:
         )
     repaired = trace.in_time_order()
     return repaired, f"{trace.name}: {what}; sorted by time, {len(trace) - len(repaired)} repeated time(s) dropped"
+
+
+def check_scorable(traces: Sequence[Trace], horizon_s: float) -> None:
+    """ConfigError naming the first trace too short to score a prediction `horizon_s` ahead: fewer
+    than MIN_SAMPLES samples, or no longer than the horizon (no prediction would land on its truth)."""
+    for trace in traces:
+        if len(trace) < MIN_SAMPLES or not trace.duration > horizon_s:
+            raise ConfigError(
+                f"trace {trace.name!r} has {len(trace)} sample(s) over {trace.duration:.6g} s: scoring a prediction "
+                f"{horizon_s * 1e3:g} ms ahead needs at least {MIN_SAMPLES} samples over more than {horizon_s * 1e3:g} ms; "
+                "record longer (or, tuning, give a larger --split or a --held-out trace)"
+            )
 
 
 def split_traces(traces: Sequence[Trace], held_out: Sequence[Trace], split: float) -> tuple[list[Trace], list[Trace]]:

@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from analysis.board.blink_code import BlinkSchedule, lfsr_bits
 from analysis.board.recording import METADATA, TABLES
-from declared import ANY, Range, check, setting
+from declared import Range, check, setting
 from rig.board.events import BoardIdentity, EncoderEdge, LedChange
 from rig.board.protocol import protocol
 from rig.board.recorder import BoardRecorder
@@ -61,14 +61,20 @@ class SimulatedBoardConfig:
     """The simulated board: its clock offset (board time = simulation time + board_offset_s), its
     blink (as `rig board blink` asks for it) and its encoder's resolution, each declared on its field."""
 
-    board_offset_s: float = setting(100.0, "seconds", "how far the board's clock runs ahead of the simulation's", ANY)
-    blink_start_s: float = setting(0.25, "seconds", "simulation time bit 0 of the blink starts", ANY)
-    blink_bits: int = setting(64, "bits", "bits in the blink code, as many as the board's protocol allows")
-    blink_bit_s: float = setting(0.05, "seconds", "how long each bit lasts, at least the board's shortest")
+    board_offset_s: float = setting(
+        100.0, "seconds", "how far the board's clock runs ahead of the simulation's, within a day",
+        Range(-86400.0, 86400.0, True, True),
+    )  # fmt: skip
+    blink_start_s: float = setting(0.25, "seconds", "simulation time bit 0 of the blink starts", Range(0.0, 3600.0, True, True))
+    blink_bits: int = setting(
+        64, "bits", "bits in the blink code (a 16-bit count), as many as the board's protocol allows",
+        Range(1.0, 65535.0, True, True),
+    )  # fmt: skip
+    blink_bit_s: float = setting(0.05, "seconds", "how long each bit lasts, at least the board's shortest", Range(0.0, 10.0, includes_high=True))
     blink_seed: int = setting(0xACE1, "", "seed of the blink code", Range(1.0, 65535.0, True, True))
     blink_level: int = setting(255, "", "the LED's drive level while lit", Range(1.0, 255.0, True, True))
     counts_per_rev: int = setting(
-        2400, "counts", "encoder counts per revolution of the pendulum", Range(MIN_COUNTS_PER_REV, includes_low=True)
+        2400, "counts", "encoder counts per revolution of the pendulum", Range(MIN_COUNTS_PER_REV, 1e6, True, True)
     )
 
     def __post_init__(self) -> None:

@@ -29,12 +29,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from declared import NON_NEGATIVE, POSITIVE, Flag, Range, check, setting
+from declared import Flag, Range, check, setting
 from rig.clock import Clock
 from rig.devices.protocols import CameraFrame, Fault
 from rig.errors import ConfigError
 from rig.film_file import CODECS, CONTAINERS, check_film_format, default_codec
-from rig.sim.impairments import FILM, FilmImpairments, FrameImpairer
+from rig.sim.impairments import FILM, SENSOR_LEVELS, FilmImpairments, FrameImpairer
 
 if TYPE_CHECKING:
     from rig.sim.flash import FlashingLightScene
@@ -56,33 +56,37 @@ class CameraConfig:
     constant rate), size, sensor and film; `container` and `codec` are the film's file
     (`rig.film_file`: an MJPEG AVI, or H.264 or HEVC in an MP4 or a MOV)."""
 
-    fps: float = setting(240.0, "frames per second", "camera frame rate", Range(1.0, 10000.0, True, True), flag="--camera-fps")
+    fps: float = setting(
+        240.0, "frames per second", "camera frame rate: a webcam films tens of frames a second, a high-speed camera "
+        "several thousand", Range(1.0, 10000.0, True, True), flag="--camera-fps",
+    )  # fmt: skip
     exposure_s: float | None = setting(
-        None, "seconds", "camera exposure, at most one frame interval", POSITIVE, unset="the whole frame interval",
+        None, "seconds", "camera exposure, at most one frame interval", Range(0.0, 1.0, includes_high=True), unset="the whole frame interval",
         flag=Flag(
             "--exposure", unit="frame intervals", per="fps", range=Range(0.0, 1.0, includes_high=True), default=1.0, metavar="F",
             help="camera exposure, as a fraction of the frame interval",
         ),
     )  # fmt: skip
-    width: int = setting(640, "pixels", "sensor width", Range(64.0, includes_low=True))
-    height: int = setting(480, "pixels", "sensor height", Range(48.0, includes_low=True))
-    noise_dn: float = setting(2.0, "DN", "sensor read noise, in digital numbers", NON_NEGATIVE, flag=Flag("--noise-dn", group=FILM))
-    dark_dn: float = setting(8.0, "DN", "the sensor's dark level", NON_NEGATIVE)
-    led_peak_dn: float = setting(900.0, "DN", "the LED's peak before the sensor saturates", POSITIVE)
-    display_black_dn: float = setting(6.0, "DN", "how bright the display's black films", NON_NEGATIVE)
+    width: int = setting(640, "pixels", "sensor width", Range(64.0, 4096.0, True, True))
+    height: int = setting(480, "pixels", "sensor height", Range(48.0, 4096.0, True, True))
+    noise_dn: float = setting(2.0, "DN", "sensor read noise, in digital numbers", SENSOR_LEVELS, flag=Flag("--noise-dn", group=FILM))
+    dark_dn: float = setting(8.0, "DN", "the sensor's dark level", SENSOR_LEVELS)
+    led_peak_dn: float = setting(900.0, "DN", "the LED's peak before the sensor saturates", Range(0.0, SENSOR_LEVELS.high, includes_high=True))
+    display_black_dn: float = setting(6.0, "DN", "how bright the display's black films", SENSOR_LEVELS)
     display_white_dn: float = setting(
-        190.0, "DN", "how bright the display's white films: lower for a dim sphere", POSITIVE,
+        190.0, "DN", "how bright the display's white films: lower for a dim sphere",
+        Range(0.0, SENSOR_LEVELS.high, includes_high=True),
         flag=Flag("--display-white-dn", group=FILM),
     )  # fmt: skip
-    subsamples: int = setting(8, "", "instants of each exposure averaged (motion blur)", Range(1.0, includes_low=True))
+    subsamples: int = setting(8, "", "instants of each exposure averaged (motion blur)", Range(1.0, 64.0, True, True))
     impairments: FilmImpairments = field(default_factory=FilmImpairments)
     readout_s: float = setting(
         0.0, "seconds", "rolling shutter: row y of H starts exposing y/H of this after row 0, at most a frame interval",
-        NON_NEGATIVE, flag=Flag("--readout-ms", unit="ms", factor=1e3, metavar="R"),
+        Range(0.0, 1.0, True, True), flag=Flag("--readout-ms", unit="ms", factor=1e3, metavar="R"),
     )  # fmt: skip
     frame_jitter_s: float = setting(
         0.0, "seconds", "start each exposure up to half this before or after its nominal time, drawn by the seed, as "
-        "phones do; needs an mp4 or mov, which stamps each frame", NON_NEGATIVE,
+        "phones do; needs an mp4 or mov, which stamps each frame", Range(0.0, 1.0, True, True),
         flag=Flag("--frame-jitter-ms", unit="ms", factor=1e3, metavar="J", group=FILM),
     )  # fmt: skip
     container: str = setting("avi", "", "the film's file", choices=CONTAINERS, flag=Flag("--container", group=FILM))

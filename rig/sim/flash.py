@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from declared import ANY, FRACTION, OPEN_UNIT, POSITIVE, Range, check, setting
+from declared import FRACTION, OPEN_UNIT, Range, check, setting
 from rig.errors import ConfigError
 from rig.sim.layout import BenchLayout
 from rig.sim.display import SimDisplay
@@ -38,12 +38,12 @@ class FlashTarget:
     field; `rig simulate --flash-hz F [--flash-duty D]` or `--flash-display N` makes one."""
 
     source: str = setting("light", "", "what flashes: a card lit by an LED, or the display full-field", choices=FLASH_SOURCES)
-    hz: float = setting(100.0, "Hz", "the LED's flash frequency", POSITIVE)
+    hz: float = setting(100.0, "Hz", "the LED's flash frequency, at most 10 kHz", Range(0.0, 10000.0, includes_high=True))
     duty: float = setting(0.5, "", "the share of each period the LED is on", OPEN_UNIT)
-    phase_s: float = setting(0.0, "seconds", "when the LED's first period starts", ANY)
-    level_dn: float = setting(150.0, "digital numbers", "how bright the card films at the frame's centre, the LED on", POSITIVE)
+    phase_s: float = setting(0.0, "seconds", "when the LED's first period starts", Range(-3600.0, 3600.0, True, True))
+    level_dn: float = setting(150.0, "digital numbers", "how bright the card films at the frame's centre, the LED on", Range(0.0, 65535.0, includes_high=True))
     vignette: float = setting(0.3, "", "the share of the card's level lost at the frame's corners", FRACTION)
-    refreshes: int = setting(2, "refreshes", "the flashing display's period: white for the first half, black for the rest", Range(2.0, includes_low=True))
+    refreshes: int = setting(2, "refreshes", "the flashing display's period: white for the first half, black for the rest", Range(2.0, 1000.0, True, True))
 
     def __post_init__(self) -> None:
         check(self, ConfigError, "flash.")

@@ -16,7 +16,7 @@ from typing import Callable
 import cv2
 import numpy as np
 
-from declared import FRACTION, NON_NEGATIVE, Flag, Range, check, setting
+from declared import FRACTION, Flag, Range, check, setting
 from rig.errors import ConfigError
 
 Rect = tuple[int, int, int, int]
@@ -25,6 +25,8 @@ OCCLUDABLE = ("sphere", "led")
 OCCLUDER_FRACTION = 0.12
 BRIGHT_OBJECT_SIGMA_PX = 4.0
 FILM = "film"
+SENSOR_LEVELS = Range(0.0, 65535.0, True, True)
+"""A level a sensor films, in digital numbers: zero up to a 16-bit sensor's full scale."""
 """The group of the command line's options that these settings are."""
 
 
@@ -33,7 +35,7 @@ class FilmImpairments:
     """What a lab's camera does to its film, each setting declared on its field (`declared.setting`;
     the LED's half is the left one, unless mirrored); they act in the order of the fields."""
 
-    blur_sigma_px: float = setting(0.0, "pixels", "defocus blur, Gaussian sigma", NON_NEGATIVE, flag=Flag("--blur-px", group=FILM))
+    blur_sigma_px: float = setting(0.0, "pixels", "defocus blur, Gaussian sigma", Range(0.0, 100.0, True, True), flag=Flag("--blur-px", group=FILM))
     dim_led: float = setting(
         1.0, "", "scale the LED's half of each frame by this, after the sensor saturates", Range(0.0, 1.0, includes_high=True),
         flag=Flag("--dim-led", metavar="F", group=FILM),
@@ -42,7 +44,7 @@ class FilmImpairments:
         False, "", "flip the film left to right: the LED on the right, the sphere on the left", flag=Flag("--mirrored", group=FILM)
     )
     bright_object_dn: float = setting(
-        0.0, "DN", "a static lamp in view between and above the two halves, its peak (0: none)", NON_NEGATIVE,
+        0.0, "DN", "a static lamp in view between and above the two halves, its peak (0: none)", SENSOR_LEVELS,
         flag=Flag("--bright-object-dn", group=FILM),
     )  # fmt: skip
     occluded: str | None = setting(
@@ -52,9 +54,9 @@ class FilmImpairments:
         0.0, "", "hide the sphere in this share of the frames, drawn by the seed", FRACTION,
         flag=Flag("--missing-fraction", metavar="F", group=FILM),
     )  # fmt: skip
-    every_nth: int = setting(1, "", "film every N-th exposure only", Range(1.0, includes_low=True), flag=Flag("--every-nth", metavar="N", group=FILM))
+    every_nth: int = setting(1, "", "film every N-th exposure only", Range(1.0, 1000.0, True, True), flag=Flag("--every-nth", metavar="N", group=FILM))
     first_frame: int = setting(
-        0, "", "with --every-nth, the first exposure filmed, 0 to N - 1", NON_NEGATIVE, flag=Flag("--first-frame", metavar="K", group=FILM)
+        0, "", "with --every-nth, the first exposure filmed, 0 to N - 1", Range(0.0, 999.0, True, True), flag=Flag("--first-frame", metavar="K", group=FILM)
     )
 
     def __post_init__(self) -> None:

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from declared import ANY, NON_NEGATIVE, POSITIVE, Flag, Range, check, setting
+from declared import Flag, Range, check, setting
 from rig.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -53,9 +53,10 @@ class PendulumConfig:
     """
 
     period_s: float | None = setting(
-        1.0, "seconds", "pendulum period (small-angle); a spec may give length_m instead", POSITIVE, flag="--period-s"
+        1.0, "seconds", "pendulum period (small-angle): a lab's pendulum swings once in a fraction of a second (a 1 cm "
+        "arm) to tens of seconds (a 100 m one); a spec may give length_m instead", Range(0.2, 20.0, True, True), flag="--period-s",
     )
-    length_m: float | None = setting(None, "metres", "pendulum length, instead of the period", POSITIVE, unset="from the period")
+    length_m: float | None = setting(None, "metres", "pendulum length, instead of the period", Range(0.01, 100.0, True, True), unset="from the period")
     amplitude_deg: float = setting(
         20.0, "degrees", "swing amplitude, the angle it is released from", Range(0.0, MAX_AMPLITUDE_DEG, includes_high=True),
         flag="--amplitude-deg",
@@ -63,15 +64,15 @@ class PendulumConfig:
     quality: float = setting(
         200.0, "", "pendulum quality factor Q; inf for no damping", Range(0.0, math.inf, includes_high=True), flag="--quality"
     )
-    g: float = setting(9.80665, "m/s^2", "gravity", POSITIVE)
+    g: float = setting(9.80665, "m/s^2", "gravity (Earth's; up to ten times it)", Range(0.0, 100.0, includes_high=True))
     phase_deg: float = setting(
         0.0, "degrees", "where in the swing the simulation starts (0: at the release)", Range(0.0, 360.0, includes_low=True)
     )
-    pivot: tuple[float, float, float] = setting((0.0, 0.0, 0.0), "metres", "the pivot's position", ANY)
+    pivot: tuple[float, float, float] = setting((0.0, 0.0, 0.0), "metres", "the pivot's position, within 100 m of the origin", Range(-100.0, 100.0, True, True))
     release_s: float | None = setting(
         None, "seconds", "hold the pendulum at rest at its amplitude and release it S seconds into the film (at least "
-        "one swing before the end)", ANY, unset="swinging from the start",
-        flag=Flag("--release-s", range=NON_NEGATIVE, metavar="S", group="lab"),
+        "one swing before the end)", Range(-3600.0, 3600.0, True, True), unset="swinging from the start",
+        flag=Flag("--release-s", range=Range(0.0, 3600.0, True, True), metavar="S", group="lab"),
     )  # fmt: skip
 
     def __post_init__(self) -> None:
@@ -107,10 +108,11 @@ class Pendulum:
     """The pendulum's motion over [t_start, t_end], integrated once at construction.
 
     t_release is when it is let go from rest at +amplitude; before it (with release_s set) the
-    pendulum is held there.
+    pendulum is held there. lookback_s: times this long before t_start may be asked for too (the
+    pendulum held there; a search that looks past the run's start), the swing unchanged.
     """
 
-    def __init__(self, config: PendulumConfig, t_end: float, t_start: float = 0.0) -> None:
+    def __init__(self, config: PendulumConfig, t_end: float, t_start: float = 0.0, lookback_s: float = 0.0) -> None:
         if not (math.isfinite(t_start) and math.isfinite(t_end) and t_end > t_start):
             raise ConfigError(
                 f"Pendulum needs finite times with t_end > t_start, got t_start={t_start!r}, t_end={t_end!r}"
@@ -118,6 +120,7 @@ class Pendulum:
         self.config = config
         self.t_start = float(t_start)
         self.t_end = float(t_end)
+        self._lookback_s = float(lookback_s)
         self.length_m = config.resolved_length_m
         self.omega0 = math.sqrt(config.g / self.length_m)
         self.pivot = np.asarray(config.pivot, dtype=np.float64)
@@ -167,10 +170,11 @@ class Pendulum:
 
     def _state(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         times = np.asarray(t, dtype=np.float64)
-        if not (np.all(times >= self.t_start) and np.all(times <= self.t_end)):
-            bad = times[~((times >= self.t_start) & (times <= self.t_end))].ravel()[0]
+        first = self.t_start - self._lookback_s
+        if not (np.all(times >= first) and np.all(times <= self.t_end)):
+            bad = float(times[~((times >= first) & (times <= self.t_end))].ravel()[0])
             raise ConfigError(
-                f"time {bad!r} s is outside the simulated window [{self.t_start!r}, {self.t_end!r}] s; "
+                f"time {bad!r} s is outside the simulated window [{first!r}, {self.t_end!r}] s; "
                 "build the Pendulum with a window that covers every time you ask for"
             )
         angle = np.full(times.shape, self.amplitude_rad)

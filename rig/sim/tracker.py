@@ -32,7 +32,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from declared import FRACTION, NON_NEGATIVE, POSITIVE, Flag, check, setting
+from declared import FRACTION, Flag, Range, check, setting
 from predictors import PoseSample
 from rig.clock import Clock
 from rig.devices.protocols import Fault
@@ -56,17 +56,21 @@ class Motion(Protocol):
 class TrackerConfig:
     """Rate, noise and transport of a simulated tracker, each declared on its field (`declared.setting`)."""
 
-    rate_hz: float = setting(120.0, "Hz", "tracker sample rate", POSITIVE, flag="--tracker-hz")
-    position_noise_m: float = setting(0.0002, "metres", "position noise, standard deviation per axis", NON_NEGATIVE)
+    rate_hz: float = setting(
+        120.0, "Hz", "tracker sample rate: optical trackers sample at tens to hundreds of Hz, inertial ones up to a few kHz",
+        Range(1.0, 5000.0, True, True), flag="--tracker-hz",
+    )  # fmt: skip
+    position_noise_m: float = setting(0.0002, "metres", "position noise, standard deviation per axis", Range(0.0, 0.1, True, True))
     orientation_noise_deg: float = setting(
-        0.05, "degrees", "orientation noise, standard deviation of each rotation-vector component", NON_NEGATIVE
+        0.05, "degrees", "orientation noise, standard deviation of each rotation-vector component",
+        Range(0.0, 10.0, True, True),
     )
     transport_delay_s: float = setting(
-        0.004, "seconds", "fixed tracker-to-host delay", NON_NEGATIVE, flag=Flag("--transport-delay-ms", unit="ms", factor=1e3)
+        0.004, "seconds", "fixed tracker-to-host delay, at most a second", Range(0.0, 1.0, True, True), flag=Flag("--transport-delay-ms", unit="ms", factor=1e3)
     )
-    jitter_s: float = setting(0.0005, "seconds", "mean transport jitter, exponentially distributed", NON_NEGATIVE)
+    jitter_s: float = setting(0.0005, "seconds", "mean transport jitter, exponentially distributed", Range(0.0, 0.1, True, True))
     dropout: float = setting(0.0, "", "probability that a sample is lost", FRACTION)
-    phase_s: float = setting(0.0, "seconds", "first sensor time after the start, less than one sample interval", NON_NEGATIVE)
+    phase_s: float = setting(0.0, "seconds", "first sensor time after the start, less than one sample interval", Range(0.0, 1.0, True))
 
     def __post_init__(self) -> None:
         check(self, ConfigError, "tracker.")

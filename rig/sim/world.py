@@ -31,9 +31,11 @@ class SimulatedWorld:
         self.config = config
         self.t_begin = -config.warmup_s
         self.t_end = config.duration_s
-        # the truth's latency search (rig.sim.truth) looks up to half a period past the filmed span
+        # the truth's latency search (rig.sim.truth) looks up to half a period past either end of the filmed span
         swing_s = config.pendulum.small_angle_period_s
-        self.pendulum = Pendulum(config.pendulum, t_start=self.t_begin - 1.0, t_end=self.t_end + 1.0 + swing_s)
+        self.pendulum = Pendulum(
+            config.pendulum, t_start=self.t_begin - 1.0, t_end=self.t_end + 1.0 + swing_s, lookback_s=swing_s
+        )
         self.layout: BenchLayout = make_layout(self.pendulum, config.camera, config.display, config.layout)
         self._display = SimDisplay(DisplayConfig(**{**asdict(config.display), "t0": self.t_begin}))
         self._camera: SimCamera | None = None

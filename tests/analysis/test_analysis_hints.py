@@ -33,10 +33,10 @@ def test_the_options_side_overrules_every_hint_of_which_blob_is_the_led() -> Non
 @pytest.mark.parametrize(
     ("hint", "words"),
     [
-        (Hint("display_hz", -60.0, "bench.toml"), "the hint display_hz (bench.toml) must be a positive number of Hz, got -60.0"),
+        (Hint("display_hz", -60.0, "bench.toml"), "the hint display_hz (bench.toml) must be a positive number of Hz from 1 to 1000, got -60.0"),
         (Hint("led_side", "top", "bench.toml"), "the hint led_side (bench.toml) must be one of left, right, got 'top'"),
         (Hint("scanout", "sideways", "bench.toml"), "must be one of top-down, bottom-up"),
-        (Hint("led_row", 1.5, "bench.toml"), "must be zero or a positive number at most 1"),
+        (Hint("led_row", 1.5, "bench.toml"), "must be a number from 0 to 1"),
         (Hint("method", "fft", "bench.toml"), "the hint method (bench.toml) is not one a bench gives"),
     ],
 )

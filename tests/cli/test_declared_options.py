@@ -66,10 +66,10 @@ def test_the_options_given_make_the_config_and_the_rest_keep_their_defaults() ->
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--display-hz", "0"], "argument --display-hz: must be a positive number of Hz, got 0"),
-        (["--seed", "-1"], "argument --seed: must be zero or a positive whole number, got -1"),
+        (["--display-hz", "0"], "argument --display-hz: must be a positive number of Hz from 1 to 1000, got 0"),
+        (["--seed", "-1"], "argument --seed: must be a whole number from 0 to 1e+09, got -1"),
         (["--seed", "1.5"], "argument --seed: expected a whole number, got '1.5'"),
-        (["--led-roi=-1,0,10,10"], "argument --led-roi: must have each item zero or a positive whole number of pixels, got -1,0,10,10"),
+        (["--led-roi=-1,0,10,10"], "argument --led-roi: must have each item a whole number of pixels from 0 to 65535, got -1,0,10,10"),
         (["--led-roi", "1,2,3"], "argument --led-roi: expected X,Y,W,H, 4 whole numbers, got '1,2,3'"),
         (["--latency-range", "50,1"], "argument --latency-range: LOW must be below HIGH, got 50,1"),
     ],
@@ -108,9 +108,9 @@ def test_the_simulation_options_given_make_the_config_and_the_rest_keep_their_de
     ("argv", "message"),
     [
         (["--exposure", "1.5"], "argument --exposure: must be a positive number of frame intervals at most 1, got 1.5"),
-        (["--transport-delay-ms", "-1"], "argument --transport-delay-ms: must be zero or a positive number of ms, got -1"),
+        (["--transport-delay-ms", "-1"], "argument --transport-delay-ms: must be a number of ms from 0 to 1000, got -1"),
         (["--display-hz", "2000"], "argument --display-hz: must be a positive number of Hz from 1 to 1000, got 2000"),
-        (["--release-s=-1"], "argument --release-s: must be zero or a positive number of seconds, got -1"),
+        (["--release-s=-1"], "argument --release-s: must be a number of seconds from 0 to 3600, got -1"),
         (["--app-frame-ms", "fast"], "argument --app-frame-ms: expected a number or 'measured', got 'fast'"),
         (["--occluded", "lamp"], "argument --occluded: invalid choice: 'lamp'"),
     ],

@@ -159,7 +159,7 @@ def test_the_options_override_the_spec(tmp_path):
         ("server_ms = \"2\"\n", "server_ms must be a number"),
         ("[latency_camera]\nwidht = 320\n", "unknown key latency_camera.widht; CameraConfig takes fps, "),
         ("latency_camera = 320\n", "latency_camera must be a table of CameraConfig settings"),
-        ("ratios = [0]\n", "ratios must have each item a positive whole number at least 1, got \\(0,\\)"),
+        ("ratios = [0]\n", "ratios must have each item a positive whole number from 1 to 100, got \\(0,\\)"),
         ("refresh_hz = 5000.0\n", "refresh_hz must be a positive number of Hz from 1 to 1000, got 5000.0"),
         ("ratios = []\n", "needs at least one"),
         ("triangles = [\n", "is not valid TOML"),

@@ -61,7 +61,7 @@ def test_a_write_that_would_not_read_back_leaves_the_file_as_it_was(tmp_path: Pa
 BAD = [
     ("[camera]\nfpss = 120.0\n", "unknown key camera.fpss; CameraProfile takes fps, fps_source, exposure_ms"),
     ("[camera]\nfps = \"fast\"\n", "camera.fps must be a number, not 'fast'"),
-    ("[display]\nrefresh_hz = -60.0\n", "display.refresh_hz must be a positive number of Hz, got -60.0"),
+    ("[display]\nrefresh_hz = -60.0\n", "display.refresh_hz must be a positive number of Hz from 1 to 1000, got -60.0"),
     ("[camera\nfps = 120\n", "is not valid TOML"),
     ("[lens]\n", "unknown key lens; BenchProfile takes camera, display, layout"),
     ("[layout]\nled_roi = [0, 0, 10, 10]\n", "layout: give both regions, led_roi and sphere_roi, or neither"),

@@ -69,15 +69,16 @@ def test_led_changes_rebuild_the_led_level(seed: int, bits: int, bit_s: float, l
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        (dict(board_offset_s=math.nan), "board.board_offset_s must be a number of seconds, got nan"),
-        (dict(blink_start_s=math.inf), "board.blink_start_s must be a number of seconds, got inf"),
-        (dict(blink_bits=0), "1..65534 bits"),
+        (dict(board_offset_s=math.nan), "board.board_offset_s must be a number of seconds from -86400 to 86400, got nan"),
+        (dict(blink_start_s=math.inf), "board.blink_start_s must be a number of seconds from 0 to 3600, got inf"),
+        (dict(blink_bits=0), "board.blink_bits must be a positive whole number of bits from 1 to 65535, got 0"),
+        (dict(blink_bits=65535), "1..65534 bits"),
         (dict(blink_bit_s=0.0005), "at least 1 ms"),
         (dict(blink_seed=0), "board.blink_seed must be a positive whole number from 1 to 65535, got 0"),
         (dict(blink_seed=1 << 16), "board.blink_seed must be a positive whole number from 1 to 65535, got 65536"),
         (dict(blink_level=0), "board.blink_level must be a positive whole number from 1 to 255, got 0"),
         (dict(blink_level=256), "board.blink_level must be a positive whole number from 1 to 255, got 256"),
-        (dict(counts_per_rev=3), "board.counts_per_rev must be a positive whole number of counts at least 4, got 3"),
+        (dict(counts_per_rev=3), "board.counts_per_rev must be a positive whole number of counts from 4 to 1e\\+06, got 3"),
     ],
 )
 def test_bad_board_settings_are_rejected(kwargs: dict, message: str) -> None:

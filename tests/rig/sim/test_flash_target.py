@@ -32,7 +32,7 @@ def test_a_row_gets_the_share_of_its_window_the_light_was_on(start, exposure, hz
 @pytest.mark.parametrize(
     "fields, words",
     [({"source": "lamp"}, "flash.source must be one of light, display"), ({"hz": 0.0}, "flash.hz must be a positive number of Hz"),
-     ({"duty": 1.0}, "flash.duty must be a positive number below 1"), ({"refreshes": 1}, "at least 2")],
+     ({"duty": 1.0}, "flash.duty must be a positive number below 1"), ({"refreshes": 1}, "from 2 to 1000")],
 )
 def test_a_target_out_of_range_is_refused(fields, words):
     with pytest.raises(ConfigError, match=words):

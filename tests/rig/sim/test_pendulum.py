@@ -175,10 +175,10 @@ def test_window_ends_are_inside():
     [
         (dict(period_s=None), "exactly one of period_s and length_m"),
         (dict(period_s=1.0, length_m=0.25), "exactly one of period_s and length_m"),
-        (dict(period_s=-1.0), "pendulum.period_s must be a positive number of seconds, got -1.0"),
-        (dict(period_s=None, length_m=math.nan), "pendulum.length_m must be a positive number of metres, got nan"),
-        (dict(period_s=math.inf), "pendulum.period_s must be a positive number of seconds, got inf"),
-        (dict(g=0.0), "pendulum.g must be a positive number of m/s\\^2, got 0.0"),
+        (dict(period_s=-1.0), "pendulum.period_s must be a positive number of seconds from 0.2 to 20, got -1.0"),
+        (dict(period_s=None, length_m=math.nan), "pendulum.length_m must be a positive number of metres from 0.01 to 100, got nan"),
+        (dict(period_s=math.inf), "pendulum.period_s must be a positive number of seconds from 0.2 to 20, got inf"),
+        (dict(g=0.0), "pendulum.g must be a positive number of m/s\\^2 at most 100, got 0.0"),
         (dict(amplitude_deg=0.0), "pendulum.amplitude_deg must be a positive number of degrees at most 45, got 0.0"),
         (dict(amplitude_deg=45.1), "pendulum.amplitude_deg must be a positive number of degrees at most 45, got 45.1"),
         (dict(amplitude_deg=math.nan), "pendulum.amplitude_deg must be a positive number of degrees at most 45, got nan"),
@@ -203,3 +203,14 @@ def test_pendulum_rejects_bad_windows(t_start, t_end):
 def test_config_error_is_a_value_error():
     with pytest.raises(ValueError):
         PendulumConfig(amplitude_deg=90.0)
+
+
+def test_a_lookback_widens_the_window_without_moving_the_swing():
+    config = PendulumConfig(period_s=20.0)
+    plain = Pendulum(config, t_end=5.0, t_start=-1.5)
+    widened = Pendulum(config, t_end=5.0, t_start=-1.5, lookback_s=20.0)
+    t = np.linspace(-1.5, 5.0, 50)
+    np.testing.assert_array_equal(widened.angle(t), plain.angle(t))
+    assert widened.angle(np.array([-21.5]))[0] == pytest.approx(math.radians(config.amplitude_deg))
+    with pytest.raises(ConfigError, match="outside the simulated window"):
+        widened.angle(np.array([-21.6]))

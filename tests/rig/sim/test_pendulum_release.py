@@ -69,8 +69,8 @@ def test_the_layout_frames_the_held_led_inside_its_roi() -> None:
     "kwargs, message",
     [
         (dict(release_s=1.0, phase_deg=90.0), "release_s and phase_deg exclude each other"),
-        (dict(release_s=math.nan), "pendulum.release_s must be a number of seconds, got nan"),
-        (dict(release_s=math.inf), "pendulum.release_s must be a number of seconds, got inf"),
+        (dict(release_s=math.nan), "pendulum.release_s must be a number of seconds from -3600 to 3600, got nan"),
+        (dict(release_s=math.inf), "pendulum.release_s must be a number of seconds from -3600 to 3600, got inf"),
     ],
 )
 def test_bad_releases_are_rejected(kwargs: dict, message: str) -> None:

@@ -142,16 +142,16 @@ def test_an_empty_window_raises(pendulum):
 @pytest.mark.parametrize(
     "kwargs, message",
     [
-        (dict(rate_hz=0.0), "tracker.rate_hz must be a positive number of Hz, got 0.0"),
-        (dict(rate_hz=math.inf), "tracker.rate_hz must be a positive number of Hz, got inf"),
-        (dict(position_noise_m=-1e-3), "tracker.position_noise_m must be zero or a positive number of metres, got -0.001"),
-        (dict(orientation_noise_deg=math.nan), "tracker.orientation_noise_deg must be zero or a positive number of degrees, got nan"),
-        (dict(transport_delay_s=-0.001), "tracker.transport_delay_s must be zero or a positive number of seconds, got -0.001"),
-        (dict(jitter_s=math.inf), "tracker.jitter_s must be zero or a positive number of seconds, got inf"),
+        (dict(rate_hz=0.0), "tracker.rate_hz must be a positive number of Hz from 1 to 5000, got 0.0"),
+        (dict(rate_hz=math.inf), "tracker.rate_hz must be a positive number of Hz from 1 to 5000, got inf"),
+        (dict(position_noise_m=-1e-3), "tracker.position_noise_m must be a number of metres from 0 to 0.1, got -0.001"),
+        (dict(orientation_noise_deg=math.nan), "tracker.orientation_noise_deg must be a number of degrees from 0 to 10, got nan"),
+        (dict(transport_delay_s=-0.001), "tracker.transport_delay_s must be a number of seconds from 0 to 1, got -0.001"),
+        (dict(jitter_s=math.inf), "tracker.jitter_s must be a number of seconds from 0 to 0.1, got inf"),
         (dict(dropout=1.0), "tracker.dropout must be zero or a positive number below 1, got 1.0"),
         (dict(dropout=-0.1), "tracker.dropout must be zero or a positive number below 1, got -0.1"),
         (dict(rate_hz=100.0, phase_s=0.01), r"phase_s must be in \[0, 1 / rate_hz\)"),
-        (dict(phase_s=-0.001), "tracker.phase_s must be zero or a positive number of seconds, got -0.001"),
+        (dict(phase_s=-0.001), "tracker.phase_s must be zero or a positive number of seconds below 1, got -0.001"),
     ],
 )
 def test_config_rejects_bad_values(kwargs, message):

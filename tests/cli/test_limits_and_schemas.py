@@ -1,0 +1,160 @@
+"""Limits before work, one schema per input: a number outside its physically meaningful range, a run
+whose estimate cannot finish, or an input of the wrong shape ends in one line on stderr naming the
+option or the key, the value and what is allowed, exit status 2, before any work and with nothing
+written. Commands run in this process through `rig.cli.main`."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from rig.cli import EXIT_USER_ERROR, main
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """What a user has lying about: specs, summaries and traces of the wrong shape."""
+    lab = tmp_path_factory.mktemp("lab")
+    (lab / "a-file").write_text("precious")
+    _trace(lab / "two-samples.csv", [0.0, 0.01])
+    times = [i * 0.01 for i in range(300)]
+    times[10], times[20] = times[20], times[10]
+    _trace(lab / "unsorted.csv", times)
+    (lab / "base-a-number.toml").write_text('base = 5\n[grid]\n"camera.fps" = [120]\n')
+    (lab / "grid-a-number.toml").write_text("grid = 5\n")
+    (lab / "renderers-camera-a-number.toml").write_text("latency_camera = 5\n")
+    (lab / "analysis-a-number.toml").write_text('analysis = 3\n[grid]\n"camera.fps" = [120]\n')
+    (lab / "camera-a-number.toml").write_text('[base]\ncamera = 5\n[grid]\n"pendulum.period_s" = [1.0]\n')
+    values = ", ".join(str(120 + i) for i in range(1000))
+    (lab / "billion-points.toml").write_text(f'[grid]\n"camera.fps" = [{values}]\n"seed" = [{values}]\n"scene_triangles" = [{values}]\n')
+    (lab / "summary-a-list.json").write_text("[1, 2]")
+    (lab / "summary-rows-a-number.json").write_text('{"rows": 5}')
+    (lab / "summary-rows-of-numbers.json").write_text('{"rows": [1, 2]}')
+    (lab / "summary-latency-a-table.json").write_text('{"rows": [{"video": "a.avi", "latency_ms": {"ms": 1}}]}')
+    for name, truth in (("truncated-truth", '{"latency_ms": 31.2, "con'), ("truth-of-another-shape", '{"latency_ms": "31.2", "config": {}}')):
+        (lab / name).mkdir()
+        (lab / name / "video.avi").write_text("a film")
+        (lab / name / "truth.json").write_text(truth)
+    return lab
+
+
+def _trace(path: Path, times: list[float]) -> None:
+    rows = "".join(f"{t!r},{math.sin(t)},0,0,1,0,0,0\n" for t in times)
+    path.write_text(f"t,px,py,pz,qw,qx,qy,qz\n{rows}")
+
+
+def _snapshot(folder: Path) -> dict[Path, str]:
+    return {path: hashlib.sha256(path.read_bytes()).hexdigest() for path in sorted(folder.rglob("*")) if path.is_file()}
+
+
+# (id, argv with {lab} for the lab folder, words the message must hold)
+CASES = [
+    # simulate: each number within what a lab's rig can be
+    ("simulate-negative-seed", "simulate --out {lab}/new --seed=-1", ("--seed", "from 0 to 1e+09", "-1")),
+    ("simulate-tracker-rate-beyond-any-tracker", "simulate --out {lab}/new --tracker-hz 1e9", ("--tracker-hz", "from 1 to 5000", "1e9")),
+    ("simulate-scene-beyond-any-gpu", "simulate --out {lab}/new --scene-triangles 1e12", ("--scene-triangles", "from 0 to 1e+08", "1e12")),
+    ("simulate-app-frame-beyond-a-second", "simulate --out {lab}/new --app-frame-ms 1e9", ("--app-frame-ms", "at most 1000", "1e9")),
+    ("simulate-period-too-short", "simulate --out {lab}/new --period-s 1e-9", ("--period-s", "from 0.2 to 20", "1e-9")),
+    ("simulate-period-too-long", "simulate --out {lab}/new --period-s 1000", ("--period-s", "from 0.2 to 20", "1000")),
+    ("simulate-camera-beyond-any-camera", "simulate --out {lab}/new --camera-fps 1e6", ("--camera-fps", "from 1 to 10000")),
+    # simulate: every number in range, their product days of work
+    ("simulate-film-that-cannot-finish", "simulate --out {lab}/new --duration 3600 --camera-fps 10000", ("about 24.6 hours", "24 hours")),
+    # plan: the pendulum it simulates
+    ("plan-period-too-short", "plan --display-hz 60 --camera-fps 120 --period-s 1e-9", ("--period-s", "from 0.2 to 20")),
+    ("plan-display-beyond-any-display", "plan --display-hz 1e9 --camera-fps 120", ("--display-hz", "from 1 to 1000", "1e9")),
+    ("plan-amplitude-out-of-range", "plan --display-hz 60 --camera-fps 120 --amplitude-deg 90", ("--amplitude-deg", "at most 45")),
+    # bench: each option within a lab's reach, a batch within a day
+    ("bench-predictors-duration-beyond-ten-minutes", "bench predictors --duration 1e12", ("--duration", "from 1 to 600", "1e12")),
+    ("bench-predictors-horizon-beyond-a-second", "bench predictors --horizons-ms 10,5000", ("--horizons-ms", "from 0 to 1000")),
+    ("bench-predictors-negative-seed", "bench predictors --seed=-3", ("--seed", "from 0 to 1e+09")),
+    ("bench-batch-videos-beyond-a-lab", "bench batch --videos 1000000000", ("--videos", "from 1 to 1000")),
+    ("bench-batch-that-cannot-finish", "bench batch --videos 1000 --duration 3600 --rounds 100", ("about 1.53e+04 hours", "24 hours")),
+    ("bench-trackers-duration-beyond-ten-minutes", "bench trackers --duration 1e12", ("--duration", "from 0.5 to 600")),
+    ("bench-trackers-rate-beyond-any-tracker", "bench trackers --rate 1e9", ("--rate", "from 1 to 10000")),
+    # traces: scored only where a prediction can land on the truth, in time order
+    ("bench-predictors-two-sample-trace", "bench predictors --trace {lab}/two-samples.csv", ("'two-samples'", "at least 10 samples")),
+    ("bench-predictors-unsorted-trace", "bench predictors --trace {lab}/unsorted.csv", ("not in time order", "--repair")),
+    # sweep and bench specs: a table where a table belongs, a grid counted before it is made
+    ("sweep-base-a-number", "sweep {lab}/base-a-number.toml --out {lab}/sweep", ("base must be a table", "5")),
+    ("sweep-grid-a-number", "sweep {lab}/grid-a-number.toml --out {lab}/sweep", ("grid must be a table", "5")),
+    ("sweep-analysis-a-number", "sweep {lab}/analysis-a-number.toml --out {lab}/sweep", ("analysis must be a table", "3")),
+    ("sweep-camera-a-number", "sweep {lab}/camera-a-number.toml --out {lab}/sweep", ("camera must be a table", "5")),
+    ("sweep-billion-points", "sweep {lab}/billion-points.toml --out {lab}/sweep", ("1000000000 points", "1000 x 1000 x 1000", "10000")),
+    ("bench-analyser-base-a-number", "bench analyser --spec {lab}/base-a-number.toml", ("base must be a table",)),
+    ("bench-renderers-camera-a-number", "bench renderers --spec {lab}/renderers-camera-a-number.toml", ("latency_camera must be a table", "5")),
+    # summaries and truths: the shape the rig writes
+    ("report-summary-a-list", "report {lab}/summary-a-list.json --out {lab}/r.html", ('"rows" is a list',)),
+    ("report-summary-rows-a-number", "report {lab}/summary-rows-a-number.json --out {lab}/r.html", ('"rows" is a list',)),
+    ("report-summary-rows-of-numbers", "report {lab}/summary-rows-of-numbers.json --out {lab}/r.html", ("video column",)),
+    ("report-summary-latency-a-table", "report {lab}/summary-latency-a-table.json --out {lab}/r.html", ("summary-latency-a-table.json",)),
+    ("report-truncated-truth", "report {lab}/truncated-truth --out {lab}/r.html", ("truth.json", "simulate the run again")),
+    ("report-truth-of-another-shape", "report {lab}/truth-of-another-shape --out {lab}/r.html", ("latency_ms (a number)",)),
+    ("tune-horizon-beyond-a-second", "tune kalman-cv --trace {lab}/unsorted.csv --horizon-ms 1e12 --out {lab}/p.json", ("--horizon-ms", "from 0 to 1000")),
+    ("tune-iterations-beyond-any-fit", "tune kalman-cv --trace {lab}/unsorted.csv --horizon-ms 20 --max-iterations 1e12 --out {lab}/p.json",
+     ("--max-iterations", "from 0 to 10000")),
+    ("tune-two-sample-trace", "tune kalman-cv --trace {lab}/two-samples.csv --horizon-ms 20 --out {lab}/p.json", ("at least 10 samples",)),
+]
+
+
+def _rig(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    try:
+        code = main(argv)
+    except SystemExit as exit_:
+        code = exit_.code
+    return code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, words", [pytest.param(argv, words, id=name) for name, argv, words in CASES])
+def test_out_of_bounds_is_one_line_before_any_work(argv: str, words: tuple[str, ...], lab: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    before = _snapshot(lab)
+    code, err = _rig(argv.format(lab=lab).split(), capsys)
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert code == EXIT_USER_ERROR, err
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert _snapshot(lab) == before
+    assert not (lab / "new").exists()
+
+
+SHORT_FILM = "[base]\nduration_s = 0.5\ncamera.fps = 30.0\ncamera.width = 160\ncamera.height = 120\ncamera.subsamples = 1\n"
+"""Half a pendulum period, filmed small: simulated in a moment, refused by the analyser (too few periods)."""
+
+
+def _every_one_failed(code: int, err: str, what: str) -> None:
+    """Exit status 2, and the last line of stderr says every one of `what` failed."""
+    assert "Traceback" not in err
+    assert code == EXIT_USER_ERROR, err
+    assert f"every one of the {what}" in err.strip().splitlines()[-1], err
+
+
+def test_a_sweep_whose_every_point_failed_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "short.toml"
+    spec.write_text(SHORT_FILM + "[grid]\nseed = [1, 2]\n")
+    code, err = _rig(["sweep", str(spec), "--out", str(tmp_path / "sweep")], capsys)
+    _every_one_failed(code, err, "2 points failed")
+    assert "pendulum periods" in err
+    assert (tmp_path / "sweep" / "summary.csv").exists()
+
+
+def test_a_bench_whose_every_case_was_refused_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    spec = tmp_path / "short.toml"
+    spec.write_text(SHORT_FILM + '[[points]]\nlabels = { case = "short", group = "mixed", impairment = "none" }\nseed = 1\n')
+    code, err = _rig(["bench", "analyser", "--spec", str(spec)], capsys)
+    _every_one_failed(code, err, "1 cases")
+
+
+def test_a_batch_whose_every_video_failed_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    for name in ("black.avi", "grey.avi"):
+        writer = cv2.VideoWriter(str(tmp_path / name), cv2.VideoWriter_fourcc(*"MJPG"), 60.0, (64, 48))
+        for _ in range(40):
+            writer.write(np.full((48, 64, 3), 0 if name == "black.avi" else 128, np.uint8))
+        writer.release()
+    code, err = _rig(["analyse", str(tmp_path / "black.avi"), str(tmp_path / "grey.avi")], capsys)
+    _every_one_failed(code, err, "2 videos failed")
