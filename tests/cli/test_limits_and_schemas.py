@@ -123,7 +123,7 @@ def test_out_of_bounds_is_one_line_before_any_work(argv: str, words: tuple[str, 
     assert not (lab / "new").exists()
 
 
-SHORT_FILM = "[base]\nduration_s = 0.5\ncamera.fps = 30.0\ncamera.width = 160\ncamera.height = 120\ncamera.subsamples = 1\n"
+SHORT_FILM = "[base]\nduration_s = 0.5\ncamera.fps = 60.0\ncamera.width = 160\ncamera.height = 120\ncamera.subsamples = 1\n"
 """Half a pendulum period, filmed small: simulated in a moment, refused by the analyser (too few periods)."""
 
 
