@@ -4,7 +4,6 @@ the output location) as it was. Commands run in this process through `rig.cli.ma
 
 from __future__ import annotations
 
-import hashlib
 import math
 import socket
 import threading
@@ -15,7 +14,6 @@ import cv2
 import numpy as np
 import pytest
 
-from rig.cli import EXIT_USER_ERROR, main
 
 HEADER = "t,px,py,pz,qw,qx,qy,qz"
 FRAME = (48, 64)
@@ -93,9 +91,6 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
         (run / name).write_text(f"the user's {name}")
     return lab
 
-
-def _snapshot(folder: Path) -> dict[Path, str]:
-    return {path: hashlib.sha256(path.read_bytes()).hexdigest() for path in sorted(folder.rglob("*")) if path.is_file()}
 
 
 @pytest.fixture
@@ -242,40 +237,38 @@ CASES = [
 ]
 
 
-def _rig(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        code = main(argv)
-    except SystemExit as exit_:
-        code = exit_.code
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def _assert_one_line_error(code: int, err: str, word: str) -> None:
-    assert "Traceback" not in err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert code == EXIT_USER_ERROR, err
-    assert word in lines[0], lines[0]
-    assert "np.float64" not in lines[0] and "Config." not in lines[0]
 
 
 @pytest.mark.parametrize("argv, word", [pytest.param(argv, word, id=name) for name, argv, word in CASES])
-def test_bad_input_is_one_line_and_loses_nothing(argv: str, word: str, lab: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    before = _snapshot(lab)
-    code, _, err = _rig(argv.format(lab=lab).split(), capsys)
-    _assert_one_line_error(code, err, word)
-    assert {path: digest for path, digest in _snapshot(lab).items() if path in before} == before
+def test_bad_input_is_one_line_and_loses_nothing(
+    one_line_error: Callable[..., None],
+    run_rig: Callable[..., tuple[int, str, str]],
+    snapshot: Callable[[Path], dict[Path, str]],
+    argv: str,
+    word: str,
+    lab: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    before = snapshot(lab)
+    code, _, err = run_rig(argv.format(lab=lab).split(), capsys)
+    one_line_error(code, err, word)
+    assert {path: digest for path, digest in snapshot(lab).items() if path in before} == before
 
 
-def test_a_board_that_says_nothing(silent_board: str, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = _rig(["board", "info", "--port", silent_board], capsys)
-    _assert_one_line_error(code, err, "did not answer")
+def test_a_board_that_says_nothing(
+    one_line_error: Callable[..., None],
+    run_rig: Callable[..., tuple[int, str, str]], silent_board: str, capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, _, err = run_rig(["board", "info", "--port", silent_board], capsys)
+    one_line_error(code, err, "did not answer")
 
 
-def test_a_board_that_answers_garbage(babbling_board: str, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = _rig(["board", "info", "--port", babbling_board], capsys)
-    _assert_one_line_error(code, err, "did not answer")
+def test_a_board_that_answers_garbage(
+    one_line_error: Callable[..., None],
+    run_rig: Callable[..., tuple[int, str, str]], babbling_board: str, capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, _, err = run_rig(["board", "info", "--port", babbling_board], capsys)
+    one_line_error(code, err, "did not answer")
 
 
 def test_matrix_covers_every_command() -> None:

@@ -5,15 +5,15 @@ written. Commands run in this process through `rig.cli.main`."""
 
 from __future__ import annotations
 
-import hashlib
 import math
 from pathlib import Path
+from typing import Callable
 
 import cv2
 import numpy as np
 import pytest
 
-from rig.cli import EXIT_USER_ERROR, main
+from rig.cli import EXIT_USER_ERROR
 
 
 @pytest.fixture(scope="module")
@@ -47,9 +47,6 @@ def _trace(path: Path, times: list[float]) -> None:
     rows = "".join(f"{t!r},{math.sin(t)},0,0,1,0,0,0\n" for t in times)
     path.write_text(f"t,px,py,pz,qw,qx,qy,qz\n{rows}")
 
-
-def _snapshot(folder: Path) -> dict[Path, str]:
-    return {path: hashlib.sha256(path.read_bytes()).hexdigest() for path in sorted(folder.rglob("*")) if path.is_file()}
 
 
 # (id, argv with {lab} for the lab folder, words the message must hold)
@@ -101,25 +98,21 @@ CASES = [
 ]
 
 
-def _rig(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
-    try:
-        code = main(argv)
-    except SystemExit as exit_:
-        code = exit_.code
-    return code, capsys.readouterr().err
-
 
 @pytest.mark.parametrize("argv, words", [pytest.param(argv, words, id=name) for name, argv, words in CASES])
-def test_out_of_bounds_is_one_line_before_any_work(argv: str, words: tuple[str, ...], lab: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    before = _snapshot(lab)
-    code, err = _rig(argv.format(lab=lab).split(), capsys)
-    assert "Traceback" not in err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert code == EXIT_USER_ERROR, err
-    for word in words:
-        assert word in lines[0], lines[0]
-    assert _snapshot(lab) == before
+def test_out_of_bounds_is_one_line_before_any_work(
+    run_rig: Callable[..., tuple[int, str, str]],
+    snapshot: Callable[[Path], dict[Path, str]],
+    one_line_error: Callable[..., None],
+    argv: str,
+    words: tuple[str, ...],
+    lab: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    before = snapshot(lab)
+    code, _, err = run_rig(argv.format(lab=lab).split(), capsys)
+    one_line_error(code, err, *words)
+    assert snapshot(lab) == before
     assert not (lab / "new").exists()
 
 
@@ -134,27 +127,33 @@ def _every_one_failed(code: int, err: str, what: str) -> None:
     assert f"every one of the {what}" in err.strip().splitlines()[-1], err
 
 
-def test_a_sweep_whose_every_point_failed_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_sweep_whose_every_point_failed_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str],
+) -> None:
     spec = tmp_path / "short.toml"
     spec.write_text(SHORT_FILM + "[grid]\nseed = [1, 2]\n")
-    code, err = _rig(["sweep", str(spec), "--out", str(tmp_path / "sweep")], capsys)
+    code, _, err = run_rig(["sweep", str(spec), "--out", str(tmp_path / "sweep")], capsys)
     _every_one_failed(code, err, "2 points failed")
     assert "pendulum periods" in err
     assert (tmp_path / "sweep" / "summary.csv").exists()
 
 
-def test_a_bench_whose_every_case_was_refused_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_bench_whose_every_case_was_refused_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str],
+) -> None:
     spec = tmp_path / "short.toml"
     spec.write_text(SHORT_FILM + '[[points]]\nlabels = { case = "short", group = "mixed", impairment = "none" }\nseed = 1\n')
-    code, err = _rig(["bench", "analyser", "--spec", str(spec)], capsys)
+    code, _, err = run_rig(["bench", "analyser", "--spec", str(spec)], capsys)
     _every_one_failed(code, err, "1 cases")
 
 
-def test_a_batch_whose_every_video_failed_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_batch_whose_every_video_failed_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str],
+) -> None:
     for name in ("black.avi", "grey.avi"):
         writer = cv2.VideoWriter(str(tmp_path / name), cv2.VideoWriter_fourcc(*"MJPG"), 60.0, (64, 48))
         for _ in range(40):
             writer.write(np.full((48, 64, 3), 0 if name == "black.avi" else 128, np.uint8))
         writer.release()
-    code, err = _rig(["analyse", str(tmp_path / "black.avi"), str(tmp_path / "grey.avi")], capsys)
+    code, _, err = run_rig(["analyse", str(tmp_path / "black.avi"), str(tmp_path / "grey.avi")], capsys)
     _every_one_failed(code, err, "2 videos failed")
