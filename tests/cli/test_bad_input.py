@@ -14,7 +14,6 @@ import cv2
 import numpy as np
 import pytest
 
-
 HEADER = "t,px,py,pz,qw,qx,qy,qz"
 FRAME = (48, 64)
 
