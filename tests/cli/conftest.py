@@ -39,7 +39,7 @@ def _assert_one_line_error(code: int, err: str, *words: str) -> None:
 
 
 @pytest.fixture
-def one_line_error() -> Callable[..., None]:
+def assert_one_line_error() -> Callable[..., None]:
     """Checks a user error: exit status 2, one line on stderr holding each word, no traceback and
     no Python value's representation."""
     return _assert_one_line_error

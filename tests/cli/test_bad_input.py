@@ -240,7 +240,7 @@ CASES = [
 
 @pytest.mark.parametrize("argv, word", [pytest.param(argv, word, id=name) for name, argv, word in CASES])
 def test_bad_input_is_one_line_and_loses_nothing(
-    one_line_error: Callable[..., None],
+    assert_one_line_error: Callable[..., None],
     run_rig: Callable[..., tuple[int, str, str]],
     snapshot: Callable[[Path], dict[Path, str]],
     argv: str,
@@ -250,24 +250,24 @@ def test_bad_input_is_one_line_and_loses_nothing(
 ) -> None:
     before = snapshot(lab)
     code, _, err = run_rig(argv.format(lab=lab).split(), capsys)
-    one_line_error(code, err, word)
+    assert_one_line_error(code, err, word)
     assert {path: digest for path, digest in snapshot(lab).items() if path in before} == before
 
 
 def test_a_board_that_says_nothing(
-    one_line_error: Callable[..., None],
+    assert_one_line_error: Callable[..., None],
     run_rig: Callable[..., tuple[int, str, str]], silent_board: str, capsys: pytest.CaptureFixture[str],
 ) -> None:
     code, _, err = run_rig(["board", "info", "--port", silent_board], capsys)
-    one_line_error(code, err, "did not answer")
+    assert_one_line_error(code, err, "did not answer")
 
 
 def test_a_board_that_answers_garbage(
-    one_line_error: Callable[..., None],
+    assert_one_line_error: Callable[..., None],
     run_rig: Callable[..., tuple[int, str, str]], babbling_board: str, capsys: pytest.CaptureFixture[str],
 ) -> None:
     code, _, err = run_rig(["board", "info", "--port", babbling_board], capsys)
-    one_line_error(code, err, "did not answer")
+    assert_one_line_error(code, err, "did not answer")
 
 
 def test_matrix_covers_every_command() -> None:

@@ -131,12 +131,12 @@ NAME_CASES = [
 
 @pytest.mark.parametrize("argv, word", [pytest.param(argv, word, id=name) for name, argv, word in NAME_CASES])
 def test_a_name_that_is_not_utf8_is_refused_in_one_line(
-    one_line_error: Callable[..., None],
+    assert_one_line_error: Callable[..., None],
     snapshot: Callable[[Path], dict[Path, str]], argv: str, word: str, lab: Path,
 ) -> None:
     before, listing = snapshot(lab), _listing(lab)
     code, _, err = _rig_process(argv.format(lab=lab, bad=NOT_UTF8).split(), lab)
-    one_line_error(code, err, word)
+    assert_one_line_error(code, err, word)
     assert snapshot(lab) == before
     assert _listing(lab) == listing, "a refused run left something behind"
 
@@ -165,7 +165,7 @@ EMULATOR_CASES = [
 
 @pytest.mark.parametrize("argv, word", [pytest.param(argv, word, id=name) for name, argv, word in EMULATOR_CASES])
 def test_the_emulator_never_takes_a_path_over(
-    one_line_error: Callable[..., None],
+    assert_one_line_error: Callable[..., None],
     run_rig: Callable[..., tuple[int, str, str]],
     snapshot: Callable[[Path], dict[Path, str]],
     argv: str,
@@ -175,7 +175,7 @@ def test_the_emulator_never_takes_a_path_over(
 ) -> None:
     before, listing, link = snapshot(lab), _listing(lab), os.readlink(lab / "a-link")
     code, _, err = run_rig(argv.format(lab=lab).split(), capsys)
-    one_line_error(code, err, word)
+    assert_one_line_error(code, err, word)
     assert snapshot(lab) == before and _listing(lab) == listing
     assert (lab / "a-file").read_text() == "precious" and os.readlink(lab / "a-link") == link
 
@@ -204,7 +204,7 @@ def impatient_scheduler_check(monkeypatch: pytest.MonkeyPatch) -> None:
 @pytest.mark.usefixtures("impatient_scheduler_check")
 @pytest.mark.parametrize("argv, word, output", [pytest.param(a, w, o, id=name) for name, a, w, o in RERUN_CASES])
 def test_a_run_that_recorded_nothing_leaves_nothing_and_runs_again(
-    one_line_error: Callable[..., None],
+    assert_one_line_error: Callable[..., None],
     run_rig: Callable[..., tuple[int, str, str]],
     snapshot: Callable[[Path], dict[Path, str]],
     argv: str, word: str, output: str, lab: Path, tmp_path: Path, silent_port: str, capsys: pytest.CaptureFixture[str]
@@ -213,7 +213,7 @@ def test_a_run_that_recorded_nothing_leaves_nothing_and_runs_again(
     before, listing = snapshot(lab), _listing(lab)
     for attempt in ("first", "again"):
         code, _, err = run_rig(argv.format(**fill).split(), capsys)
-        one_line_error(code, err, word)
+        assert_one_line_error(code, err, word)
         assert "--overwrite" not in err, f"{attempt} run refused: {err}"
         assert snapshot(lab) == before and _listing(lab) == listing
         assert not (tmp_path / "new").exists()

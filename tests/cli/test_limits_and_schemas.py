@@ -103,7 +103,7 @@ CASES = [
 def test_out_of_bounds_is_one_line_before_any_work(
     run_rig: Callable[..., tuple[int, str, str]],
     snapshot: Callable[[Path], dict[Path, str]],
-    one_line_error: Callable[..., None],
+    assert_one_line_error: Callable[..., None],
     argv: str,
     words: tuple[str, ...],
     lab: Path,
@@ -111,7 +111,7 @@ def test_out_of_bounds_is_one_line_before_any_work(
 ) -> None:
     before = snapshot(lab)
     code, _, err = run_rig(argv.format(lab=lab).split(), capsys)
-    one_line_error(code, err, *words)
+    assert_one_line_error(code, err, *words)
     assert snapshot(lab) == before
     assert not (lab / "new").exists()
 
@@ -120,7 +120,7 @@ SHORT_FILM = "[base]\nduration_s = 0.5\ncamera.fps = 60.0\ncamera.width = 160\nc
 """Half a pendulum period, filmed small: simulated in a moment, refused by the analyser (too few periods)."""
 
 
-def _every_one_failed(code: int, err: str, what: str) -> None:
+def _assert_every_one_failed(code: int, err: str, what: str) -> None:
     """Exit status 2, and the last line of stderr says every one of `what` failed."""
     assert "Traceback" not in err
     assert code == EXIT_USER_ERROR, err
@@ -133,7 +133,7 @@ def test_a_sweep_whose_every_point_failed_exits_2(
     spec = tmp_path / "short.toml"
     spec.write_text(SHORT_FILM + "[grid]\nseed = [1, 2]\n")
     code, _, err = run_rig(["sweep", str(spec), "--out", str(tmp_path / "sweep")], capsys)
-    _every_one_failed(code, err, "2 points failed")
+    _assert_every_one_failed(code, err, "2 points failed")
     assert "pendulum periods" in err
     assert (tmp_path / "sweep" / "summary.csv").exists()
 
@@ -144,7 +144,7 @@ def test_a_bench_whose_every_case_was_refused_exits_2(
     spec = tmp_path / "short.toml"
     spec.write_text(SHORT_FILM + '[[points]]\nlabels = { case = "short", group = "mixed", impairment = "none" }\nseed = 1\n')
     code, _, err = run_rig(["bench", "analyser", "--spec", str(spec)], capsys)
-    _every_one_failed(code, err, "1 cases")
+    _assert_every_one_failed(code, err, "1 cases")
 
 
 def test_a_batch_whose_every_video_failed_exits_2(
@@ -156,4 +156,4 @@ def test_a_batch_whose_every_video_failed_exits_2(
             writer.write(np.full((48, 64, 3), 0 if name == "black.avi" else 128, np.uint8))
         writer.release()
     code, _, err = run_rig(["analyse", str(tmp_path / "black.avi"), str(tmp_path / "grey.avi")], capsys)
-    _every_one_failed(code, err, "2 videos failed")
+    _assert_every_one_failed(code, err, "2 videos failed")
