@@ -132,7 +132,10 @@ NAME_CASES = [
 @pytest.mark.parametrize("argv, word", [pytest.param(argv, word, id=name) for name, argv, word in NAME_CASES])
 def test_a_name_that_is_not_utf8_is_refused_in_one_line(
     assert_one_line_error: Callable[..., None],
-    snapshot: Callable[[Path], dict[Path, str]], argv: str, word: str, lab: Path,
+    snapshot: Callable[[Path], dict[Path, str]],
+    argv: str,
+    word: str,
+    lab: Path,
 ) -> None:
     before, listing = snapshot(lab), _listing(lab)
     code, _, err = _rig_process(argv.format(lab=lab, bad=NOT_UTF8).split(), lab)
