@@ -15,7 +15,7 @@ Brightness decides nothing: a dim LED or a bright display is common. What differ
 - saturation: the LED is a point of light bright enough to saturate its core in most frames; a
   display's sphere rarely reaches the sensor's top level.
 - size: the LED is point-like; the sphere is a drawn disc, usually larger in the image.
-- side: the rig puts the LED left of the display (``rig simulate`` and the README's layout).
+- side: the rig puts the LED left of the display (``rig simulate`` and the layout docs/filming.md advises).
 
 Each is a log-odds that the first (left) blob is the LED; their sum must reach DECISION_MARGIN
 either way, or no decision is made and the caller asks the user for the regions.

@@ -241,7 +241,7 @@ def targets_met(summaries: dict[str, dict[str, dict[str, Any]]]) -> dict[str, bo
 
 
 def table(summary: dict[str, dict[str, Any]]) -> str:
-    """A summary as a Markdown table (the README's)."""
+    """A summary as a Markdown table (as docs/benchmarks.md shows them)."""
 
     lines = [
         "| method | median abs error (ms / frames) | worst abs error (ms / frames) | 95% coverage | confidently wrong | "

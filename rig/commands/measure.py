@@ -142,7 +142,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--camera", metavar="SPEC", help=f"the camera filming the LED and the screen: {CAMERA_SPECS}")
     parser.add_argument("--renderer", default="warp", metavar="NAME",
                         help="the rig's renderer (listed below), with options as warp:OPTIONS (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--external", action="store_true", help="measure an external renderer over LSL instead (see README)")
+    parser.add_argument("--external", action="store_true", help="measure an external renderer over LSL instead (see docs/lsl.md)")
     parser.add_argument("--predictor", type=options.predictor_spec, default=("default", {}), metavar="NAME[:key=value,...]",
                         help="the pose predictor (listed below), with parameters or a `rig tune` file (default: default)")  # fmt: skip
     parser.add_argument("--display", default="window", metavar="SPEC",

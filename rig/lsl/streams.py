@@ -1,6 +1,6 @@
 """The rig's Lab Streaming Layer interface for any renderer (Unity through LSL4Unity, Unreal, C++
 with liblsl, Python with pylsl): what each stream is called, what its channels hold, and the clock
-its times are on. README.md ("Measuring your own renderer over LSL") explains it for implementers.
+its times are on. docs/lsl.md ("Measuring your own renderer over LSL") explains it for implementers.
 
 Every time in these streams, sample timestamps and time channels alike, is on the LSL clock of the
 machine that sent it (`lsl_local_clock()`, the system's monotonic clock); a receiver on another

@@ -113,8 +113,8 @@ def relative_loss(errors: dict[str, float], reference: dict[str, float]) -> floa
 @dataclass(frozen=True)
 class TuneReport:
     """The fit, and the RMS errors on training and validation of the tuned parameters, the
-    defaults, constant velocity and the default predictor: errors[part][label] =
-    {"angular_rms_deg", "position_rms_mm"}; `validation_loss` is the tuned parameters' relative to
+    defaults, constant velocity and the default predictor: `errors[part][label]` holds
+    `{"angular_rms_deg", "position_rms_mm"}`; `validation_loss` is the tuned parameters' relative to
     the defaults' on validation (below 1 is better)."""
 
     fit: TuneResult
