@@ -25,7 +25,7 @@ $(STAMP): pyproject.toml setup.py analysis/_jpeg_region.c rig/devices/trackers/_
 	touch $(STAMP)
 
 $(TEST_STAMP): $(STAMP)
-	$(BIN)/pip install --quiet -c constraints.txt -e '.[test]'
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[test,docs]'
 	touch $(TEST_STAMP)
 
 demo: system $(STAMP)
@@ -43,3 +43,26 @@ test-all: test-system $(TEST_STAMP)
 
 clean:
 	rm -rf $(VENV) out
+
+# `make docs` builds the documentation site into out/site in strict mode (tests/test_docs.py builds it
+# in CI); `make notebooks` installs Jupyter and executes both notebooks into out/notebooks.
+DOCS_STAMP := $(VENV)/.installed-docs
+NOTEBOOKS_STAMP := $(VENV)/.installed-notebooks
+
+.PHONY: docs notebooks
+
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[docs]'
+	touch $(DOCS_STAMP)
+
+docs: system $(DOCS_STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+
+$(NOTEBOOKS_STAMP): $(STAMP)
+	@echo "installing Jupyter (nbconvert, ipykernel, notebook) into $(VENV)"
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[notebooks]'
+	touch $(NOTEBOOKS_STAMP)
+
+notebooks: system $(NOTEBOOKS_STAMP)
+	$(BIN)/jupyter nbconvert --to notebook --execute --ExecutePreprocessor.timeout=600 --output-dir out/notebooks notebooks/*.ipynb
+	@echo "executed notebooks in out/notebooks; open them with: $(BIN)/jupyter notebook notebooks/"
