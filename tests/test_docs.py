@@ -15,6 +15,7 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 
@@ -105,3 +106,32 @@ def demo_output(path: Path) -> str:
 
 def test_the_readme_shows_the_same_demo_output_as_getting_started() -> None:
     assert demo_output(README) == demo_output(ROOT / "docs" / "getting-started.md")
+
+
+def repository_links() -> ModuleType:
+    require_mkdocs()
+    spec = importlib.util.spec_from_file_location("repository_links", ROOT / "docs" / "hooks" / "repository_links.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_link_to_a_repository_file_becomes_its_path_and_a_link_to_a_missing_file_stays() -> None:
+    rewrite = repository_links().outside_links_as_paths
+    docs = ROOT / "docs"
+    markdown = (
+        "See [the example](../examples/external_renderer.py), [Filming](filming.md), "
+        "[gone](../examples/missing.py) and [web](https://example.org/a.py).\n"
+        "```\n[in code](../examples/external_renderer.py)\n```\n"
+    )
+    assert rewrite(markdown, docs, docs, ROOT) == (
+        "See the example (`examples/external_renderer.py`), [Filming](filming.md), "
+        "[gone](../examples/missing.py) and [web](https://example.org/a.py).\n"
+        "```\n[in code](../examples/external_renderer.py)\n```\n"
+    )
+
+
+def test_a_link_whose_text_is_the_path_is_written_once() -> None:
+    rewrite = repository_links().outside_links_as_paths
+    docs = ROOT / "docs"
+    assert rewrite("[firmware/README.md](../firmware/README.md)", docs, docs, ROOT) == "`firmware/README.md`"
