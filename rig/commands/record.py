@@ -1,8 +1,10 @@
 """`rig record --camera SPEC --duration S --out DIR`: film with a camera, every frame to disk as it comes.
 
-Writes DIR/video.avi (Motion-JPEG, what `rig analyse` reads), DIR/camera_frames.csv (each frame's
-capture time on the host's monotonic clock, the backend's own timestamp, and the stand-ins written
-for dropped frames) and DIR/camera.json (the settings asked for and what the camera reports).
+Writes DIR/video.avi (Motion-JPEG, what `rig analyse` reads; for a camera faster than 1000 fps,
+which an AVI cannot hold, DIR/video.mp4 in H.264 with each frame's time, and DIR/frame_times.csv),
+DIR/camera_frames.csv (each frame's capture time on the host's monotonic clock, the backend's own
+timestamp, and the stand-ins written for dropped frames) and DIR/camera.json (the settings asked for
+and what the camera reports); a camera faster than 10000 fps is refused before anything is written.
 Ctrl-C or an unplugged camera stops cleanly and keeps every frame.
 """
 
