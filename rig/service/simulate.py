@@ -139,6 +139,7 @@ def simulate(
     world = SimulatedWorld(config)
     context = DeviceContext(world.twins())
     display, camera = world.display(), world.camera()  # the registry's `sim` devices, whose details the truth reads
+    _check_film(config, len(camera.film_times))
     renderer = make_renderer(config.renderer)
     board = world.board(out_dir / BOARD_FOLDER)
     timing = timing_for(renderer, cost_model(config.warp_ms))
@@ -166,7 +167,6 @@ def simulate(
         instruments=[board] if board is not None else [],
         target=PhotonTarget(config.photon_target, config.persistence),
     )
-    _check_film(config, len(camera.film_times))
     with removed_unless_recorded(out_dir):
         _prepare(out_dir, overwrite)
         with RunRecord(out_dir, overwrite=overwrite, film=config.camera.film) as record:

@@ -5,6 +5,7 @@ written. Commands run in this process through `rig.cli.main`."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Callable
@@ -136,6 +137,20 @@ def test_a_sweep_whose_every_point_failed_exits_2(
     _assert_every_one_failed(code, err, "2 points failed")
     assert "pendulum periods" in err
     assert (tmp_path / "sweep" / "summary.csv").exists()
+
+
+def test_a_sweep_point_whose_film_is_too_short_is_a_failed_row_and_the_sweep_goes_on(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str],
+) -> None:
+    spec = tmp_path / "short.toml"
+    spec.write_text(SHORT_FILM + "[[points]]\ncamera.impairments.every_nth = 2\n\n[[points]]\nseed = 2\n")
+    code, _, err = run_rig(["sweep", str(spec), "--out", str(tmp_path / "sweep")], capsys)
+    _assert_every_one_failed(code, err, "2 points failed")
+    rows = json.loads((tmp_path / "sweep" / "summary.json").read_text())["rows"]
+    assert [row["status"] for row in rows] == ["failed", "failed"]
+    assert rows[0]["error"].startswith("not simulated: the film would hold 15 frames") and "at least 24" in rows[0]["error"]
+    assert "pendulum periods" in rows[1]["error"]
+    assert not (tmp_path / "sweep" / "point000").exists() and (tmp_path / "sweep" / "point001" / "video.avi").exists()
 
 
 def test_a_bench_whose_every_case_was_refused_exits_2(
