@@ -53,6 +53,7 @@ from declared import Range, check, like, setting
 from predictors import Pose
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, SpecFile, cell, given
+from rig.bench.renderer_estimate import estimated_hours
 from rig.bench.renderer_latency import LatencyRun, film_latencies
 from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup
 from rig.bench.spec_reader import read_spec
@@ -63,6 +64,7 @@ from rig.render.gl import LOAD_SHAPES
 from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, RenderSetup
 from rig.sim.camera import CameraConfig
+from rig.sim.config import MAX_HOURS
 from rig.sim.display import DisplayConfig
 
 QUICK_SPEC = Path(__file__).parent / "specs" / "renderers-quick.toml"
@@ -135,6 +137,9 @@ class BenchGrid:
             raise ConfigError("a renderer bench grid needs at least one load size, resolution and rate ratio")
         if min(min(size) for size in self.resolutions) < 16:
             raise ConfigError(f"a display is at least 16x16 pixels, got {self.resolutions}")
+        if (hours := estimated_hours(self)) > MAX_HOURS:
+            raise ConfigError(f"this grid would take about {hours:.3g} hours at the least, more than the {MAX_HOURS:g} hours the rig "
+                              "starts: fewer or smaller loads, resolutions, phases or warp rounds, or split it into grids of its own")  # fmt: skip
 
     def latency_run(
         self, renderer: str, triangles: int, predictor: str, photon_target: str = "photons", load: str = "soup"

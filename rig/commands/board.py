@@ -31,7 +31,7 @@ from rig.board.microcontroller import Microcontroller
 from rig.board.recorder import BoardRecorder
 from rig.clock import MonotonicClock
 from rig.commands import outputs
-from rig.commands.options import non_negative_float, non_negative_int, positive_float
+from rig.commands.options import non_negative_float, non_negative_int, positive_float, run_seconds
 from rig.errors import RigError
 from rig.progress import ProgressBar
 
@@ -66,7 +66,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     record = commands.add_parser("record", help="record encoder, photodiode and LED events as CSV files")
     _add_port(record)
     record.add_argument("--out", type=outputs.output_folder, required=True, help="folder for the CSV files (must not hold a recording)")
-    record.add_argument("--duration", type=positive_float, required=True, help="seconds to record")
+    record.add_argument("--duration", type=run_seconds, required=True, help="seconds to record")
     record.add_argument("--encoder-rate", type=non_negative_float, default=0.0, help="encoder reports per second; 0 (default) reports every edge")
     record.add_argument("--rise", type=non_negative_int, default=DEFAULT_RISE, help=f"photodiode rising threshold, ADC counts (default {DEFAULT_RISE})")
     record.add_argument("--fall", type=non_negative_int, default=DEFAULT_FALL, help=f"photodiode falling threshold, below --rise (default {DEFAULT_FALL})")

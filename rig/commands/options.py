@@ -48,6 +48,16 @@ def positive_int(text: str) -> int:
     return value
 
 
+def run_seconds(text: str) -> float:
+    """How long a live run or a recording lasts, as a live run's duration is declared
+    (`rig.live.run.LiveConfig`: at most a day); loaded when an option is read, not when the command
+    line is built."""
+    from rig.commands.declared_options import declared_type
+    from rig.live.run import LiveConfig
+
+    return declared_type(LiveConfig, "duration_s")(text)
+
+
 def roi(text: str) -> tuple[int, int, int, int]:
     """X,Y,W,H in pixels."""
     parts = text.split(",")

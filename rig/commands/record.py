@@ -65,7 +65,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[1].replace("\n", " "),
     )
     parser.add_argument("--camera", required=True, metavar="SPEC", help=f"the camera: {CAMERA_SPECS}")
-    parser.add_argument("--duration", type=options.positive_float, required=True, metavar="S", help="seconds to film")
+    parser.add_argument("--duration", type=options.run_seconds, required=True, metavar="S", help="seconds to film")
     parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder to write the video and frame table into")
     parser.add_argument("--preview", action="store_true", help="show the camera's frames with both regions of interest")
     parser.add_argument("--overwrite", action="store_true", help="replace a recording already in DIR")
