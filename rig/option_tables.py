@@ -11,6 +11,9 @@ from rig.bench.batch import BatchBenchOptions
 from rig.bench.predictors import PredictorBenchOptions
 from rig.bench.renderers import BenchGrid
 from rig.bench.trackers import TrackerBenchOptions
+from rig.board.instrument import BoardSettings
+from rig.commands.board import BlinkOptions, SyncOptions
+from rig.commands.devices import Listing
 from rig.commands.emulate import EmulatorOptions
 from rig.live.run import LiveConfig
 from rig.service.tune import TuneSettings
@@ -57,6 +60,10 @@ SECTIONS = (
         "`rig measure --duration`; `rig record`, `rig record-tracker` and `rig board record` take the same range.",
     ),
     ("Planning", PlanRequest, True, "`rig plan --accuracy-ms`."),
+    ("Listing devices", Listing, True, "`rig devices`'s options."),
+    ("Recording the board", BoardSettings, True, "`rig board record`'s options (the board's own limits are checked when it connects)."),
+    ("Synchronising with the board", SyncOptions, True, "`rig board sync`'s options; a series longer than a day is refused with its estimate."),
+    ("The board's blink code", BlinkOptions, True, "`rig board blink`'s and `rig board record --blink`'s options."),
 )
 
 

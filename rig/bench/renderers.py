@@ -58,6 +58,7 @@ from rig.bench.renderer_latency import LatencyRun, film_latencies
 from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup
 from rig.bench.spec_reader import read_spec
 from rig.commands import options
+from rig.commands.declared_options import declared_type
 from rig.errors import ConfigError
 from rig.render.direct import DirectRenderer
 from rig.render.gl import LOAD_SHAPES
@@ -371,7 +372,7 @@ def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants, --seed-table: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
     parser.add_argument("--predictor", help="the predictor of every latency run, both renderers alike (default: the spec's, hold, as in Smit et al. 2010, Table 2)")
     parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")
-    parser.add_argument("--server-ms", type=options.positive_float, metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
+    parser.add_argument("--server-ms", type=declared_type(BenchGrid, "server_ms"), metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
 
 
 BENCH = Bench(

@@ -116,6 +116,22 @@ CASES = [
     ("simulate-flash-of-no-frequency", "simulate --out {lab}/new --flash-hz 0", ("--flash-hz", "at most 10000", "got 0")),
     ("simulate-flash-display-of-one-refresh", "simulate --out {lab}/new --flash-display 1", ("--flash-display", "from 2 to 1000")),
     ("simulate-flash-always-on", "simulate --out {lab}/new --flash-hz 30 --flash-duty 1", ("--flash-duty", "below 1")),
+    # the board: what its protocol carries and a lab's day holds
+    ("board-sync-too-few-round-trips", "board sync --port loop:// --round-trips 2", ("--round-trips", "from 4 to 10000")),
+    ("board-sync-series-beyond-a-day", "board sync --port loop:// --repeat 100000 --every 3600", ("about 1e+05 hours", "24 hours")),
+    ("board-blink-code-of-no-bits", "board blink --port loop:// --bits 0", ("--bits", "from 1 to 4096")),
+    ("board-blink-beyond-the-led", "board blink --port loop:// --level 256", ("--level", "from 1 to 255")),
+    ("board-blink-seed-beyond-sixteen-bits", "board blink --port loop:// --seed 70000", ("--seed", "from 1 to 65535")),
+    ("board-record-threshold-of-nothing", "board record --port loop:// --out {lab}/new --duration 5 --rise 0", ("--rise", "from 1 to 65535")),
+    ("board-record-resync-beyond-an-hour", "board record --port loop:// --out {lab}/new --duration 5 --resync-every 1e9", ("--resync-every", "from 0.1 to 3600")),
+    ("board-record-encoder-beyond-any-encoder", "board record --port loop:// --out {lab}/new --duration 5 --encoder-rate 1e9", ("--encoder-rate", "from 0 to 100000")),
+    # listening, executors and benches: within a machine's reach
+    ("devices-listening-beyond-ten-minutes", "devices --lsl-wait 1e9", ("--lsl-wait", "from 0 to 600")),
+    ("sweep-workers-beyond-any-machine", "sweep {lab}/base-a-number.toml --out {lab}/sweep --workers 100000", ("--workers", "1 to 256")),
+    ("bench-live-duration-beyond-a-day", "bench live --duration 1e9", ("--duration", "at most 86400")),
+    ("bench-renderers-server-beyond-a-second", "bench renderers --server-ms 1e9", ("--server-ms", "at most 1000")),
+    ("bench-seed-table-load-beyond-any-gpu", "bench renderers --seed-table --max-triangles 1e12", ("--max-triangles", "from 1 to 1e+08")),
+    ("bench-seed-table-frame-beyond-ten-minutes", "bench renderers --seed-table --max-frame-s 1e6", ("--max-frame-s", "at most 600")),
     # plan: an accuracy a camera can reach and a latency needs
     ("plan-accuracy-beyond-any-camera", "plan --display-hz 60 --camera-fps 120 --accuracy-ms 1e-9", ("--accuracy-ms", "from 0.01 to 100")),
     ("plan-accuracy-of-no-use", "plan --display-hz 60 --camera-fps 120 --accuracy-ms 1e6", ("--accuracy-ms", "from 0.01 to 100")),
