@@ -57,3 +57,18 @@ def test_a_calibration_bench_whose_every_film_was_refused_writes_its_record_and_
     code, _, err = run_rig(["bench", "camera-calibration", "--quick", "--json", str(out)], capsys)
     _assert_exits_2_saying(code, err, "refused every one of the 4 films (the first: no flashing light)")
     assert [row["refused"] for row in json.loads(out.read_text())["rows"]] == ["no flashing light"] * 4
+
+
+def test_an_analyser_bench_case_that_cannot_be_filmed_is_refused_and_the_bench_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str],
+) -> None:
+    spec = tmp_path / "unfilmable.toml"
+    spec.write_text(
+        "[base]\nduration_s = 0.5\ncamera.fps = 60.0\ncamera.impairments.every_nth = 2\n"
+        '[[points]]\nlabels = { case = "half the frames", group = "mixed", impairment = "none" }\nseed = 1\n'
+    )
+    out = tmp_path / "analyser.json"
+    code, _, err = run_rig(["bench", "analyser", "--spec", str(spec), "--json", str(out)], capsys)
+    _assert_exits_2_saying(code, err, "refused every one of the 1 cases (the first: not simulated: the film would hold 15 frames")
+    (case,) = json.loads(out.read_text())["cases"]
+    assert (case["case"], case["truth_ms"], case["frames"]) == ("half the frames", None, 0)
