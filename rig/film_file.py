@@ -7,8 +7,9 @@ presentation time is its exposure's start rounded to it, counted from the first 
 `frame_times.csv` beside the film lists both for every frame. The grey image is written as
 full-range luma (chroma neutral), so decoding the film to grey gives back the pixels the codec kept.
 A packet the file cannot take (a full disk) raises RigError, and closing counts the film's frames
-back: RigError unless it holds every frame written. Such a film holds any frame rate its time base
-resolves (4000 fps and more).
+back: RigError unless it holds every frame written. Such a film is written up to `STAMPED_MAX_FPS`
+(10000 fps, each rate to it filmed and read back frame by frame in the tests); `film_holding` picks
+the film a camera's rate needs.
 """
 
 from __future__ import annotations
@@ -67,7 +68,7 @@ def check_film_rate(fps: float, container: str, advice: str = "") -> None:
         check_avi_rate(fps, advice)
     elif not fps <= STAMPED_MAX_FPS:
         raise RigError(
-            f"an {container.upper()} film is written at most {STAMPED_MAX_FPS:g} frames a second, not {fps:g}: "
+            f"a film in an MP4 or a MOV is written at most {STAMPED_MAX_FPS:g} frames a second, not {fps:g}: "
             f"film at {STAMPED_MAX_FPS:g} fps or fewer"
         )
 
