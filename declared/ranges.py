@@ -37,6 +37,15 @@ class Range:
             bounds = " and ".join(part for part in (lower, upper) if part)
         return " ".join(part for part in (kind, f"of {unit}" if unit else "", bounds) if part)
 
+    def clipped(self, value: float) -> float:
+        """`value` moved onto the end it passes, where the range holds that end (an open end has no
+        nearest value inside: a value past it is returned as it is)."""
+        if self.includes_low and value < self.low:
+            return self.low
+        if self.includes_high and value > self.high:
+            return self.high
+        return value
+
     def scaled(self, factor: float) -> Range:
         """The same range in a unit `factor` times smaller (seconds as milliseconds: 1e3)."""
         return Range(self.low * factor, self.high * factor, self.includes_low, self.includes_high)

@@ -41,7 +41,7 @@ from predictors import scalar_quaternion as squat
 from predictors.checks import horizon, read_sample
 from predictors.extrapolators import MIN_INTERVAL
 from predictors.horizon_scores import BASELINE, COLD_START, MODEL_NAMES, MODELS, Choice, HorizonScore
-from predictors.params import MAX_GAP, MAX_HORIZON, OPEN_UNIT, POSITIVE, Param, ParamSet, declare_params
+from predictors.params import MAX_GAP, MAX_HORIZON, OPEN_UNIT, Param, ParamSet, Range, declare_params
 from predictors.pose import Pose, PoseSample
 from predictors.smoothers import Estimate, Smoothers, two_sample
 
@@ -57,7 +57,7 @@ MEMORY = Param(
     "memory", 10.0, "seconds",
     "Time constant of the scores, the learnt gains and the noise estimate: how long what the stream "
     "showed counts.",
-    POSITIVE,
+    Range(0.0, 3600.0, includes_high=True),
 )
 MARGIN = Param(
     "margin", 0.05, "",
@@ -69,7 +69,7 @@ MARGIN = Param(
 GAIN_PRIOR = Param(
     "gain_prior", 2.0, "seconds",
     "The learnt velocity gains start at 1 and count as this many seconds of evidence for 1.",
-    POSITIVE,
+    Range(0.0, 3600.0, includes_high=True),
 )
 
 # (t_sensor, position, orientation, the candidates' estimates) of a sample.

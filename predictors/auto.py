@@ -39,7 +39,7 @@ from predictors.kalman import (
     ConstantVelocityPosition,
     OrientationFilter,
 )
-from predictors.params import LOG, MAX_GAP, MAX_HORIZON, POSITIVE, Param, ParamSet, declare_params
+from predictors.params import LOG, MAX_GAP, MAX_HORIZON, Param, ParamSet, Range, declare_params
 from predictors.pose import Pose, PoseSample
 
 POSITION_MODELS = ("none", "constant-velocity", "constant-acceleration")
@@ -53,13 +53,13 @@ AUTO_JERK_NOISE = replace(
 MEMORY = Param(
     "memory", 2.0, "seconds",
     "Time constant of the error scores, and how long a cold start uses the simplest models before choosing.",
-    POSITIVE, LOG, trainable=True,
+    Range(1e-3, 3600.0, True, True), LOG, trainable=True,
 )
 MARGIN = Param(
     "margin", 0.1, "",
     "A fraction: a simpler model is used while its RMS error is at most (1 + margin) times the best "
     "one's plus the tracker's noise.",
-    POSITIVE, LOG, trainable=True,
+    Range(1e-4, 100.0, True, True), LOG, trainable=True,
 )
 
 

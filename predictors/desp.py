@@ -26,7 +26,7 @@ from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
 from predictors.checks import horizon, read_sample
-from predictors.params import LOGIT, MAX_GAP, MAX_HORIZON, OPEN_UNIT, POSITIVE, Param, ParamSet, declare_params
+from predictors.params import LOGIT, MAX_GAP, MAX_HORIZON, OPEN_UNIT, Param, Range, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
 
 # Weight of the newest interval in the running mean of the sample interval (about 20 samples).
@@ -45,7 +45,7 @@ ORIENTATION_ALPHA = Param(
 SAMPLE_INTERVAL = Param(
     "sample_interval", None, "seconds",
     "The tracker's sample interval, which turns a horizon into samples; None estimates it from the samples.",
-    POSITIVE,
+    Range(0.0, 10.0, includes_high=True),
 )
 
 

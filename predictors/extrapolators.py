@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
 from predictors.checks import finite_time, no_sample_yet, read_sample
-from predictors.params import POSITIVE, Param, ParamSet, declare_params
+from predictors.params import Param, ParamSet, Range, declare_params
 from predictors.pose import Pose, PoseSample
 
 MIN_INTERVAL = Param(
@@ -24,7 +24,7 @@ MIN_INTERVAL = Param(
     "A sample less than this after the newest one counts as a duplicate: it replaces the newest and "
     "the older, distinct sample is kept, so the two samples used are always at least this far apart "
     "and a repeated timestamp never divides by zero or amplifies jitter into a wild velocity.",
-    POSITIVE,
+    Range(0.0, 1.0, includes_high=True),
 )
 
 

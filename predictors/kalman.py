@@ -43,12 +43,14 @@ says little about the motion after it.
 
 from __future__ import annotations
 
+import math
 from typing import Any, ClassVar
 
+from declared import Range
 from predictors import scalar_quaternion as squat
 from predictors.checks import horizon, read_sample
 from predictors.kinematic_covariance import KinematicCovariance, damped_reach, damped_step
-from predictors.params import LOG, MAX_GAP, MAX_HORIZON, NON_NEGATIVE, POSITIVE, Param, ParamSet, declare_params
+from predictors.params import LOG, MAX_GAP, MAX_HORIZON, Param, ParamSet, declare_params
 from predictors.pose import Pose, PoseSample
 
 # Prior spread of the motion at a cold start or after a drop-out (the first sample gives the pose).
@@ -60,35 +62,37 @@ INITIAL_ANGULAR_SPEED_STD = 3.0  # rad/s
 # damping are fitted: the predicted means depend on the noises only through their ratio, so the
 # measurement noises stay as the tracker's datasheet (or the default) gives them.
 POSITION_NOISE = Param(
-    "position_noise", 0.0005, "metres", "Standard deviation of the tracker's position noise per axis.",
-    POSITIVE, LOG, acts_on="position",
+    "position_noise", 0.0005, "metres",
+    "Standard deviation of the tracker's position noise per axis: from a nanometre (an interferometer) to a metre.",
+    Range(1e-9, 1.0, True, True), LOG, acts_on="position",
 )
 ACCELERATION_NOISE = Param(
     "acceleration_noise", 1.0, "m/s^1.5",
     "Square root of the spectral density of the white acceleration that drives the velocity "
     "(velocity wanders by this times sqrt(seconds)).",
-    POSITIVE, LOG, trainable=True, acts_on="position",
+    Range(1e-6, 1e4, True, True), LOG, trainable=True, acts_on="position",
 )
 JERK_NOISE = Param(
     "jerk_noise", 20.0, "m/s^2.5",
     "Square root of the spectral density of the white jerk that drives the acceleration.",
-    POSITIVE, LOG, trainable=True, acts_on="position",
+    Range(1e-6, 1e6, True, True), LOG, trainable=True, acts_on="position",
 )
 ORIENTATION_NOISE = Param(
-    "orientation_noise", 0.002, "radians", "Standard deviation of the tracker's orientation noise per axis.",
-    POSITIVE, LOG, acts_on="orientation",
+    "orientation_noise", 0.002, "radians",
+    "Standard deviation of the tracker's orientation noise per axis: from a nanoradian to half a turn.",
+    Range(1e-9, math.pi, True, True), LOG, acts_on="orientation",
 )
 ANGULAR_ACCELERATION_NOISE = Param(
     "angular_acceleration_noise", 5.0, "rad/s^1.5",
     "Square root of the spectral density of the white angular acceleration that drives the angular velocity.",
-    POSITIVE, LOG, trainable=True, acts_on="orientation",
+    Range(1e-6, 1e5, True, True), LOG, trainable=True, acts_on="orientation",
 )
 ANGULAR_VELOCITY_DAMPING = Param(
     "angular_velocity_damping", 0.0, "1/s",
     "The rate at which the angular velocity reverts to rest between its random changes (see "
     "`predictors.kalman`); 0 keeps it constant. From 0, tuning starts at a rate slow against the "
     "horizons tuned for, which predicts almost as the undamped model while giving the loss a slope in it.",
-    NON_NEGATIVE, LOG, trainable=True, acts_on="orientation", tune_from=1.0,
+    Range(0.0, 1e4, True, True), LOG, trainable=True, acts_on="orientation", tune_from=1.0,
 )
 
 

@@ -223,11 +223,11 @@ def declare_params(*params: Param) -> Callable[[PredictorClass], PredictorClass]
 
 MAX_GAP = Param(
     "max_gap", 1.0, "seconds", "A longer gap between samples restarts the predictor from the sample after it.",
-    POSITIVE,
+    Range(0.0, 86400.0, includes_high=True),
 )
 MAX_HORIZON = Param(
     "max_horizon", 0.5, "seconds",
     "Predictions further than this from the newest sample (either way) are made for this horizon: "
     "a drop-out holds the motion instead of flying away.",
-    POSITIVE,
+    Range(0.0, 10.0, includes_high=True),
 )

@@ -125,7 +125,9 @@ class _Parameterisation:
         return np.array(start)
 
     def natural(self, x: np.ndarray) -> dict[str, float]:
-        return {param.name: float(param.transform.to_natural(v)) for param, v in zip(self.trained, x)}
+        """The fitted values; one the fit took past its declared range (a noise ratio the trace does
+        not bound: the loss is flat there) is held at the range's end, so the parameters load back."""
+        return {param.name: param.range.clipped(float(param.transform.to_natural(v))) for param, v in zip(self.trained, x)}
 
     def predictions(self) -> Callable[[jax.Array, jax_filters.TraceArrays], tuple[jax.Array, jax.Array]]:
         fixed, trained, runs, predictor = self.values, self.trained, self.runs, self.predictor

@@ -7,8 +7,9 @@ presentation time is its exposure's start rounded to it, counted from the first 
 `frame_times.csv` beside the film lists both for every frame. The grey image is written as
 full-range luma (chroma neutral), so decoding the film to grey gives back the pixels the codec kept.
 A packet the file cannot take (a full disk) raises RigError, and closing counts the film's frames
-back: RigError unless it holds every frame written. Such a film holds any frame rate its time base
-resolves (4000 fps and more).
+back: RigError unless it holds every frame written. Such a film is written up to `STAMPED_MAX_FPS`
+(10000 fps, each rate to it filmed and read back frame by frame in the tests); `film_holding` picks
+the film a camera's rate needs.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from rig.errors import ConfigError, RigError
-from rig.writers import CsvRecord
+from rig.writers import MJPEG_AVI_MAX_FPS, CsvRecord, check_avi_rate
 
 CONTAINERS = ("avi", "mp4", "mov")
 CODECS = ("mjpeg", "h264", "hevc")
@@ -53,6 +54,32 @@ def check_film_format(container: str, codec: str, stamped: bool) -> None:
         raise ConfigError(
             "a film with variable frame timing needs a container that stamps each frame: give --container mp4 or mov"
         )
+
+
+STAMPED_MAX_FPS = 10_000.0
+"""The fastest film written in an MP4 or a MOV: the fastest camera the rig simulates, each frame nine
+or more ticks of the time base after the one before."""
+
+
+def check_film_rate(fps: float, container: str, advice: str = "") -> None:
+    """RigError unless a film in `container` holds `fps` frames a second (`check_avi_rate` for an
+    AVI); `advice` says what else the caller may film in."""
+    if container not in STAMPED_CONTAINERS:
+        check_avi_rate(fps, advice)
+    elif not fps <= STAMPED_MAX_FPS:
+        raise RigError(
+            f"a film in an MP4 or a MOV is written at most {STAMPED_MAX_FPS:g} frames a second, not {fps:g}: "
+            f"film at {STAMPED_MAX_FPS:g} fps or fewer"
+        )
+
+
+def film_holding(fps: float) -> tuple[str, str]:
+    """The (container, codec) a camera filming `fps` frames a second is written in: an MJPEG AVI, which
+    every OpenCV build reads, where it holds the rate, else H.264 in an MP4 (each frame stamped with
+    its time); RigError above what either holds."""
+    film = ("avi", "mjpeg") if fps <= MJPEG_AVI_MAX_FPS else ("mp4", "h264")
+    check_film_rate(fps, film[0])
+    return film
 
 
 def default_codec(container: str) -> str:

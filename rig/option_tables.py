@@ -11,8 +11,14 @@ from rig.bench.batch import BatchBenchOptions
 from rig.bench.predictors import PredictorBenchOptions
 from rig.bench.renderers import BenchGrid
 from rig.bench.trackers import TrackerBenchOptions
+from rig.board.instrument import BoardSettings
+from rig.commands.board import BlinkOptions, SyncOptions
+from rig.commands.devices import Listing
+from rig.commands.emulate import EmulatorOptions
+from rig.live.run import LiveConfig
 from rig.service.tune import TuneSettings
 from rig.service.bench_profile import BenchProfile
+from rig.service.plan import PlanRequest
 from rig.sim.config import SimulationConfig
 
 SECTIONS = (
@@ -46,6 +52,18 @@ SECTIONS = (
     ("The predictor bench", PredictorBenchOptions, True, "`rig bench predictors`'s numeric options."),
     ("The tracker bench", TrackerBenchOptions, True, "`rig bench trackers`'s options."),
     ("The batch bench", BatchBenchOptions, True, "`rig bench batch`'s options; a batch that would take more than a day is refused with its estimate."),
+    ("The tracker emulator", EmulatorOptions, True, "`rig emulate-tracker`'s numeric options (`--drift-ppm`: `serial` only)."),
+    (
+        "A live run",
+        LiveConfig,
+        True,
+        "`rig measure --duration`; `rig record`, `rig record-tracker` and `rig board record` take the same range.",
+    ),
+    ("Planning", PlanRequest, True, "`rig plan --accuracy-ms`."),
+    ("Listing devices", Listing, True, "`rig devices`'s options."),
+    ("Recording the board", BoardSettings, True, "`rig board record`'s options (the board's own limits are checked when it connects)."),
+    ("Synchronising with the board", SyncOptions, True, "`rig board sync`'s options; a series longer than a day is refused with its estimate."),
+    ("The board's blink code", BlinkOptions, True, "`rig board blink`'s and `rig board record --blink`'s options."),
 )
 
 

@@ -46,7 +46,8 @@ from analysis import AnalysisOptions
 from analysis.sampling.model import commensurate
 from analysis.video.sources import open_frames
 from rig.bench.contract import Bench, Context, Log, SpecFile, cell
-from rig.service.sweep import Sweep, SweepPoint, read_sweep, run_sweep, simulate_and_analyse
+from rig.service.batch import USER_ERRORS
+from rig.service.sweep import Sweep, SweepPoint, read_sweep, run_sweep, simulate_and_analyse, unsimulated_row
 from rig.sim.config import SimulationConfig
 
 SPECS = Path(__file__).parent / "specs"
@@ -110,18 +111,25 @@ def measure_point(point: SweepPoint, log: Log) -> dict[str, Any]:
     """A sweep job: the point's sweep row (simulated and analysed as `rig sweep` does), with the
     bench's record of the case under "bench": the film decoded and analysed with every method."""
     started = time.perf_counter()
-    run = simulate_and_analyse(point)
+    try:
+        run = simulate_and_analyse(point)
+    except USER_ERRORS as error:
+        row = unsimulated_row(point, error)
+        log(f"{_case_name(point)}: REFUSED before filming: {error}")
+        return row | {"bench": _case_fields(point, None, 0) | {"refused": row["error"], "ambiguous": False, "methods": {},
+                                                                "warnings": [], "decode_s": 0.0}}  # fmt: skip
     return run.row | {"bench": _case_record(point, run.options, run.row, log, started)}
 
 
-def _case_record(point: SweepPoint, options: AnalysisOptions, row: dict[str, Any], log: Log, started: float) -> dict[str, Any]:
-    """The case's record: the film decoded, and analysed with every method and the `options` the
-    sweep's analysis was given."""
-    config, video, truth_ms = point.config, point.analysis.video, float(row["truth_ms"])
-    name = point.labels.get("case", point.out_dir.name)
-    first_decode, frames = decode_seconds(video)
-    record: dict[str, Any] = {
-        "case": name,
+def _case_name(point: SweepPoint) -> str:
+    return point.labels.get("case", point.out_dir.name)
+
+
+def _case_fields(point: SweepPoint, truth_ms: float | None, frames: int) -> dict[str, Any]:
+    """What the case is: its settings and labels, its true latency and the frames filmed."""
+    config = point.config
+    return {
+        "case": _case_name(point),
         "group": point.labels.get("group", "mixed"),
         "period_s": config.pendulum.period_s,
         "camera_fps": config.camera.film_fps,
@@ -136,6 +144,15 @@ def _case_record(point: SweepPoint, options: AnalysisOptions, row: dict[str, Any
         "truth_ms": truth_ms,
         "frames": frames,
     }
+
+
+def _case_record(point: SweepPoint, options: AnalysisOptions, row: dict[str, Any], log: Log, started: float) -> dict[str, Any]:
+    """The case's record: the film decoded, and analysed with every method and the `options` the
+    sweep's analysis was given."""
+    config, video, truth_ms = point.config, point.analysis.video, float(row["truth_ms"])
+    name = _case_name(point)
+    first_decode, frames = decode_seconds(video)
+    record = _case_fields(point, truth_ms, frames)
     refused = row["error"] if row["status"] == "failed" else None
     if refused is None:
         try:

@@ -234,6 +234,13 @@ def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
     return {"rows": found, "seconds": time.perf_counter() - started}
 
 
+def every_film_refused(found: list[dict[str, Any]]) -> str | None:
+    """Where the estimate refused every film: how many, and the first refusal."""
+    if not found or any(row["refused"] is None for row in found):
+        return None
+    return f"the estimate refused every one of the {len(found)} films (the first: {found[0]['refused']})"
+
+
 def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quick", action="store_true", help="four small films (a smoke test)")
 
@@ -242,7 +249,7 @@ BENCH = Bench(
     name="camera-calibration",
     help="rig calibrate-camera's readout and exposure error on simulated films, 30 to 240 fps",
     run=run, table=table, plot=plot, options=_options,
-    targets=lambda report: targets_met(report["rows"]),
+    targets=lambda report: targets_met(report["rows"]), all_failed=lambda report: every_film_refused(report["rows"]),
     notes=lambda report: f"{len(report['rows'])} films in {report['seconds'] / 60:.1f} minutes",
     record=lambda report: {"summary": summary(report["rows"]), "targets_met": targets_met(report["rows"]), **report},
     outputs={"json": "write the summaries and every film's row as JSON", "plot": "plot seconds per film against each error"},

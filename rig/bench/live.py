@@ -144,7 +144,7 @@ def plot(report: dict[str, Any], path: Path) -> None:
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--duration", type=options.positive_float, default=10.0, help="seconds of live run (default: %(default)s)")
+    parser.add_argument("--duration", type=options.run_seconds, default=10.0, help="seconds of live run (default: %(default)s)")
 
 
 BENCH = Bench(

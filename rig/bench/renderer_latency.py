@@ -21,7 +21,10 @@ from pathlib import Path
 from typing import Any, Callable
 
 from rig.service.analyse import AnalysisRequest
-from rig.service.sweep import SIMULATED_ROIS, PointRun, Sweep, SweepPoint, run_sweep, settings_of, simulate_and_analyse, write_sweep
+from rig.service.batch import USER_ERRORS
+from rig.service.sweep import (
+    SIMULATED_ROIS, PointRun, Sweep, SweepPoint, run_sweep, settings_of, simulate_and_analyse, unsimulated_row, write_sweep,
+)
 from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
 from rig.sim.display import DisplayConfig
@@ -171,7 +174,10 @@ def film_figures(filmed: PointRun) -> dict[str, Any]:
 def film_row(point: SweepPoint) -> dict[str, Any]:
     """A sweep job: the point's summary row (simulated, then analysed within the simulation's
     regions, as a lab marks them once for its camera), with its film's figures under "film"."""
-    filmed = simulate_and_analyse(point)
+    try:
+        filmed = simulate_and_analyse(point)
+    except USER_ERRORS as error:
+        return unsimulated_row(point, error) | {"film": {**_no_figures(point.config), "latency_note": f"not simulated: {error}"}}
     return filmed.row | {"film": film_figures(filmed)}
 
 

@@ -53,16 +53,19 @@ from declared import Range, check, like, setting
 from predictors import Pose
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, SpecFile, cell, given
+from rig.bench.renderer_estimate import estimated_hours
 from rig.bench.renderer_latency import LatencyRun, film_latencies
 from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup
 from rig.bench.spec_reader import read_spec
 from rig.commands import options
+from rig.commands.declared_options import declared_type
 from rig.errors import ConfigError
 from rig.render.direct import DirectRenderer
 from rig.render.gl import LOAD_SHAPES
 from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, RenderSetup
 from rig.sim.camera import CameraConfig
+from rig.sim.config import MAX_HOURS
 from rig.sim.display import DisplayConfig
 
 QUICK_SPEC = Path(__file__).parent / "specs" / "renderers-quick.toml"
@@ -135,6 +138,9 @@ class BenchGrid:
             raise ConfigError("a renderer bench grid needs at least one load size, resolution and rate ratio")
         if min(min(size) for size in self.resolutions) < 16:
             raise ConfigError(f"a display is at least 16x16 pixels, got {self.resolutions}")
+        if (hours := estimated_hours(self)) > MAX_HOURS:
+            raise ConfigError(f"this grid would take about {hours:.3g} hours at the least, more than the {MAX_HOURS:g} hours the rig "
+                              "starts: fewer or smaller loads, resolutions, phases or warp rounds, or split it into grids of its own")  # fmt: skip
 
     def latency_run(
         self, renderer: str, triangles: int, predictor: str, photon_target: str = "photons", load: str = "soup"
@@ -366,7 +372,7 @@ def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants, --seed-table: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
     parser.add_argument("--predictor", help="the predictor of every latency run, both renderers alike (default: the spec's, hold, as in Smit et al. 2010, Table 2)")
     parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")
-    parser.add_argument("--server-ms", type=options.positive_float, metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
+    parser.add_argument("--server-ms", type=declared_type(BenchGrid, "server_ms"), metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
 
 
 BENCH = Bench(

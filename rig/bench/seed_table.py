@@ -31,12 +31,13 @@ from typing import Any
 
 import numpy as np
 
+from declared import Range, setting
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
 from rig.bench.renderer_latency import film_latency
 from rig.bench.renderer_setup import machine_name, open_warp, pose_of, scene_setup
 from rig.bench.renderers import BenchGrid, plain, time_direct, with_options
-from rig.commands import options
+from rig.commands.declared_options import declared_type
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest
 from rig.sim.camera import CameraConfig
 
@@ -62,8 +63,12 @@ class SeedTableSpec:
     refresh), predictor, warp spec and server cost the table takes."""
 
     first: int = 4_000
-    max_triangles: int = 20_000_000
-    max_frame_s: float = 60.0
+    max_triangles: int = setting(
+        20_000_000, "triangles", "the largest load (720 MB and the GL driver's copy)", Range(1.0, 1e8, True, True),
+    )  # fmt: skip
+    max_frame_s: float = setting(
+        60.0, "seconds", "the largest direct frame a scene may take, at most ten minutes", Range(0.0, 600.0, includes_high=True),
+    )  # fmt: skip
     load: str = "soup"
     """what the load's triangles make (`rig.render.gl.LOAD_SHAPES`): the soup is the stress case,
     meshes a few tessellated solid objects, as the seed's scenes were"""
@@ -223,9 +228,9 @@ def _plot(rows: list[dict[str, Any]], path: Path) -> None:
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--max-frame-s", type=options.positive_float, default=SeedTableSpec().max_frame_s,
-                        help="--seed-table: the largest direct frame, in seconds, a scene may take (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--max-triangles", type=options.positive_int, metavar="N",
+    parser.add_argument("--max-frame-s", type=declared_type(SeedTableSpec, "max_frame_s"), metavar="S",
+                        help="--seed-table: the largest direct frame, in seconds, a scene may take (default: 60)")  # fmt: skip
+    parser.add_argument("--max-triangles", type=declared_type(SeedTableSpec, "max_triangles"), metavar="N",
                         help="--seed-table: the largest load (default: 20000000, 720 MB and the GL driver's copy)")  # fmt: skip
 
 

@@ -48,7 +48,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from declared import Range, setting
+from declared import Flag, Range, like, setting
 from rig.bench.contract import Bench, Context, Log
 from rig.clock import MonotonicClock
 from rig.commands.declared_options import add_declared_options
@@ -57,6 +57,7 @@ from rig.devices.trackers.profile import load_profile
 from rig.devices.trackers.stream import TrackerRecord
 from rig.errors import RigError
 from rig.service.tracker_recording import record_tracker
+from rig.sim.tracker import TrackerConfig
 
 TARGET_US_PER_SAMPLE = 50.0
 TARGET_LATENCY_MEDIAN_MS = 1.0
@@ -64,6 +65,7 @@ TARGET_LATENCY_P95_MS = 2.0
 # Recording runs this much longer than the emulator sends, for it to find its reader and finish.
 RECORD_MARGIN_S = 3.0
 START_TIMEOUT_S = 30.0
+"""How long the emulator may take to start, and to finish after the recording (beyond its duration)."""
 WAKE_FLOOR_S = 2.0
 
 
@@ -99,9 +101,10 @@ def _emulator_command(case: Case, address: str, rate_hz: float, duration_s: floa
 
 
 @contextmanager
-def _emulator(command: list[str], folder: Path) -> Iterator[tuple[subprocess.Popen, str]]:
+def _emulator(command: list[str], folder: Path, duration_s: float) -> Iterator[tuple[subprocess.Popen, str]]:
     """The emulator, started, and the tracker spec it printed once ready; on the way out it is
-    waited for (killed if the block failed or it does not end) and its pipe closed."""
+    waited for (killed if the block failed or it does not end within its `duration_s` and
+    START_TIMEOUT_S: RigError) and its pipe closed."""
     with open(folder / "emulator.err", "w") as errors:
         process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=errors, text=True)
     try:
@@ -109,7 +112,11 @@ def _emulator(command: list[str], folder: Path) -> Iterator[tuple[subprocess.Pop
         if "--tracker " not in line:
             raise RigError(f"the tracker emulator did not start: {(folder / 'emulator.err').read_text()[-500:]}")
         yield process, line.rsplit("--tracker ", 1)[1].strip()
-        process.wait(timeout=START_TIMEOUT_S)
+        try:
+            process.wait(timeout=duration_s + START_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            raise RigError(f"the tracker emulator did not finish {duration_s + START_TIMEOUT_S:g} s after it started sending "
+                           "(a machine this loaded cannot run the case)") from None  # fmt: skip
     finally:
         if process.poll() is None:
             process.kill()
@@ -143,7 +150,7 @@ def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: L
         origin = clock.origin_ns / 1e9
         arrivals.extend((record.device_time, origin + record.t_arrival) for record in records)
 
-    with _emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder) as (_, spec):
+    with _emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder, duration_s) as (_, spec):
         cpu = resource.getrusage(resource.RUSAGE_SELF)
         recording = record_tracker(spec, duration_s + RECORD_MARGIN_S, folder / "recording", overwrite=True,
                                    on_batch=on_batch, clock=clock)  # fmt: skip
@@ -155,6 +162,7 @@ def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: L
     counters = recording.sidecar["counters"]
     tracker_latency = recording.sidecar.get("latency") or {}
     row = {
+        "failed": None,
         "source": case.source,
         "transport": case.transport,
         "profile": case.profile or "pose (7 channels)",
@@ -191,7 +199,7 @@ def wake_floor(rate_hz: float, duration_s: float, folder: Path) -> float:
     case = Case("serial", "pty", "binary-pose", "none")
     link = folder / "tracker"
     received = 0
-    with _emulator(_emulator_command(case, str(link), rate_hz, duration_s, folder / "sent.csv"), folder) as (process, _):
+    with _emulator(_emulator_command(case, str(link), rate_hz, duration_s, folder / "sent.csv"), folder, duration_s) as (process, _):
         started = time.thread_time()
         fd = os.open(link, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY)
         try:
@@ -213,11 +221,26 @@ def wake_floor(rate_hz: float, duration_s: float, folder: Path) -> float:
     return cpu_s / max(records, 1.0) * 1e6
 
 
-def targets(rows: list[dict[str, Any]]) -> dict[str, bool]:
-    """The issue's targets, met or not, in this run."""
+def failed_case(case: Case, rate_hz: float, duration_s: float, error: Exception) -> dict[str, Any]:
+    """The row of a case that could not run: what it was, and why."""
+    return {"failed": str(error), "source": case.source, "transport": case.transport, "profile": case.profile or "pose (7 channels)",
+            "faults": case.faults, "rate_hz": rate_hz, "duration_s": duration_s}  # fmt: skip
+
+
+def every_case_failed(rows: list[dict[str, Any]]) -> str | None:
+    """Where no case recorded a sample: how many, and the first one's reason."""
+    if not rows or any(row["failed"] is None and row["recorded"] > 0 for row in rows):
+        return None
+    first = rows[0]["failed"] or "nothing recorded"
+    return f"every one of the {len(rows)} cases failed or recorded nothing (the first: {first})"
+
+
+def targets(rows: list[dict[str, Any]]) -> dict[str, bool | None]:
+    """The bench's targets, met or not, in this run (None for each where no case ran)."""
+    rows = [r for r in rows if r["failed"] is None]
     clean = [r for r in rows if r["faults"] == "none"]
     faulty = [r for r in rows if r["faults"] != "none"]
-    return {
+    met = {
         "clean runs: every sample sent recorded, in order": all(r["recorded"] == r["sent"] and r["missing"] == 0 and r["in_order"] for r in clean),
         "faults: every intact record recovered, nothing fabricated": all(r["missing"] == 0 and r["fabricated"] == 0 for r in faulty),
         "faults: every damaged record counted": all(r["corrupt"] >= r["damaged_sent"] for r in faulty),
@@ -228,6 +251,7 @@ def targets(rows: list[dict[str, Any]]) -> dict[str, bool]:
             and r["latency_ms_p95"] <= TARGET_LATENCY_P95_MS for r in rows
         ),
     }  # fmt: skip
+    return met if rows else dict.fromkeys(met)
 
 
 def cpu_ticks() -> tuple[int, int] | None:
@@ -259,7 +283,11 @@ def run(args: argparse.Namespace, context: Context) -> list[dict[str, Any]]:
         load = os.getloadavg()[0]
         floor = wake_floor(args.rate, WAKE_FLOOR_S, context.folder / f"floor{index}")
         before = cpu_ticks()
-        row = run_case(case, args.rate, args.duration, context.folder / f"case{index}", context.log)
+        try:
+            row = run_case(case, args.rate, args.duration, context.folder / f"case{index}", context.log)
+        except RigError as error:
+            context.log(f"{case.source}/{case.transport}/{case.profile or 'pose'} faults {case.faults}: FAILED: {error}")
+            row = failed_case(case, args.rate, args.duration, error)
         rows.append({**row, "load_average_1min": load, "wake_floor_us": floor, "stolen_cpu_pct": stolen_pct(before, cpu_ticks())})
     return rows
 
@@ -279,6 +307,9 @@ def table(rows: list[dict[str, Any]]) -> str:
     )
     lines = [head, "|" + " --- |" * (head.count("|") - 1)]
     for r in rows:
+        if r["failed"] is not None:
+            lines.append(f"| {r['source']} | {r['transport']} | {r['profile']} | {r['faults']} | failed: {r['failed']} |")
+            continue
         latency = f"{r['latency_ms_median']:.3f}, {r['latency_ms_p95']:.3f}" if r["latency_ms_median"] is not None else "n/a"
         stolen = f"{r['stolen_cpu_pct']:.1f}" if r.get("stolen_cpu_pct") is not None else "n/a"
         lines.append(
@@ -293,6 +324,7 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
     """CPU per sample and added latency (median and 95th percentile) per case."""
     from matplotlib.figure import Figure
 
+    rows = [r for r in rows if r["failed"] is None]
     labels = ["\n".join([f"{r['source']}/{r['transport']}", *r["faults"].split(",")]) for r in rows]
     x = np.arange(len(rows))
     figure = Figure(figsize=(max(6.0, 1.6 * len(rows)) + 2.5, 7.0))
@@ -319,10 +351,7 @@ class TrackerBenchOptions:
     """The tracker bench's options, each declared on its field; each case runs in real time, so its
     duration is the bench's time."""
 
-    rate_hz: float = setting(
-        1000.0, "Hz", "records a second: trackers send up to a few kHz, 10 kHz stresses the reader beyond any",
-        Range(1.0, 10000.0, True, True), flag="--rate",
-    )  # fmt: skip
+    rate_hz: float = like(TrackerConfig, "rate_hz", default=1000.0, flag=Flag("--rate", help="records a second the emulators send"))
     duration_s: float = setting(10.0, "seconds", "seconds per case, run in real time (at most ten minutes)",
                                 Range(0.5, 600.0, True, True), flag="--duration")  # fmt: skip
 
@@ -335,7 +364,7 @@ def _options(parser: argparse.ArgumentParser) -> None:
 BENCH = Bench(
     name="trackers",
     help="the serial and LSL tracker sources fed by the emulators: loss, fabrication, CPU per sample, added latency",
-    run=run, table=table, targets=targets, notes=machine_noise, plot=plot, options=_options,
+    run=run, table=table, targets=targets, notes=machine_noise, plot=plot, options=_options, all_failed=every_case_failed,
     outputs={"json": "write the rows as a JSON list", "plot": "plot CPU per sample and latency per case"},
     runs="keep the recordings and emulator logs here (default: a temporary folder)",
 )

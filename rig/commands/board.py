@@ -19,20 +19,23 @@ import json
 import os
 import threading
 import time
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
 from analysis.board.blink_code import BlinkSchedule
 from analysis.board.photodiode_latency import estimate_from_recording, plot_board_latency
 from rig.board.clock_sync import OffsetInterval
-from rig.board.instrument import DEFAULT_FALL, DEFAULT_RISE, BoardInstrument, BoardSettings
+from declared import Range, setting
+from rig.board.instrument import BoardInstrument, BoardSettings
 from rig.board.microcontroller import Microcontroller
 from rig.board.recorder import BoardRecorder
 from rig.clock import MonotonicClock
 from rig.commands import outputs
-from rig.commands.options import non_negative_float, non_negative_int, positive_float
-from rig.errors import RigError
+from rig.commands.declared_options import add_declared_options, config_from_args
+from rig.commands.options import positive_float, run_seconds
+from rig.errors import ConfigError, RigError
+from rig.sim.config import MAX_HOURS
 from rig.progress import ProgressBar
 
 PORT_VARIABLE = "RIG_BOARD_PORT"
@@ -57,21 +60,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
     sync = commands.add_parser("sync", help="measure the host-board clock offset, and its drift when repeated")
     _add_port(sync)
-    sync.add_argument("--round-trips", type=non_negative_int, default=48, help="round trips per measurement (default 48)")
-    sync.add_argument("--repeat", type=non_negative_int, default=1, help="measurements to make (default 1)")
-    sync.add_argument("--every", type=positive_float, default=2.0, help="seconds between measurements (default 2)")
+    add_declared_options(sync, SyncOptions)
     sync.add_argument("--json", action="store_true", help="print one JSON object")
     sync.set_defaults(func=run_sync)
 
     record = commands.add_parser("record", help="record encoder, photodiode and LED events as CSV files")
     _add_port(record)
     record.add_argument("--out", type=outputs.output_folder, required=True, help="folder for the CSV files (must not hold a recording)")
-    record.add_argument("--duration", type=positive_float, required=True, help="seconds to record")
-    record.add_argument("--encoder-rate", type=non_negative_float, default=0.0, help="encoder reports per second; 0 (default) reports every edge")
-    record.add_argument("--rise", type=non_negative_int, default=DEFAULT_RISE, help=f"photodiode rising threshold, ADC counts (default {DEFAULT_RISE})")
-    record.add_argument("--fall", type=non_negative_int, default=DEFAULT_FALL, help=f"photodiode falling threshold, below --rise (default {DEFAULT_FALL})")
-    record.add_argument("--raw-every", type=non_negative_int, default=0, help="also record every n-th raw ADC sample (0, the default: none)")
-    record.add_argument("--resync-every", type=positive_float, default=5.0, help="seconds between clock syncs while recording (default 5)")
+    record.add_argument("--duration", type=run_seconds, required=True, help="seconds to record")
+    add_declared_options(record, BoardSettings)
     record.add_argument(
         "--blink",
         action="store_true",
@@ -96,11 +93,27 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     latency.set_defaults(func=run_latency)
 
 
+@dataclass(frozen=True)
+class SyncOptions:
+    """`rig board sync`'s numbers, each declared with its option."""
+
+    round_trips: int = setting(48, "", "round trips per measurement", Range(4.0, 10000.0, True, True), flag="--round-trips")
+    repeat: int = setting(1, "", "measurements to make", Range(1.0, 100000.0, True, True), flag="--repeat")
+    every: float = setting(2.0, "seconds", "seconds between measurements, at most an hour", Range(0.0, 3600.0, includes_high=True), flag="--every")
+
+
+@dataclass(frozen=True)
+class BlinkOptions:
+    """The blink code's numbers (`rig board blink`, `rig board record --blink`), each declared with its option."""
+
+    bits: int = setting(64, "bits", "bits of blink code", Range(1.0, 4096.0, True, True), flag="--bits")
+    bit_ms: float = setting(50.0, "ms", "duration of one bit", Range(1.0, 10000.0, True, True), flag="--bit-ms")
+    seed: int = setting(0xACE1, "", "code seed", Range(1.0, 65535.0, True, True), flag="--seed")
+    level: int = setting(255, "", "LED level of a 1 bit (and after a recording's blink)", Range(1.0, 255.0, True, True), flag="--level")
+
+
 def _add_blink_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--bits", type=non_negative_int, default=64, help="bits of blink code (default 64)")
-    parser.add_argument("--bit-ms", type=positive_float, default=50.0, help="duration of one bit, ms (default 50)")
-    parser.add_argument("--seed", type=non_negative_int, default=0xACE1, help="code seed, 1..65535 (default 44257)")
-    parser.add_argument("--level", type=non_negative_int, default=255, help="LED level of a 1 bit (and after a recording's blink), 1..255 (default 255)")
+    add_declared_options(parser, BlinkOptions)
 
 
 def _add_port(parser: argparse.ArgumentParser) -> None:
@@ -152,8 +165,10 @@ def run_info(args: argparse.Namespace) -> int:
 
 
 def run_sync(args: argparse.Namespace) -> int:
-    if args.round_trips < 4 or args.repeat < 1:
-        raise RigError("--round-trips must be at least 4 and --repeat at least 1")
+    hours = (args.repeat - 1) * args.every / 3600.0
+    if hours > MAX_HOURS:
+        raise ConfigError(f"--repeat {args.repeat} --every {args.every:g} would take about {hours:.3g} hours, more than the "
+                          f"{MAX_HOURS:g} hours the rig starts: repeat less often or fewer times")  # fmt: skip
     with _board(args, sync_round_trips=args.round_trips) as board:
         for _ in range(args.repeat - 1):
             _wait(board, args.every)
@@ -174,7 +189,7 @@ def run_sync(args: argparse.Namespace) -> int:
 def run_record(args: argparse.Namespace) -> int:
     if args.blink and _blink_seconds(args) > args.duration:
         raise RigError(f"--duration {args.duration:g} s is shorter than the blink ({_blink_seconds(args):.2f} s): record for longer")
-    settings = BoardSettings(args.encoder_rate, args.rise, args.fall, args.raw_every, args.resync_every)
+    settings = config_from_args(BoardSettings, args, ConfigError)
     instrument = BoardInstrument(_port(args), args.out, settings, options={"requested_s": args.duration, "blink": args.blink})
     clock = MonotonicClock()
     try:

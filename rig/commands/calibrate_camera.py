@@ -16,12 +16,13 @@ from analysis import AnalysisError
 from analysis.shutter import ShutterOptions, ShutterResult
 from analysis.shutter.options import DISPLAY_GROUP
 from rig.cli import EXIT_WARNINGS
-from rig.commands import options, outputs
-from rig.commands.declared_options import add_declared_options, config_from_args
+from rig.commands import outputs
+from rig.commands.declared_options import add_declared_options, config_from_args, declared_type
 from rig.progress import ProgressBar
 from rig.service import CalibrationRequest, calibrate_camera
 from rig.service.bench_profile import read_profile, shutter_display, write_profile
 from rig.service.calibrate import bench_changes
+from rig.sim.flash import FlashTarget
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -86,7 +87,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "(the message says what to change).",
     )
     parser.add_argument("film", type=Path, metavar="FILM", help="video file (mp4, avi, mov, mkv) or folder of numbered images")
-    parser.add_argument("--flash-hz", type=options.positive_float, required=True, metavar="F", help="the light's flash frequency (Hz)")
+    parser.add_argument("--flash-hz", type=declared_type(FlashTarget, "hz"), required=True, metavar="F", help="the light's flash frequency (Hz)")
     add_declared_options(parser, ShutterOptions, {"display": DISPLAY_GROUP})
     parser.add_argument(
         "--bench",

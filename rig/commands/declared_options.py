@@ -9,7 +9,7 @@ import argparse
 import typing
 from typing import Any, Callable, TypeVar
 
-from declared import Entry, from_table, walk
+from declared import Entry, Flag, from_table, walk
 from declared.settings import whole_numbers
 
 Config = TypeVar("Config")
@@ -37,6 +37,13 @@ def add_declared_option(parser: argparse.ArgumentParser, kind: type, path: str, 
     if required:
         argument |= {"required": True, "default": None, "help": argument["help"].rpartition(" (")[0] + f" ({entry.setting.unit})"}
     parser.add_argument(entry.setting.flag.name, dest=_dest(entry), **argument)
+
+
+def declared_type(kind: type, path: str) -> Callable[[str], Any]:
+    """The type of an option for the setting `path` (dotted) of `kind`, as `add_declared_options`
+    makes it: for an option a command adds itself (one of alternatives, or whose absence means
+    something of its own), read and checked against the setting's range."""
+    return _parser(next(entry for entry in walk(kind) if entry.path == path))
 
 
 def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception], **given: Any) -> Config:
@@ -100,8 +107,8 @@ def _converted(value: Any, factor: float) -> Any:
 
 def _parser(entry: Entry) -> Callable[[str], Any]:
     """Text to the option's value (a list is comma-separated), checked against the setting's range
-    in the option's unit."""
-    setting, flag = entry.setting, entry.setting.flag
+    in the option's unit (the setting's own where it declares no option)."""
+    setting, flag = entry.setting, entry.setting.flag or Flag("")
     kinds = typing.get_args(entry.hint) if typing.get_origin(entry.hint) is tuple else (entry.hint,)
     listed = len(kinds) > 1
     allowed = flag.range or (setting.range.scaled(flag.factor) if setting.range is not None else None)

@@ -5,9 +5,21 @@ from __future__ import annotations
 
 import argparse
 import json
+from dataclasses import dataclass
 
-from rig.commands import options
+from declared import Flag, Range, setting
+from rig.commands.declared_options import add_declared_options
 from rig.devices.trackers.discovery import hid_devices, lsl_streams, serial_ports
+
+
+@dataclass(frozen=True)
+class Listing:
+    """How long `rig devices` listens, declared with its option."""
+
+    lsl_wait_s: float = setting(
+        1.0, "seconds", "seconds to listen for LSL streams, at most ten minutes", Range(0.0, 600.0, True, True),
+        flag=Flag("--lsl-wait", metavar="S"),
+    )  # fmt: skip
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -31,7 +43,6 @@ def _run(args: argparse.Namespace) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `devices`."""
     parser = subparsers.add_parser("devices", help="list the serial ports, HID devices and LSL streams this machine sees", description=__doc__)
-    parser.add_argument("--lsl-wait", type=options.non_negative_float, default=1.0, metavar="S",
-                        help="seconds to listen for LSL streams (default: %(default)s)")  # fmt: skip
+    add_declared_options(parser, Listing)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=_run)

@@ -15,14 +15,40 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
+from declared import Flag, Range, like, setting
 from rig.commands import options, outputs
+from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.emulate import EmulatorConfig, make_sink, run_emulator
 from rig.errors import ConfigError
 from rig.sim.tracker import TrackerConfig
 from rig.sim.tracker_faults import FaultPlan, parse_faults
+
+
+SERIAL = "serial"
+"""The group of the options only the serial emulator takes."""
+
+
+@dataclass(frozen=True)
+class EmulatorOptions:
+    """The emulator's numbers, each declared with its option: the tracker's as the simulated
+    tracker's are (`rig.sim.tracker.TrackerConfig`, exact and sent at once unless given), how long it
+    sends, its seed, and a serial device clock's rate error."""
+
+    rate_hz: float = like(TrackerConfig, "rate_hz", default=1000.0, flag=Flag("--rate", help="records a second"))
+    duration_s: float = setting(10.0, "seconds", "seconds to send, at most a day", Range(0.0, 86400.0, includes_high=True), flag="--duration")
+    position_noise_m: float = like(TrackerConfig, "position_noise_m", default=0.0, flag=Flag("--noise-mm", unit="mm", factor=1e3))
+    orientation_noise_deg: float = like(TrackerConfig, "orientation_noise_deg", default=0.0, flag=Flag("--noise-deg"))
+    transport_delay_s: float = like(TrackerConfig, "transport_delay_s", default=0.0, flag=Flag("--delay-ms", unit="ms", factor=1e3))
+    jitter_s: float = like(TrackerConfig, "jitter_s", default=0.0, flag=Flag("--jitter-ms", unit="ms", factor=1e3))
+    dropout: float = like(TrackerConfig, "dropout", default=0.0, flag=Flag("--dropout"))
+    seed: int = setting(0, "", "seed of the noise, jitter, dropouts and faults", Range(0.0, 1e9, True, True), flag="--seed")
+    drift_ppm: float = setting(
+        0.0, "ppm", "the device clock's rate error: a crystal's is tens of ppm", Range(-1000.0, 1000.0, True, True),
+        flag=Flag("--drift-ppm", group=SERIAL),
+    )  # fmt: skip
 
 
 def _faults(text: str) -> FaultPlan:
@@ -37,23 +63,24 @@ def _run(args: argparse.Namespace) -> int:
         transport, address = "lsl", args.name
     else:
         transport, address = ("pty", str(args.pty)) if args.pty is not None else ("tcp", str(args.tcp))
+    numbers = config_from_args(EmulatorOptions, args, ConfigError)
     config = EmulatorConfig(
         transport=transport,
         address=address,
         tracker=TrackerConfig(
-            rate_hz=args.rate,
-            position_noise_m=args.noise_mm / 1e3,
-            orientation_noise_deg=args.noise_deg,
-            transport_delay_s=args.delay_ms / 1e3,
-            jitter_s=args.jitter_ms / 1e3,
-            dropout=args.dropout,
+            rate_hz=numbers.rate_hz,
+            position_noise_m=numbers.position_noise_m,
+            orientation_noise_deg=numbers.orientation_noise_deg,
+            transport_delay_s=numbers.transport_delay_s,
+            jitter_s=numbers.jitter_s,
+            dropout=numbers.dropout,
         ),
-        duration_s=args.duration,
+        duration_s=numbers.duration_s,
         profile=getattr(args, "profile", "binary-pose"),
         trace=args.trace,
         faults=args.faults,
-        seed=args.seed,
-        drift_ppm=getattr(args, "drift_ppm", 0.0),
+        seed=numbers.seed,
+        drift_ppm=numbers.drift_ppm,
         log=args.log,
     )
     sink = make_sink(config)
@@ -74,19 +101,12 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _common(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--rate", type=options.positive_float, default=1000.0, help="records a second (default: %(default)s)")
-    parser.add_argument("--duration", type=options.positive_float, default=10.0, help="seconds to send (default: %(default)s)")
+def _common(parser: argparse.ArgumentParser, serial: bool) -> None:
+    add_declared_options(parser, EmulatorOptions, {SERIAL: ""} if serial else {})
     parser.add_argument("--trace", type=Path, metavar="FILE", help="play this recorded trace in a loop (default: the simulated pendulum)")
-    parser.add_argument("--noise-mm", type=options.non_negative_float, default=0.0, help="position noise, std-dev per axis (default: 0)")
-    parser.add_argument("--noise-deg", type=options.non_negative_float, default=0.0, help="orientation noise, std-dev per axis (default: 0)")
-    parser.add_argument("--delay-ms", type=options.non_negative_float, default=0.0, help="transport delay before each write (default: 0)")
-    parser.add_argument("--jitter-ms", type=options.non_negative_float, default=0.0, help="mean of the exponential jitter added to it (default: 0)")
-    parser.add_argument("--dropout", type=float, default=0.0, help="probability that a record is lost, never sent (default: 0)")
     parser.add_argument("--faults", type=_faults, default=parse_faults("none"), metavar="SPEC",
                         help="faults such as corrupt=0.01,drop=0.001,garbage=2,burst=8,stall=3:0.5,disconnect=5:0.5 "
                         "(default: none)")  # fmt: skip
-    parser.add_argument("--seed", type=int, default=0, help="seed of the noise, jitter, dropouts and faults (default: %(default)s)")
     parser.add_argument("--log", type=outputs.csv_file, metavar="FILE.csv", help="write every record's seq, device time, write time and fate")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     parser.set_defaults(func=_run)
@@ -105,8 +125,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     where.add_argument("--pty", type=Path, metavar="LINK", help="make a pseudo-terminal reachable at this path (a symlink)")
     where.add_argument("--tcp", type=options.non_negative_int, metavar="PORT", help="serve on 127.0.0.1:PORT (0: any free port)")
     serial.add_argument("--profile", default="binary-pose", help="record format: a shipped profile or a .toml file (default: %(default)s)")
-    serial.add_argument("--drift-ppm", type=float, default=0.0, help="the device clock's rate error in ppm (default: 0)")
-    _common(serial)
+    _common(serial, serial=True)
     lsl = transports.add_parser("lsl", help="a 7-channel LSL pose stream")
     lsl.add_argument("--name", required=True, help="the stream's name")
-    _common(lsl)
+    _common(lsl, serial=False)

@@ -147,7 +147,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         help="the pose predictor (listed below), with parameters or a `rig tune` file (default: default)")  # fmt: skip
     parser.add_argument("--display", default="window", metavar="SPEC",
                         help="the window: window[:MONITOR][?fullscreen=1&size=WxH&pos=X,Y&scanout=F] (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--duration", type=options.positive_float, metavar="S", help="seconds to run (default: 60; self-test 20)")
+    parser.add_argument("--duration", type=options.run_seconds, metavar="S", help="seconds to run (default: 60; self-test 20)")
     parser.add_argument("--until-still", action="store_true", help="end sooner once the pendulum has stopped swinging")
     parser.add_argument("--photon-target", choices=("photons", "scanout"), default="photons",
                         help="what each frame's pose is predicted for (default: %(default)s)")  # fmt: skip

@@ -48,6 +48,28 @@ def positive_int(text: str) -> int:
     return value
 
 
+MAX_WORKERS = 256
+"""The most local Dask processes: more than the cores of any one machine a lab runs the rig on."""
+
+
+def workers(text: str) -> int:
+    """A local cluster's processes: 1 to MAX_WORKERS."""
+    value = positive_int(text)
+    if value > MAX_WORKERS:
+        raise argparse.ArgumentTypeError(f"must be 1 to {MAX_WORKERS} processes, got {text}")
+    return value
+
+
+def run_seconds(text: str) -> float:
+    """How long a live run or a recording lasts, as a live run's duration is declared
+    (`rig.live.run.LiveConfig`: at most a day); loaded when an option is read, not when the command
+    line is built."""
+    from rig.commands.declared_options import declared_type
+    from rig.live.run import LiveConfig
+
+    return declared_type(LiveConfig, "duration_s")(text)
+
+
 def roi(text: str) -> tuple[int, int, int, int]:
     """X,Y,W,H in pixels."""
     parts = text.split(",")
@@ -98,7 +120,7 @@ def predictor_spec(text: str) -> tuple[str, dict[str, Any]]:
 
 def add_executor_options(parser: argparse.ArgumentParser, what: str) -> None:
     """--workers and --scheduler: where `what` runs (`rig.executor`; neither: here, serially)."""
-    parser.add_argument("--workers", type=positive_int, metavar="N", help=f"run {what} on a local Dask cluster of N processes")
+    parser.add_argument("--workers", type=workers, metavar="N", help=f"run {what} on a local Dask cluster of N processes (at most {MAX_WORKERS})")
     parser.add_argument("--scheduler", metavar="tcp://HOST:PORT", help=f"run {what} on an existing Dask cluster (its workers must reach the files)")
 
 

@@ -118,9 +118,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     add_declared_option(parser, PendulumConfig, "period_s")
     add_declared_option(parser, PendulumConfig, "amplitude_deg")
-    parser.add_argument(
-        "--accuracy-ms", type=options.positive_float, default=1.0, help="the 95%% half-width wanted, in ms (default: %(default)s)"
-    )
+    add_declared_option(parser, PlanRequest, "accuracy_ms")
     parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the simulated films here (default: a temporary folder)")
     parser.add_argument(
         "--bench",

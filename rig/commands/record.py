@@ -1,8 +1,10 @@
 """`rig record --camera SPEC --duration S --out DIR`: film with a camera, every frame to disk as it comes.
 
-Writes DIR/video.avi (Motion-JPEG, what `rig analyse` reads), DIR/camera_frames.csv (each frame's
-capture time on the host's monotonic clock, the backend's own timestamp, and the stand-ins written
-for dropped frames) and DIR/camera.json (the settings asked for and what the camera reports).
+Writes DIR/video.avi (Motion-JPEG, what `rig analyse` reads; for a camera faster than 1000 fps,
+which an AVI cannot hold, DIR/video.mp4 in H.264 with each frame's time, and DIR/frame_times.csv),
+DIR/camera_frames.csv (each frame's capture time on the host's monotonic clock, the backend's own
+timestamp, and the stand-ins written for dropped frames) and DIR/camera.json (the settings asked for
+and what the camera reports); a camera faster than 10000 fps is refused before anything is written.
 Ctrl-C or an unplugged camera stops cleanly and keeps every frame.
 """
 
@@ -63,7 +65,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[1].replace("\n", " "),
     )
     parser.add_argument("--camera", required=True, metavar="SPEC", help=f"the camera: {CAMERA_SPECS}")
-    parser.add_argument("--duration", type=options.positive_float, required=True, metavar="S", help="seconds to film")
+    parser.add_argument("--duration", type=options.run_seconds, required=True, metavar="S", help="seconds to film")
     parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder to write the video and frame table into")
     parser.add_argument("--preview", action="store_true", help="show the camera's frames with both regions of interest")
     parser.add_argument("--overwrite", action="store_true", help="replace a recording already in DIR")

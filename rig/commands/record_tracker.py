@@ -61,7 +61,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         epilog=choices.trackers_listing(),
     )
     parser.add_argument("--tracker", required=True, metavar="SPEC", help="the tracker (listed below)")
-    parser.add_argument("--duration", type=options.positive_float, metavar="S", help="seconds to record (default: until Ctrl-C)")
+    parser.add_argument("--duration", type=options.run_seconds, metavar="S", help="seconds to record (default: until Ctrl-C)")
     parser.add_argument("--out", type=outputs.output_folder, required=True, metavar="DIR", help="folder to write tracker.csv and its sidecar into")
     parser.add_argument("--overwrite", action="store_true", help="replace a recording already in DIR")
     parser.add_argument("--json", action="store_true", help="print the sidecar as one JSON object")

@@ -10,7 +10,7 @@ import argparse
 
 from rig.commands import options
 from rig.commands.choices import predictors_listing, renderers_listing
-from rig.commands.declared_options import add_declared_options, config_from_args
+from rig.commands.declared_options import add_declared_options, config_from_args, declared_type
 from rig.errors import ConfigError
 from rig.service import SimulationConfig
 from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
@@ -55,12 +55,12 @@ def add_flash_options(parser: argparse.ArgumentParser) -> None:
         "`rig calibrate-camera` (the pendulum, tracker and renderer still run, unseen).",
     )
     target = group.add_mutually_exclusive_group()
-    target.add_argument("--flash-hz", type=options.positive_float, metavar="F",
+    target.add_argument("--flash-hz", type=declared_type(FlashTarget, "hz"), metavar="F",
                         help="a white card lit by an LED flashing at F Hz fills the view")  # fmt: skip
-    target.add_argument("--flash-display", type=options.positive_int, metavar="N",
+    target.add_argument("--flash-display", type=declared_type(FlashTarget, "refreshes"), metavar="N",
                         help="the display flashes full-field: white for the first half of every N refreshes (N = 2 "
                         "alternates white and black), black for the rest")  # fmt: skip
-    group.add_argument("--flash-duty", type=options.positive_float, default=light.duty, metavar="D",
+    group.add_argument("--flash-duty", type=declared_type(FlashTarget, "duty"), default=light.duty, metavar="D",
                        help="with --flash-hz, the share of each period the LED is on (default: %(default)s)")  # fmt: skip
 
 

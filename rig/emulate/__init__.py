@@ -54,8 +54,6 @@ class EmulatorConfig:
     log: Path | None = None
 
     def __post_init__(self) -> None:
-        if not 1.0 <= self.tracker.rate_hz <= 10000.0:
-            raise ConfigError(f"--rate {self.tracker.rate_hz:g}: an emulated tracker sends 1 to 10000 records a second")
         if self.transport == "lsl" and self.faults.damages_bytes:
             raise ConfigError("an LSL stream carries no bytes to damage: corrupt, drop and garbage are serial faults")
 

@@ -1,7 +1,8 @@
 """Recording a camera (`rig record`), its live preview, and the guided check of the first seconds.
 
 `record_camera` films for a duration into a folder: the film a run's camera makes
-(`rig.session.run_record.FilmRecord`: `video.avi`, `camera_frames.csv`) and `camera.json` (the camera's
+(`rig.session.run_record.FilmRecord`: `video.avi`, or `video.mp4` for a camera faster than an AVI
+holds (`rig.film_file.film_holding`), and `camera_frames.csv`) and `camera.json` (the camera's
 report and the film's); Ctrl-C or an unplugged camera stops it with every frame kept. With a
 preview, a window shows the newest frame with both regions of interest drawn (given, or found by
 the analyser's calibration on the first second and a half of swing).
@@ -28,6 +29,7 @@ from rig.devices.camera.opencv_camera import opencv_camera
 from rig.devices.protocols import CameraFrame
 from rig.devices.window.gl_window import GlWindow, WindowSettings
 from rig.errors import RigError
+from rig.film_file import film_holding
 from rig.fresh_outputs import removed_unless_recorded
 from rig.session.run_record import FilmRecord
 
@@ -103,8 +105,9 @@ def record_camera(
     with removed_unless_recorded(out_dir):
         try:
             camera.connect(clock)
+            container_and_codec = film_holding(camera.fps)
             out_dir.mkdir(parents=True, exist_ok=True)
-            film = FilmRecord(out_dir, camera.fps, camera.width, camera.height, overwrite=overwrite)
+            film = FilmRecord(out_dir, camera.fps, camera.width, camera.height, film=container_and_codec, overwrite=overwrite)
             end = clock.now() + duration_s
             while (now := clock.now()) < end and not camera.finished and camera.fault() is None:
                 _film(camera.poll(), film, window)

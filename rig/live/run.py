@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
@@ -26,6 +25,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 import predictors
+from declared import Flag, Range, check, setting
 from rig.clock import Clock, MonotonicClock
 from rig.devices.protocols import Camera, Display, Instrument, TrackerSource
 from rig.devices.registry import make_tracker
@@ -60,7 +60,10 @@ class LiveConfig:
     renderer: str = "warp"
     predictor: str = "default"
     predictor_params: tuple[tuple[str, Any], ...] = ()
-    duration_s: float = 30.0
+    duration_s: float = setting(
+        30.0, "seconds", "how long the run lasts, at most a day", Range(0.0, 86400.0, includes_high=True),
+        flag=Flag("--duration", metavar="S"),
+    )  # fmt: skip
     window: WindowSettings = WindowSettings()
     scanout_fraction: float = 1.0
     photon_target: str = "photons"
@@ -72,8 +75,7 @@ class LiveConfig:
     """End when the pendulum has stopped swinging (`rig.live.still`), if before the duration."""
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.duration_s) and self.duration_s > 0):
-            raise ConfigError(f"a live run lasts a positive number of seconds, got {self.duration_s!r}")
+        check(self, ConfigError)
         if self.renderer == EXTERNAL and self.streams is None:
             raise ConfigError("an external renderer is reached through LSL: the run needs its streams")
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from rig.clock import Clock
 from rig.devices.protocols import NO_IMAGE
-from rig.devices.trackers.lsl_tracker import lsl_origin, pylsl, resolve_streams, time_correction
+from rig.devices.trackers.lsl_tracker import lsl_origin, open_inlet, pylsl, resolve_streams, time_correction
 from rig.devices.window.refresh import RefreshModel
 from rig.errors import RigError
 from rig.lsl.streams import MARKER_CHANNELS, StreamNames
@@ -96,7 +96,7 @@ class MarkerDisplay:
         self._origin = lsl_origin(clock)
         self._inlet = lsl.StreamInlet(streams[0], max_buflen=30, recover=False)
         self._correct()
-        self._inlet.open_stream(timeout=RESOLVE_TIMEOUT_S)
+        open_inlet(self._inlet, RESOLVE_TIMEOUT_S)
         swaps: list[float] = []
         deadline = clock.now() + CALIBRATION_TIMEOUT_S
         while len(swaps) < CALIBRATION_MARKERS and clock.now() < deadline:

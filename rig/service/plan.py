@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 import analysis
+from declared import Range, check, setting
 from analysis.sampling.model import bias_range_s, commensurate
 from analysis.timing import RATE_AGREEMENT
 from rig.errors import ConfigError
@@ -66,16 +67,18 @@ class PlanRequest:
     exposures: tuple[float, ...] = (1.0,)
     period_s: float = 1.0
     amplitude_deg: float = PendulumConfig().amplitude_deg
-    accuracy_ms: float = 1.0
+    accuracy_ms: float = setting(
+        1.0, "ms", "the 95% half-width of the latency wanted, from 10 us to 100 ms",
+        Range(0.01, 100.0, True, True), flag="--accuracy-ms",
+    )  # fmt: skip
 
     def __post_init__(self) -> None:
+        check(self, ConfigError)
         low, high = CAMERA_FPS_RANGE
         if not self.camera_fps or not all(low <= fps <= high for fps in self.camera_fps):
             raise ConfigError(f"camera frame rates must be {low:g}-{high:g} fps, got {list(self.camera_fps)}")
         if not self.exposures or not all(0.0 < e <= 1.0 for e in self.exposures):
             raise ConfigError(f"exposures are fractions of the frame interval in (0, 1], got {list(self.exposures)}")
-        if not (math.isfinite(self.accuracy_ms) and self.accuracy_ms > 0):
-            raise ConfigError(f"the accuracy wanted must be a positive number of ms, got {self.accuracy_ms}")
         DisplayConfig(refresh_hz=self.display_hz)
         PendulumConfig(period_s=self.period_s, amplitude_deg=self.amplitude_deg)
 

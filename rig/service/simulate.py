@@ -22,7 +22,7 @@ from analysis.windows import MIN_SAMPLES
 from rig.clock import VirtualClock
 from rig.devices.registry import DeviceContext, make_camera, make_display, make_tracker
 from rig.errors import RigError
-from rig.film_file import FRAME_TIMES_FILE, STAMPED_CONTAINERS, video_file_name
+from rig.film_file import FRAME_TIMES_FILE, STAMPED_CONTAINERS, check_film_rate, video_file_name
 from rig.fresh_outputs import removed_unless_recorded
 from rig.render import RenderSetup, make_renderer
 from rig.session import RUN_FILES, PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
@@ -31,7 +31,6 @@ from rig.sim.board import BOARD_FOLDER, remove_recording
 from rig.sim.config import SimulationConfig
 from rig.sim.truth import FilmTruth, Truth, run_truth
 from rig.sim.world import SimulatedWorld
-from rig.writers import check_avi_rate
 
 TRUTH_FILE = "truth.json"
 SIMULATION_FILES = (*RUN_FILES, *map(video_file_name, STAMPED_CONTAINERS), FRAME_TIMES_FILE, TRUTH_FILE, BOARD_FOLDER)
@@ -105,8 +104,7 @@ def _check_film(config: SimulationConfig, frames: int) -> None:
     """RigError, before the run, unless the film's container holds its rate and it holds enough
     frames to analyse."""
     camera = config.camera
-    if camera.container == "avi":
-        check_avi_rate(camera.film_fps, advice=", or in an MP4 or a MOV (--container mp4)")
+    check_film_rate(camera.film_fps, camera.container, advice=", or in an MP4 or a MOV (--container mp4)")
     least = MIN_FLASH_FRAMES if config.flash is not None else MIN_FILM_FRAMES
     if frames < least:
         kept = f" (every {camera.impairments.every_nth}-th exposure)" if camera.impairments.every_nth > 1 else ""
@@ -141,6 +139,7 @@ def simulate(
     world = SimulatedWorld(config)
     context = DeviceContext(world.twins())
     display, camera = world.display(), world.camera()  # the registry's `sim` devices, whose details the truth reads
+    _check_film(config, len(camera.film_times))
     renderer = make_renderer(config.renderer)
     board = world.board(out_dir / BOARD_FOLDER)
     timing = timing_for(renderer, cost_model(config.warp_ms))
@@ -168,7 +167,6 @@ def simulate(
         instruments=[board] if board is not None else [],
         target=PhotonTarget(config.photon_target, config.persistence),
     )
-    _check_film(config, len(camera.film_times))
     with removed_unless_recorded(out_dir):
         _prepare(out_dir, overwrite)
         with RunRecord(out_dir, overwrite=overwrite, film=config.camera.film) as record:

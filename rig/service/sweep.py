@@ -43,13 +43,14 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from analysis import AnalysisError, AnalysisOptions, LatencyResult
+from analysis.video.native_path import shown_path
 from declared import from_table, setting_of
 from rig.errors import ConfigError
 from rig.film_file import video_file_name
 from rig.executor import executor
 from rig.fresh_outputs import removed_unless_recorded
 from rig.service.analyse import AnalysisRequest
-from rig.service.batch import SUMMARY_COLUMNS, BatchItem, BatchRun, analysed_row
+from rig.service.batch import SUMMARY_COLUMNS, USER_ERRORS, BatchItem, BatchRun, analysed_row
 from rig.service.bench_profile import BenchProfile, CameraProfile, DisplayProfile, LayoutProfile, read_profile, with_profile
 from rig.service.simulate import SimulationResult, simulate
 from rig.sim.config import SimulationConfig
@@ -323,9 +324,21 @@ def simulated_bench(config: SimulationConfig) -> BenchProfile:
     )  # fmt: skip
 
 
+def unsimulated_row(point: SweepPoint, error: Exception) -> dict[str, Any]:
+    """The summary row of a point whose simulation was refused before it ran (a film too short to
+    analyse, a film rate its container does not hold): failed, with the reason."""
+    row = dict.fromkeys(SUMMARY_COLUMNS) | {"truth_ms": None, "error_ms": None}
+    row.update(index=point.index, video=shown_path(point.analysis.video), status="failed", error=f"not simulated: {error}", seconds=0.0)
+    return row | point.labels
+
+
 def run_point(point: SweepPoint) -> dict[str, Any]:
-    """Simulate one point and analyse its video: its summary row, with the truth and the error."""
-    return simulate_and_analyse(point).row
+    """Simulate one point and analyse its video: its summary row, with the truth and the error; a
+    point that cannot be simulated is a failed row, not the end of the sweep."""
+    try:
+        return simulate_and_analyse(point).row
+    except USER_ERRORS as error:
+        return unsimulated_row(point, error)
 
 
 def run_sweep(

@@ -42,7 +42,7 @@ from analysis.video.native_path import native_path
 from predictors import SAMPLE_COLUMNS
 from rig.devices.protocols import CameraFrame
 from rig.errors import RigError
-from rig.film_file import StampedVideoRecord, video_file_name
+from rig.film_file import StampedVideoRecord, check_film_rate, video_file_name
 from rig.writers import CsvRecord, VideoRecord
 
 TRACKER_FILE = "tracker.csv"
@@ -82,6 +82,7 @@ class FilmRecord:
     ) -> None:
         self.video_path = Path(out_dir) / video_file_name(film[0])
         native_path(self.video_path)  # OpenCV would crash on a name that is not UTF-8: refused here
+        check_film_rate(fps, film[0])  # before any file is made
         self.fps = fps
         self._table = CsvRecord(Path(out_dir) / FRAMES_FILE, FRAME_COLUMNS, overwrite=overwrite)
         try:

@@ -5,6 +5,7 @@ written. Commands run in this process through `rig.cli.main`."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Callable
@@ -23,6 +24,7 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (lab / "a-file").write_text("precious")
     _trace(lab / "two-samples.csv", [0.0, 0.01])
     times = [i * 0.01 for i in range(300)]
+    _trace(lab / "sorted.csv", times)
     times[10], times[20] = times[20], times[10]
     _trace(lab / "unsorted.csv", times)
     (lab / "base-a-number.toml").write_text('base = 5\n[grid]\n"camera.fps" = [120]\n')
@@ -32,6 +34,8 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (lab / "camera-a-number.toml").write_text('[base]\ncamera = 5\n[grid]\n"pendulum.period_s" = [1.0]\n')
     values = ", ".join(str(120 + i) for i in range(1000))
     (lab / "billion-points.toml").write_text(f'[grid]\n"camera.fps" = [{values}]\n"seed" = [{values}]\n"scene_triangles" = [{values}]\n')
+    (lab / "renderers-beyond-a-day.toml").write_text(f"triangles = [{', '.join(['100000000'] * 50)}]\nwarp_rounds = 10000\n")
+    (lab / "noise-beyond-a-metre.json").write_text('{"position_noise": 1e200}')
     (lab / "summary-a-list.json").write_text("[1, 2]")
     (lab / "summary-rows-a-number.json").write_text('{"rows": 5}')
     (lab / "summary-rows-of-numbers.json").write_text('{"rows": [1, 2]}')
@@ -72,7 +76,65 @@ CASES = [
     ("bench-batch-videos-beyond-a-lab", "bench batch --videos 1000000000", ("--videos", "from 1 to 1000")),
     ("bench-batch-that-cannot-finish", "bench batch --videos 1000 --duration 3600 --rounds 100", ("about 1.53e+04 hours", "24 hours")),
     ("bench-trackers-duration-beyond-ten-minutes", "bench trackers --duration 1e12", ("--duration", "from 0.5 to 600")),
-    ("bench-trackers-rate-beyond-any-tracker", "bench trackers --rate 1e9", ("--rate", "from 1 to 10000")),
+    ("bench-trackers-rate-beyond-any-tracker", "bench trackers --rate 1e9", ("--rate", "from 1 to 5000")),
+    ("bench-trackers-rate-beyond-the-simulated-tracker", "bench trackers --rate 6000", ("--rate", "from 1 to 5000", "6000")),
+    ("bench-renderers-grid-beyond-a-day", "bench renderers --spec {lab}/renderers-beyond-a-day.toml", ("about 42.7 hours at the least", "24 hours")),
+    # predictor parameters: each within what a tracker and a motion can be, never an overflow
+    ("simulate-kalman-noise-beyond-a-metre", "simulate --out {lab}/new --predictor kalman-cv:{lab}/noise-beyond-a-metre.json",
+     ("position_noise", "from 1e-09 to 1", "1e+200")),
+    ("simulate-kalman-jerk-beyond-any-motion", "simulate --out {lab}/new --predictor kalman-ca:jerk_noise=1e300", ("jerk_noise", "from 1e-06 to 1e+06")),
+    ("simulate-orientation-noise-beyond-half-a-turn", "simulate --out {lab}/new --predictor kalman-cv:orientation_noise=7",
+     ("orientation_noise", "from 1e-09 to 3.14159")),
+    ("simulate-damping-beyond-any-rate", "simulate --out {lab}/new --predictor auto:angular_velocity_damping=1e9", ("angular_velocity_damping", "from 0 to 10000")),
+    ("simulate-desp-interval-beyond-ten-seconds", "simulate --out {lab}/new --predictor desp:sample_interval=1e6", ("sample_interval", "at most 10")),
+    ("simulate-auto-memory-beyond-an-hour", "simulate --out {lab}/new --predictor auto:memory=1e9", ("memory", "from 0.001 to 3600")),
+    ("simulate-adaptive-prior-beyond-an-hour", "simulate --out {lab}/new --predictor adaptive:gain_prior=1e9", ("gain_prior", "at most 3600")),
+    ("simulate-slerp-interval-beyond-a-second", "simulate --out {lab}/new --predictor slerp:min_interval=5", ("min_interval", "at most 1")),
+    ("simulate-gap-beyond-a-day", "simulate --out {lab}/new --predictor kalman-cv:max_gap=1e9", ("max_gap", "at most 86400")),
+    ("bench-predictors-noise-beyond-a-metre", "bench predictors --predictor kalman-cv:position_noise=1e200", ("position_noise", "from 1e-09 to 1")),
+    ("tune-acceleration-noise-beyond-any-motion", "tune kalman-cv:acceleration_noise=1e100 --trace {lab}/sorted.csv --horizon-ms 20 --out {lab}/p.json",
+     ("acceleration_noise", "from 1e-06 to 10000")),
+    # the tracker emulator: a tracker a lab could have
+    ("emulate-tracker-rate-beyond-the-simulated-tracker", "emulate-tracker serial --tcp 0 --rate 1e9", ("--rate", "from 1 to 5000", "1e9")),
+    ("emulate-tracker-duration-beyond-a-day", "emulate-tracker serial --tcp 0 --duration 1e12", ("--duration", "at most 86400")),
+    ("emulate-tracker-noise-beyond-ten-centimetres", "emulate-tracker serial --tcp 0 --noise-mm 1e9", ("--noise-mm", "from 0 to 100")),
+    ("emulate-tracker-orientation-noise-beyond-ten-degrees", "emulate-tracker lsl --name rig-test --noise-deg 90", ("--noise-deg", "from 0 to 10")),
+    ("emulate-tracker-delay-beyond-a-second", "emulate-tracker serial --tcp 0 --delay-ms 5000", ("--delay-ms", "from 0 to 1000")),
+    ("emulate-tracker-jitter-beyond-a-tenth", "emulate-tracker serial --tcp 0 --jitter-ms 1e6", ("--jitter-ms", "from 0 to 100")),
+    ("emulate-tracker-dropout-beyond-all", "emulate-tracker lsl --name rig-test --dropout 1.5", ("--dropout", "below 1")),
+    ("emulate-tracker-negative-seed", "emulate-tracker serial --tcp 0 --seed=-1", ("--seed", "from 0 to 1e+09")),
+    ("emulate-tracker-drift-beyond-any-crystal", "emulate-tracker serial --tcp 0 --drift-ppm 1e9", ("--drift-ppm", "from -1000 to 1000")),
+    ("emulate-tracker-port-beyond-tcp", "emulate-tracker serial --tcp 99999", ("--tcp 99999", "0 to 65535")),
+    # live runs and recordings: at most a day
+    ("measure-duration-beyond-a-day", "measure --tracker serial:loop:// --camera camera:0 --out {lab}/new --duration 1e9", ("--duration", "at most 86400")),
+    ("measure-self-test-of-no-time", "measure --self-test --duration 0", ("--duration", "at most 86400", "got 0")),
+    ("record-duration-beyond-a-day", "record --camera camera:0 --out {lab}/new --duration 1e12", ("--duration", "at most 86400")),
+    ("record-tracker-duration-beyond-a-day", "record-tracker --tracker serial:loop:// --out {lab}/new --duration 1e9", ("--duration", "at most 86400")),
+    ("board-record-duration-beyond-a-day", "board record --port loop:// --out {lab}/new --duration 1e9", ("--duration", "at most 86400")),
+    # flashing lights: what an LED or a display can flash
+    ("calibrate-camera-flash-beyond-ten-kilohertz", "calibrate-camera {lab}/a-file --flash-hz 1e9", ("--flash-hz", "at most 10000")),
+    ("simulate-flash-of-no-frequency", "simulate --out {lab}/new --flash-hz 0", ("--flash-hz", "at most 10000", "got 0")),
+    ("simulate-flash-display-of-one-refresh", "simulate --out {lab}/new --flash-display 1", ("--flash-display", "from 2 to 1000")),
+    ("simulate-flash-always-on", "simulate --out {lab}/new --flash-hz 30 --flash-duty 1", ("--flash-duty", "below 1")),
+    # the board: what its protocol carries and a lab's day holds
+    ("board-sync-too-few-round-trips", "board sync --port loop:// --round-trips 2", ("--round-trips", "from 4 to 10000")),
+    ("board-sync-series-beyond-a-day", "board sync --port loop:// --repeat 100000 --every 3600", ("about 1e+05 hours", "24 hours")),
+    ("board-blink-code-of-no-bits", "board blink --port loop:// --bits 0", ("--bits", "from 1 to 4096")),
+    ("board-blink-beyond-the-led", "board blink --port loop:// --level 256", ("--level", "from 1 to 255")),
+    ("board-blink-seed-beyond-sixteen-bits", "board blink --port loop:// --seed 70000", ("--seed", "from 1 to 65535")),
+    ("board-record-threshold-of-nothing", "board record --port loop:// --out {lab}/new --duration 5 --rise 0", ("--rise", "from 1 to 65535")),
+    ("board-record-resync-beyond-an-hour", "board record --port loop:// --out {lab}/new --duration 5 --resync-every 1e9", ("--resync-every", "from 0.1 to 3600")),
+    ("board-record-encoder-beyond-any-encoder", "board record --port loop:// --out {lab}/new --duration 5 --encoder-rate 1e9", ("--encoder-rate", "from 0 to 100000")),
+    # listening, executors and benches: within a machine's reach
+    ("devices-listening-beyond-ten-minutes", "devices --lsl-wait 1e9", ("--lsl-wait", "from 0 to 600")),
+    ("sweep-workers-beyond-any-machine", "sweep {lab}/base-a-number.toml --out {lab}/sweep --workers 100000", ("--workers", "1 to 256")),
+    ("bench-live-duration-beyond-a-day", "bench live --duration 1e9", ("--duration", "at most 86400")),
+    ("bench-renderers-server-beyond-a-second", "bench renderers --server-ms 1e9", ("--server-ms", "at most 1000")),
+    ("bench-seed-table-load-beyond-any-gpu", "bench renderers --seed-table --max-triangles 1e12", ("--max-triangles", "from 1 to 1e+08")),
+    ("bench-seed-table-frame-beyond-ten-minutes", "bench renderers --seed-table --max-frame-s 1e6", ("--max-frame-s", "at most 600")),
+    # plan: an accuracy a camera can reach and a latency needs
+    ("plan-accuracy-beyond-any-camera", "plan --display-hz 60 --camera-fps 120 --accuracy-ms 1e-9", ("--accuracy-ms", "from 0.01 to 100")),
+    ("plan-accuracy-of-no-use", "plan --display-hz 60 --camera-fps 120 --accuracy-ms 1e6", ("--accuracy-ms", "from 0.01 to 100")),
     # traces: scored only where a prediction can land on the truth, in time order
     ("bench-predictors-two-sample-trace", "bench predictors --trace {lab}/two-samples.csv", ("'two-samples'", "at least 10 samples")),
     ("bench-predictors-unsorted-trace", "bench predictors --trace {lab}/unsorted.csv", ("not in time order", "--repair")),
@@ -136,6 +198,20 @@ def test_a_sweep_whose_every_point_failed_exits_2(
     _assert_every_one_failed(code, err, "2 points failed")
     assert "pendulum periods" in err
     assert (tmp_path / "sweep" / "summary.csv").exists()
+
+
+def test_a_sweep_point_whose_film_is_too_short_is_a_failed_row_and_the_sweep_goes_on(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str],
+) -> None:
+    spec = tmp_path / "short.toml"
+    spec.write_text(SHORT_FILM + "[[points]]\ncamera.impairments.every_nth = 2\n\n[[points]]\nseed = 2\n")
+    code, _, err = run_rig(["sweep", str(spec), "--out", str(tmp_path / "sweep")], capsys)
+    _assert_every_one_failed(code, err, "2 points failed")
+    rows = json.loads((tmp_path / "sweep" / "summary.json").read_text())["rows"]
+    assert [row["status"] for row in rows] == ["failed", "failed"]
+    assert rows[0]["error"].startswith("not simulated: the film would hold 15 frames") and "at least 24" in rows[0]["error"]
+    assert "pendulum periods" in rows[1]["error"]
+    assert not (tmp_path / "sweep" / "point000").exists() and (tmp_path / "sweep" / "point001" / "video.avi").exists()
 
 
 def test_a_bench_whose_every_case_was_refused_exits_2(

@@ -11,7 +11,8 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from predictors import PredictorError, make, names
+from declared import Range
+from predictors import PoseSample, PredictorError, make, names
 from predictors.params import LOG, LOGIT, NON_NEGATIVE, OPEN_UNIT, Param, declare_params
 from predictors.registry import params_of
 
@@ -70,6 +71,39 @@ def test_tuning_can_start_a_trainable_parameter_from_anywhere_in_its_range(name,
     assert transform is not None
     edge_needs_a_start = param.range.includes_low and not transform.domain.contains(param.range.low)
     assert not edge_needs_a_start or transform.domain.contains(param.tune_from)
+
+
+def _ends(param: Param) -> list[float]:
+    """The largest and smallest values the parameter takes (an open end approached within 1e-9 of it)."""
+    low = param.range.low if param.range.includes_low else param.range.low + 1e-9 * max(1.0, abs(param.range.low))
+    high = param.range.high if param.range.includes_high else math.nextafter(param.range.high, 0.0)
+    return [low, high]
+
+
+@pytest.mark.parametrize(("name", "param"), DECLARED, ids=[f"{n}.{p.name}" for n, p in DECLARED])
+def test_every_parameter_has_a_finite_range_whose_ends_predict_finite_poses(name, param):
+    assert math.isfinite(param.range.low) and math.isfinite(param.range.high)
+    for value in _ends(param):
+        predictor = make(name, **{param.name: value})
+        for k in range(40):
+            t = 0.01 * k
+            predictor.update(PoseSample(t, t, (math.sin(t), 0.0, 1.0), (math.cos(t / 2), 0.0, 0.0, math.sin(t / 2))))
+        pose = predictor.predict(0.45)
+        assert np.all(np.isfinite(pose.position)) and np.all(np.isfinite(pose.orientation)), (param.name, value)
+
+
+def test_a_value_far_past_a_noise_s_range_is_refused_not_overflowed():
+    with pytest.raises(PredictorError, match="position_noise must be a positive number of metres from 1e-09 to 1, got 1e\\+200"):
+        make("kalman-cv", position_noise=1e200)
+
+
+@pytest.mark.parametrize(("value", "clipped"), [(-5.0, 0.0), (0.5, 0.5), (1e9, 1e4)])
+def test_a_closed_range_clips_a_value_onto_its_ends(value, clipped):
+    assert Range(0.0, 1e4, True, True).clipped(value) == clipped
+
+
+def test_an_open_end_leaves_a_value_past_it_as_it_is():
+    assert Range(0.0, 1.0).clipped(-1.0) == -1.0 and Range(0.0, 1.0).clipped(2.0) == 2.0
 
 
 def test_values_are_floats_and_unknown_names_list_the_accepted_ones():

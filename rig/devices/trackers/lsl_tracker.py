@@ -20,8 +20,9 @@ import ctypes
 import time
 from operator import itemgetter
 from types import ModuleType
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence, TypeVar
 
+from rig import interrupts
 from rig.clock import Clock
 from rig.devices.trackers.clock_mapping import CorrectedMapping
 from rig.devices.trackers.profile import DEFAULT_UNIT_TOLERANCE
@@ -42,6 +43,9 @@ RESOLVE_POLL_S = 0.1
 OPEN_TIMEOUT_S = 2.0
 CORRECTION_INTERVAL_S = 1.0
 CORRECTION_TIMEOUT_S = 2.0
+WAIT_SLICE_S = 0.2
+"""The longest liblsl is left waiting in C at once, deaf to signals: a Ctrl-C or SIGTERM that came
+meanwhile is raised between slices (`in_slices`)."""
 # Seconds of samples the inlet buffers while the reader is busy: far more than it ever is.
 BUFFER_S = 30
 _LIBLSL_CONFIG = "[log]\nlevel = -3\n"
@@ -76,8 +80,39 @@ def resolve_streams(wait_s: float, name: str | None = None) -> list[Any]:
         time.sleep(min(RESOLVE_POLL_S, left))
 
 
+Answer = TypeVar("Answer")
+
+
+def in_slices(call: Callable[[float], Answer], timeout_s: float) -> Answer:
+    """`call(slice_s)`, a liblsl wait of at most `slice_s` seconds, made again until it answers or
+    `timeout_s` has passed (liblsl's TimeoutError then): liblsl goes on with what it started between
+    calls (a connection, a clock measurement), and a pending interrupt is raised between them, on
+    any thread (`rig.interrupts`), so a signal stops the wait within WAIT_SLICE_S."""
+    timeout_error = pylsl().util.TimeoutError
+    deadline = time.monotonic() + timeout_s
+    while True:
+        interrupts.raise_pending()
+        left = deadline - time.monotonic()
+        try:
+            return call(max(min(WAIT_SLICE_S, left), 0.0))
+        except timeout_error:
+            if left <= WAIT_SLICE_S:
+                raise
+            interrupts.raise_pending()
+
+
+def open_inlet(inlet: Any, timeout_s: float) -> None:
+    """Subscribe `inlet` to its stream's samples, waiting at most `timeout_s` (`in_slices`)."""
+    in_slices(lambda slice_s: inlet.open_stream(timeout=slice_s), timeout_s)
+
+
 def time_correction(inlet: Any, timeout_s: float) -> tuple[float, float]:
-    """(offset, uncertainty) in seconds: local time = the sender's time + offset, within +-uncertainty."""
+    """(offset, uncertainty) in seconds: local time = the sender's time + offset, within +-uncertainty;
+    waiting at most `timeout_s` for liblsl's measurement (`in_slices`)."""
+    return in_slices(lambda slice_s: _time_correction(inlet, slice_s), timeout_s)
+
+
+def _time_correction(inlet: Any, timeout_s: float) -> tuple[float, float]:
     lsl = pylsl()
     function = lsl.lib.lib.lsl_time_correction_ex
     function.restype = ctypes.c_double
@@ -142,7 +177,7 @@ class LslTransport:
         try:
             # The first correction takes a good fraction of a second: measured before the samples flow.
             correction, uncertainty = time_correction(inlet, CORRECTION_TIMEOUT_S)
-            inlet.open_stream(timeout=OPEN_TIMEOUT_S)
+            open_inlet(inlet, OPEN_TIMEOUT_S)
         except (lsl.util.TimeoutError, lsl.util.LostError) as error:
             raise RigError(f"LSL stream {self.name!r} did not answer: {error}") from None
         self._origin_ns = origin_ns

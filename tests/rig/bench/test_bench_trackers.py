@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 from rig.bench import trackers
+from rig.errors import RigError
 
 
 def test_a_clean_pty_case_counts_every_record_sent_and_measures_its_costs(tmp_path: Path) -> None:
@@ -25,15 +26,17 @@ def test_the_wake_floor_is_a_cost_per_record_of_the_bare_reader(tmp_path: Path) 
 
 def test_the_table_and_the_plot_show_every_row(tmp_path: Path) -> None:
     row = {
-        "source": "serial", "transport": "pty", "profile": "csv", "faults": "corrupt=0.01,disconnect=5:0.5", "sent": 10,
+        "failed": None, "source": "serial", "transport": "pty", "profile": "csv", "faults": "corrupt=0.01,disconnect=5:0.5", "sent": 10,
         "recorded": 9, "missing": 0, "fabricated": 0, "corrupt": 1, "damaged_sent": 1, "reading_us_per_sample": 40.0,
         "reader_us_per_sample": 20.0, "us_per_sample": 70.0, "wake_floor_us": 18.0, "latency_ms_median": 0.1,
         "latency_ms_p95": 0.4, "stolen_cpu_pct": 2.5,
     }  # fmt: skip
-    lines = trackers.table([row, {**row, "source": "lsl", "stolen_cpu_pct": None}]).splitlines()
-    assert len(lines) == 4 and "40.0 (20.0), 70.0 | 18.0 | 2.5 | 0.100, 0.400 |" in lines[2]
+    failed = trackers.failed_case(trackers.cases(1.0)[3], 1000.0, 2.0, RigError("no LSL stream"))
+    lines = trackers.table([row, {**row, "source": "lsl", "stolen_cpu_pct": None}, failed]).splitlines()
+    assert len(lines) == 5 and "40.0 (20.0), 70.0 | 18.0 | 2.5 | 0.100, 0.400 |" in lines[2]
     assert "| 18.0 | n/a | 0.100" in lines[3]
-    trackers.plot([row], tmp_path / "trackers.png")
+    assert lines[4] == "| lsl | lsl | pose (7 channels) | none | failed: no LSL stream |"
+    trackers.plot([row, failed], tmp_path / "trackers.png")
     assert (tmp_path / "trackers.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and (tmp_path / "trackers.png").stat().st_size > 10_000
 
 
