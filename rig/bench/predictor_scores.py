@@ -18,6 +18,24 @@ def label(name: str, params: dict[str, Any]) -> str:
     return name if not params else f"{name}:" + ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
 
 
+def evaluate_all(
+    traces: Sequence[Trace],
+    specs: Sequence[tuple[str, dict[str, Any]]],
+    horizons: Sequence[float],
+    timing_repeats: int,
+    progress: Callable[[float, float], object] | None = None,
+) -> list[Evaluation]:
+    """Every predictor spec on every trace."""
+    results = []
+    total = len(traces) * len(specs)
+    for i, trace in enumerate(traces):
+        for j, (name, params) in enumerate(specs):
+            results.append(evaluate(name, trace, [h / 1e3 for h in horizons], params, timing_repeats))
+            if progress is not None:
+                progress(i * len(specs) + j + 1, total)
+    return results
+
+
 @dataclass(frozen=True)
 class Ratios:
     """One predictor's RMS errors over constant velocity's on each trace, per horizon (ms): angular,
