@@ -20,6 +20,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from predictors import DEFAULT, names, resolve
+from predictors.registry import params_of
 from predictors.corpus import GROUPINGS, Recording, read_corpus
 from predictors.cross_validation import CorpusScores, Fold, cross_validate, geometric_mean, groups_of, held_out_mean
 from rig.bench.contract import Context
@@ -27,14 +28,17 @@ from rig.bench.predictor_scores import BASELINE, evaluate_all, label
 from rig.service.tune import check_scorable, in_time_order
 
 COST_REFERENCE = "kalman-cv"
-# The candidates run when none is named: every predictor with its defaults, and kalman-cv with its
-# angular velocity damped at rates a head's turn dies away at (1/s; see predictors.kalman).
+# The candidates run when none is named: every predictor with its defaults, and those with a damped
+# angular velocity at each rate a head's turn dies away at (1/s; see predictors.kalman) besides.
 DAMPING_GRID = (2.0, 4.0, 8.0)
+DAMPED = ("kalman-cv", "split")
 
 
 def default_candidates(names: Sequence[str]) -> list[tuple[str, dict[str, Any]]]:
-    """Every predictor named with its defaults, then kalman-cv at each damping of `DAMPING_GRID`."""
-    return [*((name, {}) for name in names), *(("kalman-cv", {"angular_velocity_damping": d}) for d in DAMPING_GRID)]
+    """Every predictor named with its defaults, then each of `DAMPED` at every other damping of `DAMPING_GRID`."""
+    damped = [(name, {"angular_velocity_damping": d}) for name in DAMPED for d in DAMPING_GRID
+              if d != params_of(name).resolve({})["angular_velocity_damping"]]  # fmt: skip
+    return [*((name, {}) for name in names), *damped]
 
 
 @dataclass(frozen=True)
