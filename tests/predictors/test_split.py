@@ -38,11 +38,13 @@ def test_the_default_damps_the_angular_velocity():
     assert make("split").angular_velocity_damping == 4.0
 
 
-def test_before_any_sample_the_error_names_split():
+def test_errors_name_split():
+    predictor = make("split")
     with pytest.raises(PredictorError, match="'split' has no sample yet"):
-        make("split").predict(0.0)
+        predictor.predict(0.0)
+    predictor.update(PoseSample(0.0, 0.0, P0, Q0))
     with pytest.raises(PredictorError, match="'split' was asked for time nan"):
-        make("split").predict(float("nan"))
+        predictor.predict(float("nan"))
 
 
 @pytest.mark.slow
