@@ -32,6 +32,7 @@ COST_REFERENCE = "kalman-cv"
 # angular velocity at each rate a head's turn dies away at (1/s; see predictors.kalman) besides.
 DAMPING_GRID = (2.0, 4.0, 8.0)
 DAMPED = ("kalman-cv", "split")
+_PLOTTED_ABOVE_BASELINE = 1.3  # the speed plot leaves out candidates this much worse than constant velocity
 
 
 def default_candidates(names: Sequence[str]) -> list[tuple[str, dict[str, Any]]]:
@@ -202,21 +203,27 @@ def plot(found: CorpusRun, path: Path) -> None:
     figure = Figure(figsize=(13.0, 5.0))
     left, right = figure.subplots(1, 2)
     scores, groups, h = found.scores, found.groups("person"), found.plot_horizon_ms
-    for c in scores.candidates:
-        ratio = scores.corpus_ratio(c, groups, "angular", h)
+    ratios = {c: scores.corpus_ratio(c, groups, "angular", h) for c in scores.candidates}
+    shown = {c: r for c, r in ratios.items() if r <= _PLOTTED_ABOVE_BASELINE}
+    for c, ratio in shown.items():
         left.scatter(found.costs[c], ratio)
         left.annotate(c, (found.costs[c], ratio), textcoords="offset points", xytext=(4, 4), fontsize="small")
     left.axhline(1.0, color="grey", linewidth=0.8)
+    hidden = ", ".join(c for c in ratios if c not in shown)
     left.set(xlabel=f"cost per update + predict / {COST_REFERENCE}'s", ylabel=f"angular RMS / constant velocity at {h:g} ms",
-             title="geometric mean over people")  # fmt: skip
+             title="geometric mean over people" + (f" (above {_PLOTTED_ABOVE_BASELINE:g}: {hidden})" if hidden else ""))  # fmt: skip
     folds = found.folds.get("person")
     names = [f.group for f in folds] if folds else list(groups)
     width = 0.8 / len(found.shown)
+    heights: list[float] = []
     for k, horizon in enumerate(found.shown):
         values = ([f.ratios["angular"][horizon] for f in folds] if folds
                   else [scores.group_ratio(found.default, groups[g], "angular", horizon) for g in names])  # fmt: skip
         right.bar(np.arange(len(names)) + k * width, values, width, label=f"{horizon:g} ms")
+        heights += values
     right.axhline(1.0, color="grey", linewidth=0.8)
+    heights = [v for v in heights if math.isfinite(v)]
+    right.set_ylim(0.95 * min([*heights, 1.0]), 1.02 * max([*heights, 1.0]))
     right.set_xticks(np.arange(len(names)) + 0.4 - width / 2, names, rotation=60, ha="right", fontsize="small")
     right.set(ylabel="angular RMS / constant velocity",
               title="held out: chosen on the other people" if folds else f"{found.default} per person")  # fmt: skip
