@@ -110,14 +110,16 @@ def read_manifest(path: Path) -> dict[str, Labels]:
 
 def read_corpus(folder: str | os.PathLike[str], manifest: str | os.PathLike[str] | None = None) -> list[Recording]:
     """Every recording in `folder` (top level and one level of subfolders), labelled by the manifest
-    (`manifest`, else the folder's `manifest.csv` if any) or by its name, in path order."""
+    (`manifest`, else the folder's `manifest.csv` if any; never itself a recording) or by its name,
+    in path order."""
     folder = Path(folder)
     if not folder.is_dir():
         raise PredictorError(f"corpus {folder} is not a folder of recordings")
-    paths = sorted(p for p in (*folder.glob("*.csv"), *folder.glob("*/*.csv")) if p.name != MANIFEST)
+    manifest_path = Path(manifest) if manifest is not None else folder / MANIFEST
+    paths = sorted(p for p in (*folder.glob("*.csv"), *folder.glob("*/*.csv"))
+                   if p.name != MANIFEST and p.resolve() != manifest_path.resolve())  # fmt: skip
     if not paths:
         raise PredictorError(f"corpus {folder} holds no .csv recordings (top level or one folder down)")
-    manifest_path = Path(manifest) if manifest is not None else folder / MANIFEST
     listed = read_manifest(manifest_path) if manifest is not None or manifest_path.is_file() else None
     recordings = []
     for path in paths:

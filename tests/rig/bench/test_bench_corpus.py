@@ -78,3 +78,18 @@ def test_cross_validation_needs_a_corpus():
     args = parser().parse_args(["bench", "predictors", "--cross-validate", "--predictor", "hold"])
     with pytest.raises(ConfigError, match="need --corpus DIR"):
         args.func(args)
+
+
+def test_a_manifest_given_labels_the_corpus(tmp_path, capsys):
+    corpus(tmp_path)
+    rows = ["walk/walk_nyc_user1.csv,quest,ann,nyc,", "walk/walk_hill_user1.csv,quest,ann,hill,",
+            "walk/walk_hill_user2.csv,quest,bob,hill,", "walk/walk_nyc_user3.csv,quest,cy,nyc,",
+            "hmd_user9.csv,vive,dee,,", "arm_robot_1.csv,quest,robot,,yes"]  # fmt: skip
+    manifest = tmp_path / "labels.csv"
+    manifest.write_text("file,device,person,scene,apart\n" + "\n".join(rows) + "\n")
+    args = parser().parse_args(["bench", "predictors", "--corpus", str(tmp_path), "--manifest", str(manifest), "--predictor", "hold",
+                                "--horizons-ms", "50", "--timing-repeats", "0", "--cross-validate", "--json", str(tmp_path / "out.json")])  # fmt: skip
+    assert args.func(args) == 0
+    record = json.loads((tmp_path / "out.json").read_text())
+    assert [f["group"] for f in record["cross_validation"]["person"]["folds"]] == ["dee", "ann", "bob", "cy"]
+    assert [f["group"] for f in record["cross_validation"]["device"]["folds"]] == ["vive", "quest"]
