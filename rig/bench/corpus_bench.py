@@ -22,9 +22,9 @@ import numpy as np
 from predictors import DEFAULT, names, resolve
 from predictors.registry import params_of
 from predictors.corpus import GROUPINGS, Recording, read_corpus
-from predictors.cross_validation import CorpusScores, Fold, cross_validate, geometric_mean, groups_of, held_out_mean
+from predictors.cross_validation import REPORTED, CorpusScores, Fold, cross_validate, groups_of, held_out_mean
 from rig.bench.contract import Context
-from rig.bench.predictor_scores import BASELINE, evaluate_all, label
+from rig.bench.predictor_scores import BASELINE, evaluate_all, finite_or_none, label
 from rig.service.tune import check_scorable, in_time_order
 
 COST_REFERENCE = "kalman-cv"
@@ -154,10 +154,10 @@ def text(found: CorpusRun) -> str:
     return "\n".join(lines)
 
 
-def _ratios(found: CorpusRun, label_: str, recordings: Sequence[str]) -> dict[str, dict[str, float | None]]:
-    parts = ("angular", "angular_p95", "position", "position_p95")
-    out = {part: {f"{h:g}": found.scores.group_ratio(label_, recordings, part, h) for h in found.shown} for part in parts}
-    return {part: {h: (v if math.isfinite(v) else None) for h, v in by.items()} for part, by in out.items()}
+def _ratios(found: CorpusRun, candidate: str, recordings: Sequence[str]) -> dict[str, dict[str, float | None]]:
+    """The candidate's ratios over the recordings (their geometric mean) per reported part and horizon."""
+    out = {part: {f"{h:g}": found.scores.group_ratio(candidate, recordings, part, h) for h in found.shown} for part in REPORTED}
+    return {part: {h: finite_or_none(v) for h, v in by.items()} for part, by in out.items()}
 
 
 def record(found: CorpusRun) -> dict[str, Any]:
@@ -176,8 +176,8 @@ def record(found: CorpusRun) -> dict[str, Any]:
                 "cost_over_kalman_cv": found.costs[c],
                 "recordings": {r.name: _ratios(found, c, [r.name]) for r in found.recordings},
                 "groups": {by: {g: _ratios(found, c, members) for g, members in groups.items()} for by, groups in groupings.items()},
-                "geometric_mean": {by: {f"{h:g}": geometric_mean([scores.group_ratio(c, m, "angular", h) for m in groups.values()])
-                                        for h in found.shown} for by, groups in groupings.items()},  # fmt: skip
+                "geometric_mean": {by: {part: {f"{h:g}": finite_or_none(scores.corpus_ratio(c, groups, part, h)) for h in found.shown}
+                                        for part in REPORTED} for by, groups in groupings.items()},  # fmt: skip
             }
             for c in scores.candidates
         },
@@ -185,8 +185,8 @@ def record(found: CorpusRun) -> dict[str, Any]:
             by: {
                 "folds": [{"group": f.group, "recordings": list(f.recordings), "chosen": f.chosen,
                            "ratios": _ratios(found, f.chosen, f.recordings)} for f in folds],  # fmt: skip
-                "geometric_mean": {part: {f"{h:g}": held_out_mean(folds, part, h) for h in found.shown}
-                                   for part in ("angular", "angular_p95", "position")},  # fmt: skip
+                "geometric_mean": {part: {f"{h:g}": finite_or_none(held_out_mean(folds, part, h)) for h in found.shown}
+                                   for part in REPORTED},  # fmt: skip
             }
             for by, folds in found.folds.items()
         },
