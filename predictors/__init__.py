@@ -6,11 +6,13 @@
     predictor.update(PoseSample(t_sensor=0.0, t_arrival=0.002, position=p, orientation=q))
     pose = predictor.predict(0.016)
 
-Predictors (`names()`): hold, slerp, kalman-cv, kalman-ca, desp, auto, adaptive; each class documents
+Predictors (`names()`): hold, slerp, kalman-cv, kalman-ca, desp, auto, adaptive, split; each class documents
 its parameters and their units. `make(DEFAULT)` ("default") makes the one to use when none is named:
 `adaptive`, which learns on the stream it is fed which motion model to trust at each horizon. `evaluate` scores one on a `Trace` (`read_trace` reads CSV files);
 `SAMPLE_COLUMNS`, `sample_row` and `read_samples` are the one file format of tracker samples.
 `predictors.quaternion` holds the vectorised quaternion maths, (w, x, y, z) Hamilton;
+`predictors.corpus` reads a folder of recordings labelled by device, person and scene and
+`predictors.cross_validation` scores choices by group, each scored on a group it was not chosen on;
 `predictors.synthetic` generates head motion and `predictors.stress` the stress streams (rates,
 noise, faults, sudden stops) a default predictor must survive. Tuning (`predictors.tuning`) and the JAX twins of the
 filters (`predictors.jax_filters`) import JAX, so they are imported only by name, never from here:

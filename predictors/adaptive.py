@@ -270,6 +270,15 @@ class Adaptive:
     def predict(self, t: float) -> Pose:
         """The pose at t (s): each part blended from the models trusted at the horizons either side
         of t - (newest sample time), at most max_horizon seconds either way."""
+        t, position, turn = self._blended(t)
+        return Pose(t, position, squat.rotated_by(turn[0], turn[1], turn[2], self._orientation))
+
+    def position_at(self, t: float) -> tuple[float, float, float]:
+        """The position `predict(t)` gives, without making the pose (`split` takes only this part)."""
+        return self._blended(t)[1]
+
+    def _blended(self, t: float) -> tuple[float, tuple[float, float, float], tuple[float, float, float]]:
+        """(t, the position, the turn from the newest orientation as a rotation vector) at t (s)."""
         t, h = horizon(t, self._t, self.max_horizon, self.name)
         trusted = self._trusted
         if h <= HORIZONS_S[0]:
@@ -298,7 +307,7 @@ class Adaptive:
             m1 += share * a1 + reach * w1
             m2 += share * a2 + reach * w2
         p = self._position
-        return Pose(t, (p[0] + m0, p[1] + m1, p[2] + m2), squat.rotated_by(d0, d1, d2, self._orientation))
+        return t, (p[0] + m0, p[1] + m1, p[2] + m2), (d0, d1, d2)
 
     @property
     def state(self) -> AdaptiveState:

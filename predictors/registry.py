@@ -27,6 +27,7 @@ from predictors.extrapolators import HoldLast, SlerpExtrapolator
 from predictors.kalman import KalmanCA, KalmanCV
 from predictors.params import ParamSet
 from predictors.pose import Pose, PoseSample
+from predictors.split import Split
 
 
 @runtime_checkable
@@ -48,7 +49,7 @@ class Predictor(Protocol):
 _PREDICTORS: Mapping[str, Any] = MappingProxyType(
     {
         cls.name: cls
-        for cls in (HoldLast, SlerpExtrapolator, KalmanCV, KalmanCA, DoubleExponentialSmoothing, Auto, Adaptive)
+        for cls in (HoldLast, SlerpExtrapolator, KalmanCV, KalmanCA, DoubleExponentialSmoothing, Auto, Adaptive, Split)
     }
 )
 

@@ -18,6 +18,24 @@ def label(name: str, params: dict[str, Any]) -> str:
     return name if not params else f"{name}:" + ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items())
 
 
+def evaluate_all(
+    traces: Sequence[Trace],
+    specs: Sequence[tuple[str, dict[str, Any]]],
+    horizons: Sequence[float],
+    timing_repeats: int,
+    progress: Callable[[float, float], object] | None = None,
+) -> list[Evaluation]:
+    """Every predictor spec on every trace."""
+    results = []
+    total = len(traces) * len(specs)
+    for i, trace in enumerate(traces):
+        for j, (name, params) in enumerate(specs):
+            results.append(evaluate(name, trace, [h / 1e3 for h in horizons], params, timing_repeats))
+            if progress is not None:
+                progress(i * len(specs) + j + 1, total)
+    return results
+
+
 @dataclass(frozen=True)
 class Ratios:
     """One predictor's RMS errors over constant velocity's on each trace, per horizon (ms): angular,
@@ -47,17 +65,18 @@ class Ratios:
             "angular": _keyed(self.angular),
             "position": _keyed(self.position),
             "us_per_update": self.us_per_update,
-            "geometric_mean": {part: {f"{h:g}": _finite(self.geometric_mean(part, h)) for h in horizons} for part in ("angular", "position")},
-            "worst": {part: {f"{h:g}": _finite(self.worst(part, h)) for h in horizons} for part in ("angular", "position")},
+            "geometric_mean": {part: {f"{h:g}": finite_or_none(self.geometric_mean(part, h)) for h in horizons} for part in ("angular", "position")},
+            "worst": {part: {f"{h:g}": finite_or_none(self.worst(part, h)) for h in horizons} for part in ("angular", "position")},
         }
 
 
-def _finite(value: float) -> float | None:
+def finite_or_none(value: float) -> float | None:
+    """The value, or None (JSON's null) where it is not finite."""
     return value if math.isfinite(value) else None
 
 
 def _keyed(ratios: dict[str, dict[float, float]]) -> dict[str, dict[str, float | None]]:
-    return {trace: {f"{h:g}": _finite(v) for h, v in by_horizon.items()} for trace, by_horizon in ratios.items()}
+    return {trace: {f"{h:g}": finite_or_none(v) for h, v in by_horizon.items()} for trace, by_horizon in ratios.items()}
 
 
 def ratios(results: Sequence[Evaluation], horizons: Sequence[float]) -> list[Ratios]:
@@ -106,7 +125,7 @@ class HeldOut:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready values (None for a ratio on a trace without that part)."""
-        return {k: _finite(v) if isinstance(v, float) else v for k, v in vars(self).items()}
+        return {k: finite_or_none(v) if isinstance(v, float) else v for k, v in vars(self).items()}
 
 
 def leave_one_out(

@@ -12,6 +12,10 @@ Default traces:
   `hmd_orientation_user1` (orientation only, about 60 Hz with jitter) and `quest_pro_robot_traj2`
   (6-DoF, about 72 Hz).
 
+`--corpus DIR` runs on a corpus of recordings instead, scored by recording and by person, scene and
+device, and `--cross-validate` scores each group by the predictor chosen without it
+(`rig.bench.corpus_bench`).
+
 `--stress` runs the stress streams of `predictors.stress` instead (30 to 1000 Hz, clean to noisy,
 jittered, repeated samples, coloured noise, sudden stops), `--trace` files as well or instead.
 
@@ -35,12 +39,14 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 import predictors
-from predictors import Evaluation, Trace, evaluate, read_trace
+from predictors import Evaluation, Trace, read_trace
 from predictors.stress import stress_streams
 from predictors.synthetic import head_motion
 from declared import Flag, Range, setting
+from rig.bench import corpus_bench
 from rig.bench.contract import Bench, Context
-from rig.bench.predictor_scores import BASELINE, HeldOut, Ratios, cost_ratios, label, leave_one_out, ratios
+from rig.bench.corpus_bench import CorpusRun
+from rig.bench.predictor_scores import BASELINE, HeldOut, Ratios, cost_ratios, evaluate_all, label, leave_one_out, ratios
 from rig.commands import choices, options
 from rig.commands.declared_options import add_declared_options
 from rig.errors import ConfigError
@@ -72,24 +78,6 @@ def default_traces(duration_s: float, seed: int) -> list[Trace]:
     """The pendulum, the synthetic head and the two recordings."""
     head = head_motion(duration_s, 120.0, seed).with_noise(0.0005, math.radians(0.1), seed)
     return [pendulum_trace(duration_s, seed), head, *(read_trace(path) for path in RECORDINGS)]
-
-
-def evaluate_all(
-    traces: Sequence[Trace],
-    specs: Sequence[tuple[str, dict[str, Any]]],
-    horizons: Sequence[float],
-    timing_repeats: int,
-    progress: Callable[[float, float], object] | None = None,
-) -> list[Evaluation]:
-    """Every predictor spec on every trace."""
-    results = []
-    total = len(traces) * len(specs)
-    for i, trace in enumerate(traces):
-        for j, (name, params) in enumerate(specs):
-            results.append(evaluate(name, trace, [h / 1e3 for h in horizons], params, timing_repeats))
-            if progress is not None:
-                progress(i * len(specs) + j + 1, total)
-    return results
 
 
 def table(results: Sequence[Evaluation], horizons: Sequence[float]) -> str:
@@ -170,12 +158,19 @@ class Scores:
     held: list[HeldOut]
 
 
-def run(args: argparse.Namespace, context: Context) -> Scores:
+def run(args: argparse.Namespace, context: Context) -> Scores | CorpusRun:
     """Every predictor named (all by default; the baseline always) on every trace (the files, the
-    stress streams, or the default four), then each one named tuned with one trace held out in turn."""
+    stress streams, or the default four), then each one named tuned with one trace held out in turn;
+    or, with --corpus, the corpus bench (`rig.bench.corpus_bench`)."""
     horizons, plot_horizon = args.horizons_ms, args.plot_horizon_ms
     if plot_horizon not in horizons:
         raise ConfigError(f"--plot-horizon-ms {plot_horizon:g} must be one of --horizons-ms {','.join(f'{h:g}' for h in horizons)}")
+    if args.corpus is None and (args.cross_validate or args.manifest is not None):
+        raise ConfigError("--cross-validate and --manifest need --corpus DIR: they group a corpus's recordings")
+    if args.corpus is not None:
+        if args.trace or args.stress or args.leave_one_out:
+            raise ConfigError("--corpus runs on the corpus's recordings alone: leave out --trace, --stress and --leave-one-out")
+        return corpus_bench.run(args, context)
     given = []
     for path in args.trace or []:
         trace, repaired = in_time_order(read_trace(path), args.repair)
@@ -195,8 +190,10 @@ def run(args: argparse.Namespace, context: Context) -> Scores:
     return Scores(horizons, plot_horizon, results, ratios(results, horizons), cost_ratios(results), held)
 
 
-def text(scores: Scores) -> str:
+def text(scores: Scores | CorpusRun) -> str:
     """The scores table, the ratio tables (position where any trace has it), the costs and the held-out table."""
+    if isinstance(scores, CorpusRun):
+        return corpus_bench.text(scores)
     horizons = scores.horizons_ms
     shown = [h for h in horizons if h > 0.0] or list(horizons)
     at = " / ".join(f"{h:g}" for h in shown)
@@ -211,8 +208,10 @@ def text(scores: Scores) -> str:
     return "\n".join(lines)
 
 
-def record(scores: Scores) -> dict[str, Any]:
+def record(scores: Scores | CorpusRun) -> dict[str, Any]:
     """Every score, ratio and held-out result, as JSON-ready values."""
+    if isinstance(scores, CorpusRun):
+        return corpus_bench.record(scores)
     horizons = scores.horizons_ms
     return {
         "horizons_ms": list(horizons),
@@ -266,6 +265,14 @@ def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--predictor", type=options.predictor_spec, action="append", metavar="NAME[:key=value,...]",
                         help="predictor (listed below) and parameters, or NAME:FILE.json; repeat for several (default: every "
                         f"predictor); {BASELINE}, the baseline, is always run")  # fmt: skip
+    parser.add_argument("--corpus", type=Path, metavar="DIR",
+                        help="score on a corpus of recordings instead, by recording and by device, person and scene "
+                        "(labels from the file names or DIR/manifest.csv; see docs/predictor-validation.md)")  # fmt: skip
+    parser.add_argument("--manifest", type=Path, metavar="FILE",
+                        help="with --corpus: the recordings' labels (CSV file,device,person,scene,apart) instead of DIR/manifest.csv")  # fmt: skip
+    parser.add_argument("--cross-validate", action="store_true",
+                        help="with --corpus: choose among the predictors on all groups but one and score the choice on "
+                        "that one, for every person, scene and device")  # fmt: skip
     parser.add_argument("--leave-one-out", type=_tunable, action="append", metavar="NAME",
                         help="tune NAME on all traces but one and score it on that one, for each trace; repeat for several")  # fmt: skip
     add_declared_options(parser, PredictorBenchOptions)
@@ -275,7 +282,8 @@ BENCH = Bench(
     name="predictors",
     help="score every predictor on traces: error against constant velocity at several horizons, and cost per update",
     run=run, table=text, record=record,
-    plot=lambda scores, path: plot(scores.results, scores.plot_horizon_ms, path),
+    plot=lambda scores, path: (corpus_bench.plot(scores, path) if isinstance(scores, CorpusRun)
+                               else plot(scores.results, scores.plot_horizon_ms, path)),
     options=_options,
     outputs={"json": "write every score, ratio and held-out result as JSON", "plot": "draw speed against error"},
 )

@@ -197,6 +197,8 @@ CASES = [
     ("bench-predictors-unknown-predictor", "bench predictors --predictor oracle", "unknown predictor"),
     ("bench-predictors-plot-unknown-format", "bench predictors --plot {lab}/speed.jpgx", "--plot"),
     ("bench-predictors-json-is-a-folder", "bench predictors --json {lab}/mixed", "is a folder"),
+    ("bench-predictors-corpus-missing", "bench predictors --corpus {lab}/nowhere", "is not a folder"),
+    ("bench-predictors-cross-validate-without-corpus", "bench predictors --cross-validate", "need --corpus"),
     ("bench-analyser-json-folder-missing", "bench analyser --quick --json {lab}/nowhere/a.json", "does not exist"),
     ("bench-renderers-csv-wrong-extension", "bench renderers --quick --csv {lab}/rows.txt", "--csv"),
     ("bench-trackers-runs-is-a-file", "bench trackers --quick --runs {lab}/a-file", "is a file"),

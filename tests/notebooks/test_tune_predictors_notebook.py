@@ -1,5 +1,5 @@
 """CI runs the tuning notebook on its small default data, top to bottom, without errors: the tuning,
-and the default predictor's state over a recording."""
+the default predictor's state over a recording, and the choice cross-validated by person and scene."""
 
 from pathlib import Path
 
@@ -17,4 +17,6 @@ def test_tune_predictors_notebook_runs():
     )
     assert "kalman-cv (tuned)" in printed and "slerp" in printed
     assert "tracker noise measured:" in printed and "it trusts" in printed and "adaptive / slerp: angle" in printed
+    assert "leave one person out" in printed and "cross-validated geometric mean over persons:" in printed
+    assert "questpro_walk/user101" in printed and "leave one scene out" in printed
     assert any("image/png" in output.get("data", {}) for cell in notebook.cells for output in cell.get("outputs", []))

@@ -91,7 +91,7 @@ def test_damped_covariance_stays_symmetric_positive_definite_over_extreme_steps(
     assert np.all(np.linalg.eigvalsh(p) > 0.0)
 
 
-@pytest.mark.parametrize("name", ["kalman-cv", "kalman-ca", "auto"])
+@pytest.mark.parametrize("name", ["kalman-cv", "kalman-ca", "auto", "split"])
 @pytest.mark.parametrize("irregular", [False, True], ids=["100Hz", "jittered"])
 def test_a_noiseless_turn_that_slows_down_is_predicted_exactly_by_the_damped_filter(name, irregular):
     rng = np.random.default_rng(2)
@@ -151,7 +151,7 @@ def test_law_a_damped_velocity_never_carries_further_ahead_than_an_undamped_one(
     assert 0.0 <= damped_reach(h, damping) <= h
 
 
-@pytest.mark.parametrize("name", ["kalman-cv", "kalman-ca", "auto"])
+@pytest.mark.parametrize("name", ["kalman-cv", "kalman-ca", "auto", "split"])
 @pytest.mark.parametrize("step", [0.0, 1e-6, 3600.0], ids=["zero", "1us", "an-hour"])
 def test_damped_filters_take_steps_of_zero_one_microsecond_and_an_hour(name, step):
     predictor = make(name, angular_velocity_damping=60.0, max_gap=1e4)
@@ -165,7 +165,7 @@ def test_damped_filters_take_steps_of_zero_one_microsecond_and_an_hour(name, ste
         assert np.linalg.norm(pose.orientation) == pytest.approx(1.0, abs=1e-12)
 
 
-@pytest.mark.parametrize("name", ["kalman-cv", "kalman-ca", "auto"])
+@pytest.mark.parametrize("name", ["kalman-cv", "kalman-ca", "auto", "split"])
 @pytest.mark.parametrize("value", [-1.0, math.nan, math.inf, "fast"])
 def test_a_negative_or_non_finite_damping_is_a_clear_error(name, value):
     with pytest.raises(PredictorError, match=f"{name}: angular_velocity_damping must be a number of 1/s from 0 to 10000"):

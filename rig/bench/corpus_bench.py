@@ -1,0 +1,232 @@
+"""The predictor bench on a corpus of recordings (`rig bench predictors --corpus DIR`): scores by
+recording, by person, scene and device, and, with `--cross-validate`, each group scored by the
+candidate chosen without it.
+
+The recordings and their labels are `predictors.corpus`'s (file names or a manifest); the scores,
+the choosing and the folds `predictors.cross_validation`'s. Every candidate is run on every
+recording once, with constant velocity (`slerp`, the baseline) and `kalman-cv` (the cost
+reference, timed in the same run) always among them. Recordings apart (a robot's) are scored and
+listed but never grouped, chosen on or counted in a geometric mean.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from predictors import DEFAULT, names, resolve
+from predictors.registry import params_of
+from predictors.corpus import GROUPINGS, Recording, read_corpus
+from predictors.cross_validation import REPORTED, CorpusScores, Fold, cross_validate, groups_of, held_out_mean
+from rig.bench.contract import Context
+from rig.bench.predictor_scores import BASELINE, evaluate_all, finite_or_none, label
+from rig.service.tune import check_scorable, in_time_order
+
+COST_REFERENCE = "kalman-cv"
+# The candidates run when none is named: every predictor with its defaults, and those with a damped
+# angular velocity at each rate a head's turn dies away at (1/s; see predictors.kalman) besides.
+DAMPING_GRID = (2.0, 4.0, 8.0)
+DAMPED = ("kalman-cv", "split")
+_PLOTTED_ABOVE_BASELINE = 1.3  # the speed plot leaves out candidates this much worse than constant velocity
+
+
+def default_candidates(names: Sequence[str]) -> list[tuple[str, dict[str, Any]]]:
+    """Every predictor named with its defaults, then each of `DAMPED` at every other damping of `DAMPING_GRID`."""
+    damped = [(name, {"angular_velocity_damping": d}) for name in DAMPED for d in DAMPING_GRID
+              if d != params_of(name).resolve({})["angular_velocity_damping"]]  # fmt: skip
+    return [*((name, {}) for name in names), *damped]
+
+
+@dataclass(frozen=True)
+class CorpusRun:
+    """What the corpus bench found: the recordings, the scores, each candidate's cost over
+    kalman-cv's (median over recordings), the folds per grouping (empty without
+    --cross-validate), the default predictor's label and the horizon the plot shows."""
+
+    recordings: list[Recording]
+    scores: CorpusScores
+    costs: dict[str, float]
+    folds: dict[str, list[Fold]]
+    default: str
+    plot_horizon_ms: float
+
+    @property
+    def shown(self) -> tuple[float, ...]:
+        """The horizons reported (ms): those given, less 0."""
+        return tuple(h for h in self.scores.horizons_ms if h > 0.0) or self.scores.horizons_ms
+
+    def groups(self, by: str) -> dict[str, list[str]]:
+        """Recording names by group under `by`."""
+        return groups_of(self.recordings, by)
+
+
+def run(args: argparse.Namespace, context: Context) -> CorpusRun:
+    """Every candidate on every recording of the corpus, then the folds of each grouping."""
+    recordings = []
+    for recording in read_corpus(args.corpus, args.manifest):
+        trace, repaired = in_time_order(recording.trace, args.repair)
+        recordings.append(replace(recording, trace=trace))
+        if repaired is not None:
+            context.log(f"repaired {repaired}")
+    check_scorable([r.trace for r in recordings], max(args.horizons_ms) / 1e3)
+    specs = args.predictor or default_candidates(names())
+    specs = [*(s for s in ((BASELINE, {}), (COST_REFERENCE, {})) if s not in specs), *specs]
+    results = evaluate_all([r.trace for r in recordings], specs, args.horizons_ms, args.timing_repeats,
+                           context.progress("benchmarking predictors on the corpus"))  # fmt: skip
+    evaluations: dict[str, dict[str, Any]] = {}
+    for result in results:
+        evaluations.setdefault(label(result.predictor, result.params), {})[result.trace] = result
+    scores = CorpusScores(evaluations, BASELINE, tuple(args.horizons_ms))
+    costs = {name: float(np.median([by[r].us_per_update / evaluations[COST_REFERENCE][r].us_per_update for r in by]))
+             for name, by in evaluations.items()}  # fmt: skip
+    folds = {by: cross_validate(scores, groups_of(recordings, by)) for by in GROUPINGS} if args.cross_validate else {}
+    folds = {by: f for by, f in folds.items() if len(f) > 1}
+    return CorpusRun(recordings, scores, costs, folds, resolve(DEFAULT), args.plot_horizon_ms)
+
+
+def _cells(values: Sequence[float]) -> str:
+    return " / ".join("-" if not math.isfinite(v) else f"{v:.3f}" for v in values)
+
+
+def recording_table(found: CorpusRun) -> str:
+    """Per recording: its labels, constant velocity's RMS and 95th-percentile angular error (deg)
+    and RMS position error (mm) at each horizon, and each candidate's angular ratio at the plot horizon."""
+    scores, h = found.scores, found.plot_horizon_ms
+    head = ("| recording | device | person | scene | constant velocity: angular RMS, p95 (deg); position RMS (mm) at "
+            + " / ".join(f"{x:g}" for x in found.shown) + " ms | " + " | ".join(scores.candidates) + " |")
+    rows = [head, "|" + "---|" * (5 + len(scores.candidates))]
+    for r in found.recordings:
+        base = [scores.evaluations[BASELINE][r.name].at(x) for x in found.shown]
+        cv = "; ".join(f"{b.angular_rms_deg:.2f}, {b.angular_p95_deg:.2f}; {b.position_rms_mm:.1f}" for b in base)
+        ratios = [f"{scores.ratio(c, r.name, 'angular', h):.3f}" for c in scores.candidates]
+        person = f"{r.person} (apart)" if r.apart else r.person
+        rows.append(f"| {r.name} | {r.device} | {person} | {r.scene or '-'} | {cv} | " + " | ".join(ratios) + " |")
+    return "\n".join(rows)
+
+
+def candidate_table(found: CorpusRun, by: str) -> str:
+    """Per candidate, over the groups under `by`: the geometric mean of angular RMS, angular p95 and
+    position RMS ratios per horizon, the worst recording's angular ratio, and the cost."""
+    scores, groups = found.scores, found.groups(by)
+    names = [r for members in groups.values() for r in members]
+    rows = [f"| candidate | angular RMS | angular p95 | position RMS | worst recording, angular | cost / {COST_REFERENCE} |",
+            "|---|---|---|---|---|---|"]  # fmt: skip
+    for c in scores.candidates:
+        cells = [_cells([scores.corpus_ratio(c, groups, part, h) for h in found.shown]) for part in ("angular", "angular_p95", "position")]
+        worst = _cells([scores.worst(c, names, "angular", h) for h in found.shown])
+        rows.append(f"| {c} | " + " | ".join(cells) + f" | {worst} | {found.costs[c]:.2f} |")
+    return "\n".join(rows)
+
+
+def fold_table(found: CorpusRun, by: str) -> str:
+    """Per group held out: the candidate chosen on the others, its ratios there (angular RMS and
+    p95, position RMS, worst recording), and the default's and kalman-cv's angular ratios beside."""
+    scores, at = found.scores, " / ".join(f"{h:g}" for h in found.shown)
+    rows = [f"| held out ({by}) | recordings | chosen on the others | angular RMS | angular p95 | position RMS | worst recording, "
+            f"angular | {found.default}, angular | {COST_REFERENCE}, angular |", "|" + "---|" * 9]  # fmt: skip
+    for fold in found.folds[by]:
+        cells = [_cells([fold.ratios[part][h] for h in found.shown]) for part in ("angular", "angular_p95", "position")]
+        fixed = [_cells([scores.group_ratio(c, fold.recordings, "angular", h) for h in found.shown])
+                 if c in scores.evaluations else "-" for c in (found.default, COST_REFERENCE)]  # fmt: skip
+        rows.append(f"| {fold.group} | {len(fold.recordings)} | {fold.chosen} | " + " | ".join(cells) + " | "
+                    + _cells([fold.worst["angular"][h] for h in found.shown]) + " | " + " | ".join(fixed) + " |")
+    means = [_cells([held_out_mean(found.folds[by], part, h) for h in found.shown]) for part in ("angular", "angular_p95", "position")]
+    rows.append(f"| geometric mean over groups | | | " + " | ".join(means) + " | | | |")
+    return f"(ratios to constant velocity at {at} ms)\n" + "\n".join(rows)
+
+
+def text(found: CorpusRun) -> str:
+    """The recording table, the candidates by person, and each grouping's folds with its
+    cross-validated geometric mean."""
+    at = " / ".join(f"{h:g}" for h in found.shown)
+    lines = [recording_table(found),
+             f"\nby person (geometric mean over people; ratios to constant velocity at {at} ms), chosen on all of them: "
+             f"{found.scores.choose(found.groups('person'))}", candidate_table(found, "person")]  # fmt: skip
+    for by, folds in found.folds.items():
+        lines += [f"\nleave one {by} out: chosen on the others, scored on the one held out", fold_table(found, by)]
+        lines.append(f"cross-validated ({by}): angular RMS / constant velocity at {at} ms: "
+                     + _cells([held_out_mean(folds, "angular", h) for h in found.shown]))  # fmt: skip
+    return "\n".join(lines)
+
+
+def _ratios(found: CorpusRun, candidate: str, recordings: Sequence[str]) -> dict[str, dict[str, float | None]]:
+    """The candidate's ratios over the recordings (their geometric mean) per reported part and horizon."""
+    out = {part: {f"{h:g}": found.scores.group_ratio(candidate, recordings, part, h) for h in found.shown} for part in REPORTED}
+    return {part: {h: finite_or_none(v) for h, v in by.items()} for part, by in out.items()}
+
+
+def record(found: CorpusRun) -> dict[str, Any]:
+    """Labels, every evaluation, each candidate's ratios per recording and group, the folds and
+    the cross-validated means, as JSON-ready values."""
+    scores = found.scores
+    groupings = {by: found.groups(by) for by in GROUPINGS}
+    return {
+        "horizons_ms": list(found.shown),
+        "baseline": BASELINE,
+        "cost_reference": COST_REFERENCE,
+        "default": found.default,
+        "recordings": [{"name": r.name, "device": r.device, "person": r.person, "scene": r.scene, "apart": r.apart} for r in found.recordings],
+        "candidates": {
+            c: {
+                "cost_over_kalman_cv": found.costs[c],
+                "recordings": {r.name: _ratios(found, c, [r.name]) for r in found.recordings},
+                "groups": {by: {g: _ratios(found, c, members) for g, members in groups.items()} for by, groups in groupings.items()},
+                "geometric_mean": {by: {part: {f"{h:g}": finite_or_none(scores.corpus_ratio(c, groups, part, h)) for h in found.shown}
+                                        for part in REPORTED} for by, groups in groupings.items()},  # fmt: skip
+            }
+            for c in scores.candidates
+        },
+        "cross_validation": {
+            by: {
+                "folds": [{"group": f.group, "recordings": list(f.recordings), "chosen": f.chosen,
+                           "ratios": _ratios(found, f.chosen, f.recordings)} for f in folds],  # fmt: skip
+                "geometric_mean": {part: {f"{h:g}": finite_or_none(held_out_mean(folds, part, h)) for h in found.shown}
+                                   for part in REPORTED},  # fmt: skip
+            }
+            for by, folds in found.folds.items()
+        },
+        "results": [e.to_dict() for by in scores.evaluations.values() for e in by.values()],
+    }
+
+
+def plot(found: CorpusRun, path: Path) -> None:
+    """Left: each candidate's geometric mean over people of angular RMS / constant velocity at the
+    plot horizon against its cost over kalman-cv's. Right: per person held out, the chosen
+    candidate's angular ratio at each horizon (or, without folds, the default's)."""
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(13.0, 5.0))
+    left, right = figure.subplots(1, 2)
+    scores, groups, h = found.scores, found.groups("person"), found.plot_horizon_ms
+    ratios = {c: scores.corpus_ratio(c, groups, "angular", h) for c in scores.candidates}
+    shown = {c: r for c, r in ratios.items() if r <= _PLOTTED_ABOVE_BASELINE}
+    for c, ratio in shown.items():
+        left.scatter(found.costs[c], ratio)
+        left.annotate(c, (found.costs[c], ratio), textcoords="offset points", xytext=(4, 4), fontsize="small")
+    left.axhline(1.0, color="grey", linewidth=0.8)
+    hidden = ", ".join(c for c in ratios if c not in shown)
+    left.set(xlabel=f"cost per update + predict / {COST_REFERENCE}'s", ylabel=f"angular RMS / constant velocity at {h:g} ms",
+             title="geometric mean over people" + (f" (above {_PLOTTED_ABOVE_BASELINE:g}: {hidden})" if hidden else ""))  # fmt: skip
+    folds = found.folds.get("person")
+    names = [f.group for f in folds] if folds else list(groups)
+    width = 0.8 / len(found.shown)
+    heights: list[float] = []
+    for k, horizon in enumerate(found.shown):
+        values = ([f.ratios["angular"][horizon] for f in folds] if folds
+                  else [scores.group_ratio(found.default, groups[g], "angular", horizon) for g in names])  # fmt: skip
+        right.bar(np.arange(len(names)) + k * width, values, width, label=f"{horizon:g} ms")
+        heights += values
+    right.axhline(1.0, color="grey", linewidth=0.8)
+    heights = [v for v in heights if math.isfinite(v)]
+    right.set_ylim(0.95 * min([*heights, 1.0]), 1.02 * max([*heights, 1.0]))
+    right.set_xticks(np.arange(len(names)) + 0.4 - width / 2, names, rotation=60, ha="right", fontsize="small")
+    right.set(ylabel="angular RMS / constant velocity",
+              title="held out: chosen on the other people" if folds else f"{found.default} per person")  # fmt: skip
+    right.legend(fontsize="small")
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)
