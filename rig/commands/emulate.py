@@ -1,13 +1,16 @@
 """`rig emulate-tracker serial|lsl`: an emulated tracker for tests and demos.
 
-    rig emulate-tracker serial --pty /tmp/tracker [--profile binary-pose] [--rate 1000] [--duration 10]
+    rig emulate-tracker serial --pty /tmp/tracker [--profile csv] [--rate 1000] [--duration 10]
     rig emulate-tracker serial --tcp 7777 ...
     rig emulate-tracker lsl --name RigPose ...
 
 It streams the simulated tracker (`rig.sim.tracker`: on the simulated pendulum, or --trace FILE
 played in a loop) once a reader connects: exact and sent at once unless --noise-mm, --noise-deg,
 --delay-ms, --jitter-ms or --dropout say otherwise, with --faults on demand; with --log FILE it
-writes what became of every record it measured.
+writes what became of every record it measured. It ends when it has sent --duration seconds, when
+its reader hangs up, or when no reader has come within --idle-timeout seconds; it never keeps
+records for a reader that is not reading them (they are logged `unread`). Its default profile is
+the serial tracker's, so `--tracker serial:PORT` reads it as it is.
 """
 
 from __future__ import annotations
@@ -19,6 +22,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from rig.commands import options, outputs
+from rig.commands.declared_options import add_declared_option
+from rig.devices.trackers.serial_tracker import DEFAULT_PROFILE
 from rig.emulate import EmulatorConfig, make_sink, run_emulator
 from rig.errors import ConfigError
 from rig.sim.tracker import TrackerConfig
@@ -49,12 +54,13 @@ def _run(args: argparse.Namespace) -> int:
             dropout=args.dropout,
         ),
         duration_s=args.duration,
-        profile=getattr(args, "profile", "binary-pose"),
+        profile=getattr(args, "profile", DEFAULT_PROFILE),
         trace=args.trace,
         faults=args.faults,
         seed=args.seed,
         drift_ppm=getattr(args, "drift_ppm", 0.0),
         log=args.log,
+        idle_timeout_s=args.idle_timeout,
     )
     sink = make_sink(config)
     config = replace(config, address=sink.address)
@@ -69,7 +75,7 @@ def _run(args: argparse.Namespace) -> int:
     finally:
         sink.close()
     summary = {"tracker": spec, "faults": config.faults.label, "sent": counts.sent, "intact": counts.intact,
-               "damaged": counts.damaged, "lost": counts.lost}  # fmt: skip
+               "damaged": counts.damaged, "lost": counts.lost, "unread": counts.unread}  # fmt: skip
     print(json.dumps(summary) if args.json else ", ".join(f"{k} {v}" for k, v in summary.items()))
     return 0
 
@@ -88,6 +94,7 @@ def _common(parser: argparse.ArgumentParser) -> None:
                         "(default: none)")  # fmt: skip
     parser.add_argument("--seed", type=int, default=0, help="seed of the noise, jitter, dropouts and faults (default: %(default)s)")
     parser.add_argument("--log", type=outputs.csv_file, metavar="FILE.csv", help="write every record's seq, device time, write time and fate")
+    add_declared_option(parser, EmulatorConfig, "idle_timeout_s")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     parser.set_defaults(func=_run)
 
@@ -104,7 +111,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     where = serial.add_mutually_exclusive_group(required=True)
     where.add_argument("--pty", type=Path, metavar="LINK", help="make a pseudo-terminal reachable at this path (a symlink)")
     where.add_argument("--tcp", type=options.non_negative_int, metavar="PORT", help="serve on 127.0.0.1:PORT (0: any free port)")
-    serial.add_argument("--profile", default="binary-pose", help="record format: a shipped profile or a .toml file (default: %(default)s)")
+    serial.add_argument("--profile", default=DEFAULT_PROFILE,
+                        help="record format: a shipped profile or a .toml file (default: %(default)s, as the serial tracker reads)")  # fmt: skip
     serial.add_argument("--drift-ppm", type=float, default=0.0, help="the device clock's rate error in ppm (default: 0)")
     _common(serial)
     lsl = transports.add_parser("lsl", help="a 7-channel LSL pose stream")
