@@ -22,7 +22,9 @@ an LSL outlet, with the emulator's log of every record's fate) and records it in
 * latency_ms_median, latency_ms_p95: from the emulator's write of a record to its arrival, when
   the reader has queued it and a predictor's `poll()` gets it, both on the monotonic clock.
 
-Rows are keyed by the device's time (to the microsecond), which every emulated record carries.
+Rows are keyed by the device's time (to the microsecond), which every emulated record carries. A
+case that cannot run (its emulator does not start, or does not end once its recording has) is a
+row with `failed` and the reason, and the cases after it still run.
 
 The machine's share of the CPU figures is measured beside them, before each case (`wake_floor`,
 2 s): the CPU a bare Python thread spends per record reading the serial emulator's pty at the
@@ -63,6 +65,8 @@ TARGET_LATENCY_MEDIAN_MS = 1.0
 TARGET_LATENCY_P95_MS = 2.0
 # Recording runs this much longer than the emulator sends, for it to find its reader and finish.
 RECORD_MARGIN_S = 3.0
+# An emulator waits this long for its reader, and is given this long beyond its own duration to end
+# once its recording has: it ends as soon as its reader hangs up, or once it has sent everything.
 START_TIMEOUT_S = 30.0
 WAKE_FLOOR_S = 2.0
 
@@ -95,13 +99,15 @@ def _emulator_command(case: Case, address: str, rate_hz: float, duration_s: floa
         command += ["--name", address]
     else:
         command += [f"--{case.transport}", address, "--profile", case.profile]
-    return command + ["--rate", f"{rate_hz:g}", "--duration", f"{duration_s:g}", "--faults", case.faults, "--log", str(log)]
+    return command + ["--rate", f"{rate_hz:g}", "--duration", f"{duration_s:g}", "--faults", case.faults, "--log", str(log),
+                      "--idle-timeout", f"{START_TIMEOUT_S:g}"]  # fmt: skip
 
 
 @contextmanager
-def _emulator(command: list[str], folder: Path) -> Iterator[tuple[subprocess.Popen, str]]:
-    """The emulator, started, and the tracker spec it printed once ready; on the way out it is
-    waited for (killed if the block failed or it does not end) and its pipe closed."""
+def _emulator(command: list[str], folder: Path, duration_s: float) -> Iterator[tuple[subprocess.Popen, str]]:
+    """The emulator sending for `duration_s`, started, and the tracker spec it printed once ready; on
+    the way out it is waited for (killed if the block failed, RigError if it does not end) and its
+    pipe closed."""
     with open(folder / "emulator.err", "w") as errors:
         process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=errors, text=True)
     try:
@@ -109,7 +115,10 @@ def _emulator(command: list[str], folder: Path) -> Iterator[tuple[subprocess.Pop
         if "--tracker " not in line:
             raise RigError(f"the tracker emulator did not start: {(folder / 'emulator.err').read_text()[-500:]}")
         yield process, line.rsplit("--tracker ", 1)[1].strip()
-        process.wait(timeout=START_TIMEOUT_S)
+        try:
+            process.wait(timeout=duration_s + START_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            raise RigError(f"the tracker emulator had not ended {duration_s + START_TIMEOUT_S:g} s after its recording") from None
     finally:
         if process.poll() is None:
             process.kill()
@@ -143,7 +152,7 @@ def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: L
         origin = clock.origin_ns / 1e9
         arrivals.extend((record.device_time, origin + record.t_arrival) for record in records)
 
-    with _emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder) as (_, spec):
+    with _emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder, duration_s) as (_, spec):
         cpu = resource.getrusage(resource.RUSAGE_SELF)
         recording = record_tracker(spec, duration_s + RECORD_MARGIN_S, folder / "recording", overwrite=True,
                                    on_batch=on_batch, clock=clock)  # fmt: skip
@@ -191,7 +200,7 @@ def wake_floor(rate_hz: float, duration_s: float, folder: Path) -> float:
     case = Case("serial", "pty", "binary-pose", "none")
     link = folder / "tracker"
     received = 0
-    with _emulator(_emulator_command(case, str(link), rate_hz, duration_s, folder / "sent.csv"), folder) as (process, _):
+    with _emulator(_emulator_command(case, str(link), rate_hz, duration_s, folder / "sent.csv"), folder, duration_s) as (process, _):
         started = time.thread_time()
         fd = os.open(link, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY)
         try:
@@ -213,8 +222,23 @@ def wake_floor(rate_hz: float, duration_s: float, folder: Path) -> float:
     return cpu_s / max(records, 1.0) * 1e6
 
 
+def failed_row(case: Case, rate_hz: float, duration_s: float, reason: str) -> dict[str, Any]:
+    """The row of a case that could not run: what it was, and why."""
+    return {"source": case.source, "transport": case.transport, "profile": case.profile or "pose (7 channels)", "faults": case.faults,
+            "rate_hz": rate_hz, "duration_s": duration_s, "failed": reason}  # fmt: skip
+
+
+def measured(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows of the cases that ran."""
+    return [row for row in rows if "failed" not in row]
+
+
 def targets(rows: list[dict[str, Any]]) -> dict[str, bool]:
-    """The issue's targets, met or not, in this run."""
+    """The targets, met or not, in this run: a case that failed meets none of those it is under."""
+    ran = measured(rows)
+    if len(ran) < len(rows):
+        return {"every case ran": False}
+    rows = ran
     clean = [r for r in rows if r["faults"] == "none"]
     faulty = [r for r in rows if r["faults"] != "none"]
     return {
@@ -257,9 +281,14 @@ def run(args: argparse.Namespace, context: Context) -> list[dict[str, Any]]:
     rows = []
     for index, case in enumerate(cases(fault_at_s=args.duration / 2.0)):
         load = os.getloadavg()[0]
-        floor = wake_floor(args.rate, WAKE_FLOOR_S, context.folder / f"floor{index}")
-        before = cpu_ticks()
-        row = run_case(case, args.rate, args.duration, context.folder / f"case{index}", context.log)
+        try:
+            floor = wake_floor(args.rate, WAKE_FLOOR_S, context.folder / f"floor{index}")
+            before = cpu_ticks()
+            row = run_case(case, args.rate, args.duration, context.folder / f"case{index}", context.log)
+        except RigError as error:
+            context.log(f"{case.source}/{case.transport} faults {case.faults}: failed: {error}")
+            rows.append({**failed_row(case, args.rate, args.duration, str(error)), "load_average_1min": load})
+            continue
         rows.append({**row, "load_average_1min": load, "wake_floor_us": floor, "stolen_cpu_pct": stolen_pct(before, cpu_ticks())})
     return rows
 
@@ -267,7 +296,7 @@ def run(args: argparse.Namespace, context: Context) -> list[dict[str, Any]]:
 def machine_noise(rows: list[dict[str, Any]]) -> str:
     """The machine's load and the CPU its host took, over the cases."""
     loads = [row["load_average_1min"] for row in rows]
-    stolen = [row["stolen_cpu_pct"] for row in rows if row["stolen_cpu_pct"] is not None]
+    stolen = [row["stolen_cpu_pct"] for row in rows if row.get("stolen_cpu_pct") is not None]
     return (f"machine noise: {os.cpu_count()} CPUs, 1-minute load average {min(loads):.2f} to {max(loads):.2f} over the cases"
             + (f", CPU stolen by the virtual machine's host {min(stolen):.1f} to {max(stolen):.1f} %" if stolen else ""))  # fmt: skip
 
@@ -279,6 +308,9 @@ def table(rows: list[dict[str, Any]]) -> str:
     )
     lines = [head, "|" + " --- |" * (head.count("|") - 1)]
     for r in rows:
+        if "failed" in r:
+            lines.append(f"| {r['source']} | {r['transport']} | {r['profile']} | {r['faults']} | failed: {r['failed']} |")
+            continue
         latency = f"{r['latency_ms_median']:.3f}, {r['latency_ms_p95']:.3f}" if r["latency_ms_median"] is not None else "n/a"
         stolen = f"{r['stolen_cpu_pct']:.1f}" if r.get("stolen_cpu_pct") is not None else "n/a"
         lines.append(
@@ -290,9 +322,10 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 
 def plot(rows: list[dict[str, Any]], path: Path) -> None:
-    """CPU per sample and added latency (median and 95th percentile) per case."""
+    """CPU per sample and added latency (median and 95th percentile) per case that ran."""
     from matplotlib.figure import Figure
 
+    rows = measured(rows)
     labels = ["\n".join([f"{r['source']}/{r['transport']}", *r["faults"].split(",")]) for r in rows]
     x = np.arange(len(rows))
     figure = Figure(figsize=(max(6.0, 1.6 * len(rows)) + 2.5, 7.0))
@@ -336,6 +369,7 @@ BENCH = Bench(
     name="trackers",
     help="the serial and LSL tracker sources fed by the emulators: loss, fabrication, CPU per sample, added latency",
     run=run, table=table, targets=targets, notes=machine_noise, plot=plot, options=_options,
+    all_failed=lambda rows: "every case failed; each row says why" if not measured(rows) else None,
     outputs={"json": "write the rows as a JSON list", "plot": "plot CPU per sample and latency per case"},
     runs="keep the recordings and emulator logs here (default: a temporary folder)",
 )
