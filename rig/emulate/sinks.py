@@ -114,6 +114,11 @@ class PtySink:
         written = time.monotonic()
         return list(damaged[: self._outbox.send(chunks)]), written
 
+    def linger(self, seconds: float) -> None:
+        poller = select.poll()
+        poller.register(self._master, select.POLLHUP)
+        poller.poll(round(seconds * 1e3))
+
     def disconnect(self) -> None:
         os.close(self._master)
         self._master = -1
@@ -212,6 +217,10 @@ class TcpSink:
             raise ReaderGone from None
         return list(damaged[:taken]), written
 
+    def linger(self, seconds: float) -> None:
+        if self._client is not None:
+            select.select([self._client], [], [], seconds)  # readable once the client has closed its end
+
     def disconnect(self) -> None:
         for sock in (self._client, self._listener):
             if sock is not None:
@@ -258,6 +267,9 @@ class LslSink:
         for emission in emissions:
             self._outlet.push_sample([*emission.position, *emission.orientation], emission.device_time)
         return [False] * len(emissions), written
+
+    def linger(self, seconds: float) -> None:
+        time.sleep(seconds)  # an outlet does not say when its consumers have pulled what it holds
 
     def disconnect(self) -> None:
         self._outlet = None

@@ -27,10 +27,11 @@ SENT_COLUMNS = ("seq", "device_time", "t_write", "fate")
 READER_TIMEOUT_S = 60.0
 # How long after its last record the emulator waits for a reader to come back from a disconnect.
 READER_RETURN_S = 2.0
-# At the end the emulator lets the reader take what is in flight; before a disconnect, longer (up
-# to half the time the port is away), as a closed pty loses what its reader has not read yet and a
-# reader on a loaded machine may wait that long for the CPU.
-DRAIN_S = 0.05
+# At the end the emulator keeps the port open up to this long for the reader to take what is in
+# flight (less once the reader hangs up), as a closed pty loses what its reader has not read yet and
+# a reader on a loaded machine may wait that long for the CPU; before a disconnect, up to half the
+# time the port is away.
+DRAIN_S = 1.0
 DISCONNECT_DRAIN_S = 0.25
 
 
@@ -48,6 +49,9 @@ class Sink(Protocol):
     def disconnect(self) -> None: ...
 
     def reconnect(self, stop_at: float) -> bool: ...
+
+    def linger(self, seconds: float) -> None:
+        """Keeps the port open up to `seconds` for the reader to take what is in flight, less once it hangs up."""
 
     def close(self) -> None: ...
 
@@ -132,9 +136,9 @@ def stream(
             damaged, t_write = sink.send(emissions, rate_hz)
         except ReaderGone:
             on_event("the reader went away; stopping")
-            break
+            return counts
         fates = ["damaged" if d else "intact" for d in damaged]
         record(emissions, fates + ["unread"] * (len(emissions) - len(fates)), t_write)
         k = group
-    time.sleep(DRAIN_S)
+    sink.linger(DRAIN_S)
     return counts

@@ -217,6 +217,7 @@ class ScriptedSink:
         self.reader = reader
         self.takes = list(takes)
         self.deadline: float | None = None
+        self.lingered: float | None = None
 
     def wait_for_reader(self, stop_at: float) -> bool:
         self.deadline = stop_at
@@ -231,6 +232,9 @@ class ScriptedSink:
 
     def reconnect(self, stop_at: float) -> bool:
         return False
+
+    def linger(self, seconds: float) -> None:
+        self.lingered = seconds
 
     def close(self) -> None: ...
 
@@ -265,8 +269,10 @@ def test_no_reader_within_the_idle_timeout_sends_nothing(fake_time: None) -> Non
 
 
 def test_records_the_port_did_not_take_are_counted_unread_and_the_stream_ends_when_the_reader_goes(fake_time: None) -> None:
-    counts, _ = _stream(ScriptedSink(reader=True, takes=[4]), 10)
+    sink = ScriptedSink(reader=True, takes=[4])
+    counts, _ = _stream(sink, 10)
     assert (counts.intact, counts.unread, counts.sent) == (4, 6, 4)
+    assert sink.lingered == streamer.DRAIN_S, "once all is sent, the reader may take what is in flight"
     counts, events = _stream(ScriptedSink(reader=True, takes=[1, 0, 1]), 10, step_s=1e-3)
     assert (counts.intact, counts.unread, counts.lost) == (2, 1, 0)
     assert events[-1] == "the reader went away; stopping"
