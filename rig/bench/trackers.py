@@ -6,7 +6,8 @@ latency from the emulator's write to the sample's queueing for a predictor.
 
 Each case starts `rig emulate-tracker` in a process of its own (a pseudo-terminal, a TCP socket or
 an LSL outlet, with the emulator's log of every record's fate) and records it in this process with
-`rig.service.tracker_recording.record_tracker`, as `rig record-tracker` does. Then:
+`rig.service.tracker_recording.record_tracker`, as `rig record-tracker` does, until the emulator has
+ended (it has sent everything, or lost its reader) and what was in flight has arrived. Then:
 
 * sent, recorded: records the emulator wrote (intact or damaged) and rows in tracker.csv;
 * missing: intact records sent that are not in tracker.csv; fabricated: rows that match no intact
@@ -46,7 +47,7 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
@@ -63,8 +64,8 @@ from rig.service.tracker_recording import record_tracker
 TARGET_US_PER_SAMPLE = 50.0
 TARGET_LATENCY_MEDIAN_MS = 1.0
 TARGET_LATENCY_P95_MS = 2.0
-# Recording runs this much longer than the emulator sends, for it to find its reader and finish.
-RECORD_MARGIN_S = 3.0
+# Recording goes on this long after the emulator has ended, for the reader to take what is in flight.
+SETTLE_S = 2.0
 # An emulator waits this long for its reader, and is given this long beyond its own duration to end
 # once its recording has: it ends as soon as its reader hangs up, or once it has sent everything.
 START_TIMEOUT_S = 30.0
@@ -126,6 +127,20 @@ def _emulator(command: list[str], folder: Path, duration_s: float) -> Iterator[t
         process.stdout.close()
 
 
+def _ended(process: subprocess.Popen, clock: MonotonicClock) -> Callable[[], bool]:
+    """Whether the emulator `process` ended SETTLE_S ago or more: it has sent all it was asked to (a
+    recording that stopped at a fixed time would cut short an emulator that a loaded machine started
+    late, and count what it sent after as missing)."""
+    ended_at: list[float] = []
+
+    def ended() -> bool:
+        if not ended_at and process.poll() is not None:
+            ended_at.append(clock.now())
+        return bool(ended_at) and clock.now() >= ended_at[0] + SETTLE_S
+
+    return ended
+
+
 def _sent(log: Path) -> tuple[dict[int, float], int, int]:
     """The intact records' write times by device time (us), and counts of damaged and lost ones."""
     intact: dict[int, float] = {}
@@ -152,10 +167,10 @@ def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: L
         origin = clock.origin_ns / 1e9
         arrivals.extend((record.device_time, origin + record.t_arrival) for record in records)
 
-    with _emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder, duration_s) as (_, spec):
+    with _emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder, duration_s) as (process, spec):
         cpu = resource.getrusage(resource.RUSAGE_SELF)
-        recording = record_tracker(spec, duration_s + RECORD_MARGIN_S, folder / "recording", overwrite=True,
-                                   on_batch=on_batch, clock=clock)  # fmt: skip
+        recording = record_tracker(spec, duration_s + START_TIMEOUT_S, folder / "recording", overwrite=True,
+                                   on_batch=on_batch, clock=clock, until=_ended(process, clock))  # fmt: skip
     used = resource.getrusage(resource.RUSAGE_SELF)
     cpu_s = (used.ru_utime - cpu.ru_utime) + (used.ru_stime - cpu.ru_stime)
     intact, damaged, lost = _sent(sent_log)
