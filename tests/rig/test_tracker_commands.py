@@ -13,6 +13,7 @@ import pytest
 
 from rig.cli import main
 from rig.devices.trackers.serial_tracker import DEFAULT_PROFILE
+from rig.service.tracker_recording import record_tracker
 
 
 @pytest.mark.parametrize(
@@ -48,6 +49,11 @@ def test_a_tracker_that_sends_nothing_is_a_failed_recording_that_leaves_nothing(
     assert len(err.splitlines()) == 1 and "no sample arrived from serial:loop://" in err
     assert "received 0" in captured.out and "wrote" not in captured.out
     assert not out.exists()
+
+
+def test_a_recording_ends_when_told_to_before_its_duration(tmp_path: Path) -> None:
+    recording = record_tracker("serial:loop://", 600.0, tmp_path / "out", until=lambda: True)
+    assert recording.samples == 0 and recording.sidecar["partial"] is False
 
 
 def test_emulator_faults_are_checked(capsys: pytest.CaptureFixture[str]) -> None:
