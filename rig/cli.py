@@ -48,6 +48,7 @@ COMMANDS = {
     "emulate-tracker": "emulate",
     "record": "record",
     "measure": "measure",
+    "check": "check",
 }
 """Each command and its module in rig.commands, in the order `rig --help` lists them."""
 EXIT_FAULT = 1

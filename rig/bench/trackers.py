@@ -6,7 +6,8 @@ latency from the emulator's write to the sample's queueing for a predictor.
 
 Each case starts `rig emulate-tracker` in a process of its own (a pseudo-terminal, a TCP socket or
 an LSL outlet, with the emulator's log of every record's fate) and records it in this process with
-`rig.service.tracker_recording.record_tracker`, as `rig record-tracker` does. Then:
+`rig.service.tracker_recording.record_tracker`, as `rig record-tracker` does, until the emulator has
+ended (it has sent everything, or lost its reader) and what was in flight has arrived. Then:
 
 * sent, recorded: records the emulator wrote (intact or damaged) and rows in tracker.csv;
 * missing: intact records sent that are not in tracker.csv; fabricated: rows that match no intact
@@ -22,7 +23,9 @@ an LSL outlet, with the emulator's log of every record's fate) and records it in
 * latency_ms_median, latency_ms_p95: from the emulator's write of a record to its arrival, when
   the reader has queued it and a predictor's `poll()` gets it, both on the monotonic clock.
 
-Rows are keyed by the device's time (to the microsecond), which every emulated record carries.
+Rows are keyed by the device's time (to the microsecond), which every emulated record carries. A
+case that cannot run (its emulator does not start, or does not end once its recording has) is a
+row with `failed` and the reason, and the cases after it still run.
 
 The machine's share of the CPU figures is measured beside them, before each case (`wake_floor`,
 2 s): the CPU a bare Python thread spends per record reading the serial emulator's pty at the
@@ -44,7 +47,7 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
@@ -62,10 +65,11 @@ from rig.sim.tracker import TrackerConfig
 TARGET_US_PER_SAMPLE = 50.0
 TARGET_LATENCY_MEDIAN_MS = 1.0
 TARGET_LATENCY_P95_MS = 2.0
-# Recording runs this much longer than the emulator sends, for it to find its reader and finish.
-RECORD_MARGIN_S = 3.0
+# Recording goes on this long after the emulator has ended, for the reader to take what is in flight.
+SETTLE_S = 2.0
+# An emulator waits this long for its reader, and is given this long beyond its own duration to end
+# once its recording has: it ends as soon as its reader hangs up, or once it has sent everything.
 START_TIMEOUT_S = 30.0
-"""How long the emulator may take to start, and to finish after the recording (beyond its duration)."""
 WAKE_FLOOR_S = 2.0
 
 
@@ -97,14 +101,15 @@ def _emulator_command(case: Case, address: str, rate_hz: float, duration_s: floa
         command += ["--name", address]
     else:
         command += [f"--{case.transport}", address, "--profile", case.profile]
-    return command + ["--rate", f"{rate_hz:g}", "--duration", f"{duration_s:g}", "--faults", case.faults, "--log", str(log)]
+    return command + ["--rate", f"{rate_hz:g}", "--duration", f"{duration_s:g}", "--faults", case.faults, "--log", str(log),
+                      "--idle-timeout", f"{START_TIMEOUT_S:g}"]  # fmt: skip
 
 
 @contextmanager
 def _emulator(command: list[str], folder: Path, duration_s: float) -> Iterator[tuple[subprocess.Popen, str]]:
-    """The emulator, started, and the tracker spec it printed once ready; on the way out it is
-    waited for (killed if the block failed or it does not end within its `duration_s` and
-    START_TIMEOUT_S: RigError) and its pipe closed."""
+    """The emulator sending for `duration_s`, started, and the tracker spec it printed once ready; on
+    the way out it is waited for (killed if the block failed, RigError if it does not end) and its
+    pipe closed."""
     with open(folder / "emulator.err", "w") as errors:
         process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=errors, text=True)
     try:
@@ -115,13 +120,26 @@ def _emulator(command: list[str], folder: Path, duration_s: float) -> Iterator[t
         try:
             process.wait(timeout=duration_s + START_TIMEOUT_S)
         except subprocess.TimeoutExpired:
-            raise RigError(f"the tracker emulator did not finish {duration_s + START_TIMEOUT_S:g} s after it started sending "
-                           "(a machine this loaded cannot run the case)") from None  # fmt: skip
+            raise RigError(f"the tracker emulator had not ended {duration_s + START_TIMEOUT_S:g} s after its recording") from None
     finally:
         if process.poll() is None:
             process.kill()
             process.wait()
         process.stdout.close()
+
+
+def _ended(process: subprocess.Popen, clock: MonotonicClock) -> Callable[[], bool]:
+    """Whether the emulator `process` ended SETTLE_S ago or more: it has sent all it was asked to (a
+    recording that stopped at a fixed time would cut short an emulator that a loaded machine started
+    late, and count what it sent after as missing)."""
+    ended_at: list[float] = []
+
+    def ended() -> bool:
+        if not ended_at and process.poll() is not None:
+            ended_at.append(clock.now())
+        return bool(ended_at) and clock.now() >= ended_at[0] + SETTLE_S
+
+    return ended
 
 
 def _sent(log: Path) -> tuple[dict[int, float], int, int]:
@@ -150,10 +168,10 @@ def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: L
         origin = clock.origin_ns / 1e9
         arrivals.extend((record.device_time, origin + record.t_arrival) for record in records)
 
-    with _emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder, duration_s) as (_, spec):
+    with _emulator(_emulator_command(case, address, rate_hz, duration_s, sent_log), folder, duration_s) as (process, spec):
         cpu = resource.getrusage(resource.RUSAGE_SELF)
-        recording = record_tracker(spec, duration_s + RECORD_MARGIN_S, folder / "recording", overwrite=True,
-                                   on_batch=on_batch, clock=clock)  # fmt: skip
+        recording = record_tracker(spec, duration_s + START_TIMEOUT_S, folder / "recording", overwrite=True,
+                                   on_batch=on_batch, clock=clock, until=_ended(process, clock))  # fmt: skip
     used = resource.getrusage(resource.RUSAGE_SELF)
     cpu_s = (used.ru_utime - cpu.ru_utime) + (used.ru_stime - cpu.ru_stime)
     intact, damaged, lost = _sent(sent_log)
@@ -236,7 +254,9 @@ def every_case_failed(rows: list[dict[str, Any]]) -> str | None:
 
 
 def targets(rows: list[dict[str, Any]]) -> dict[str, bool | None]:
-    """The bench's targets, met or not, in this run (None for each where no case ran)."""
+    """The bench's targets, met or not, in this run (None for each where no case ran); a run where
+    a case failed has not met "every case ran"."""
+    every_case_ran = all(r["failed"] is None for r in rows)
     rows = [r for r in rows if r["failed"] is None]
     clean = [r for r in rows if r["faults"] == "none"]
     faulty = [r for r in rows if r["faults"] != "none"]
@@ -251,7 +271,7 @@ def targets(rows: list[dict[str, Any]]) -> dict[str, bool | None]:
             and r["latency_ms_p95"] <= TARGET_LATENCY_P95_MS for r in rows
         ),
     }  # fmt: skip
-    return met if rows else dict.fromkeys(met)
+    return {**(met if rows else dict.fromkeys(met)), **({} if every_case_ran else {"every case ran": False})}
 
 
 def cpu_ticks() -> tuple[int, int] | None:
@@ -295,7 +315,7 @@ def run(args: argparse.Namespace, context: Context) -> list[dict[str, Any]]:
 def machine_noise(rows: list[dict[str, Any]]) -> str:
     """The machine's load and the CPU its host took, over the cases."""
     loads = [row["load_average_1min"] for row in rows]
-    stolen = [row["stolen_cpu_pct"] for row in rows if row["stolen_cpu_pct"] is not None]
+    stolen = [row["stolen_cpu_pct"] for row in rows if row.get("stolen_cpu_pct") is not None]
     return (f"machine noise: {os.cpu_count()} CPUs, 1-minute load average {min(loads):.2f} to {max(loads):.2f} over the cases"
             + (f", CPU stolen by the virtual machine's host {min(stolen):.1f} to {max(stolen):.1f} %" if stolen else ""))  # fmt: skip
 
@@ -321,7 +341,7 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 
 def plot(rows: list[dict[str, Any]], path: Path) -> None:
-    """CPU per sample and added latency (median and 95th percentile) per case."""
+    """CPU per sample and added latency (median and 95th percentile) per case that ran."""
     from matplotlib.figure import Figure
 
     rows = [r for r in rows if r["failed"] is None]

@@ -1,13 +1,16 @@
 """`rig emulate-tracker serial|lsl`: an emulated tracker for tests and demos.
 
-    rig emulate-tracker serial --pty /tmp/tracker [--profile binary-pose] [--rate 1000] [--duration 10]
+    rig emulate-tracker serial --pty /tmp/tracker [--profile csv] [--rate 1000] [--duration 10]
     rig emulate-tracker serial --tcp 7777 ...
     rig emulate-tracker lsl --name RigPose ...
 
 It streams the simulated tracker (`rig.sim.tracker`: on the simulated pendulum, or --trace FILE
 played in a loop) once a reader connects: exact and sent at once unless --noise-mm, --noise-deg,
 --delay-ms, --jitter-ms or --dropout say otherwise, with --faults on demand; with --log FILE it
-writes what became of every record it measured.
+writes what became of every record it measured. It ends when it has sent --duration seconds, when
+its reader hangs up, or when no reader has come within --idle-timeout seconds; it never keeps
+records for a reader that is not reading them (they are logged `unread`). Its default profile is
+the serial tracker's, so `--tracker serial:PORT` reads it as it is.
 """
 
 from __future__ import annotations
@@ -20,7 +23,8 @@ from pathlib import Path
 
 from declared import Flag, Range, like, setting
 from rig.commands import options, outputs
-from rig.commands.declared_options import add_declared_options, config_from_args
+from rig.commands.declared_options import add_declared_option, add_declared_options, config_from_args
+from rig.devices.trackers.serial_tracker import DEFAULT_PROFILE
 from rig.emulate import EmulatorConfig, make_sink, run_emulator
 from rig.errors import ConfigError
 from rig.sim.tracker import TrackerConfig
@@ -76,12 +80,13 @@ def _run(args: argparse.Namespace) -> int:
             dropout=numbers.dropout,
         ),
         duration_s=numbers.duration_s,
-        profile=getattr(args, "profile", "binary-pose"),
+        profile=getattr(args, "profile", DEFAULT_PROFILE),
         trace=args.trace,
         faults=args.faults,
         seed=numbers.seed,
         drift_ppm=numbers.drift_ppm,
         log=args.log,
+        idle_timeout_s=args.idle_timeout,
     )
     sink = make_sink(config)
     config = replace(config, address=sink.address)
@@ -96,7 +101,7 @@ def _run(args: argparse.Namespace) -> int:
     finally:
         sink.close()
     summary = {"tracker": spec, "faults": config.faults.label, "sent": counts.sent, "intact": counts.intact,
-               "damaged": counts.damaged, "lost": counts.lost}  # fmt: skip
+               "damaged": counts.damaged, "lost": counts.lost, "unread": counts.unread}  # fmt: skip
     print(json.dumps(summary) if args.json else ", ".join(f"{k} {v}" for k, v in summary.items()))
     return 0
 
@@ -108,6 +113,7 @@ def _common(parser: argparse.ArgumentParser, serial: bool) -> None:
                         help="faults such as corrupt=0.01,drop=0.001,garbage=2,burst=8,stall=3:0.5,disconnect=5:0.5 "
                         "(default: none)")  # fmt: skip
     parser.add_argument("--log", type=outputs.csv_file, metavar="FILE.csv", help="write every record's seq, device time, write time and fate")
+    add_declared_option(parser, EmulatorConfig, "idle_timeout_s")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     parser.set_defaults(func=_run)
 
@@ -124,7 +130,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     where = serial.add_mutually_exclusive_group(required=True)
     where.add_argument("--pty", type=Path, metavar="LINK", help="make a pseudo-terminal reachable at this path (a symlink)")
     where.add_argument("--tcp", type=options.non_negative_int, metavar="PORT", help="serve on 127.0.0.1:PORT (0: any free port)")
-    serial.add_argument("--profile", default="binary-pose", help="record format: a shipped profile or a .toml file (default: %(default)s)")
+    serial.add_argument("--profile", default=DEFAULT_PROFILE,
+                        help="record format: a shipped profile or a .toml file (default: %(default)s, as the serial tracker reads)")  # fmt: skip
     _common(serial, serial=True)
     lsl = transports.add_parser("lsl", help="a 7-channel LSL pose stream")
     lsl.add_argument("--name", required=True, help="the stream's name")

@@ -24,7 +24,8 @@ from typing import Any
 
 from analysis import AnalysisOptions
 from rig.commands import choices, options, outputs
-from rig.commands.record import CAMERA_SPECS, add_camera_options
+from rig.commands.device_options import add_device_options
+from rig.commands.record import add_camera_options
 from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
 from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, measure
@@ -138,15 +139,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[2].replace("\n", " "),
         epilog="\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
     )
-    parser.add_argument("--tracker", metavar="SPEC", help="the tracker on the pendulum (listed below)")
-    parser.add_argument("--camera", metavar="SPEC", help=f"the camera filming the LED and the screen: {CAMERA_SPECS}")
+    add_device_options(parser)
     parser.add_argument("--renderer", default="warp", metavar="NAME",
                         help="the rig's renderer (listed below), with options as warp:OPTIONS (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--external", action="store_true", help="measure an external renderer over LSL instead (see docs/lsl.md)")
     parser.add_argument("--predictor", type=options.predictor_spec, default=("default", {}), metavar="NAME[:key=value,...]",
                         help="the pose predictor (listed below), with parameters or a `rig tune` file (default: default)")  # fmt: skip
-    parser.add_argument("--display", default="window", metavar="SPEC",
-                        help="the window: window[:MONITOR][?fullscreen=1&size=WxH&pos=X,Y&scanout=F] (default: %(default)s)")  # fmt: skip
     parser.add_argument("--duration", type=options.run_seconds, metavar="S", help="seconds to run (default: 60; self-test 20)")
     parser.add_argument("--until-still", action="store_true", help="end sooner once the pendulum has stopped swinging")
     parser.add_argument("--photon-target", choices=("photons", "scanout"), default="photons",

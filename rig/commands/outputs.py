@@ -24,7 +24,8 @@ from typing import Callable
 from rig.errors import ConfigError, RigError
 
 
-def _nearest_existing(path: Path) -> Path:
+def nearest_existing(path: Path) -> Path:
+    """`path`, or the nearest path above it that exists (a folder to be made is made there)."""
     path = path.absolute()
     while not path.exists() and path != path.parent:
         path = path.parent
@@ -51,7 +52,7 @@ def output_folder(text: str) -> Path:
     path = Path(text)
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{path} is a file, not a folder; choose an output folder")
-    problem = _writable_folder(_nearest_existing(path))
+    problem = _writable_folder(nearest_existing(path))
     if problem is not None:
         raise argparse.ArgumentTypeError(f"cannot write into {path}: {problem}")
     return path

@@ -49,10 +49,15 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_camera_options(parser: argparse.ArgumentParser) -> None:
-    """The options every command that films takes."""
+def add_accept_camera_settings(parser: argparse.ArgumentParser) -> None:
+    """--accept-camera-settings: whether a camera that refuses a setting may be used all the same."""
     parser.add_argument("--accept-camera-settings", action="store_true",
                         help="film with what the camera gives where it refuses a setting (default: refuse to run)")  # fmt: skip
+
+
+def add_camera_options(parser: argparse.ArgumentParser) -> None:
+    """The options every command that films takes."""
+    add_accept_camera_settings(parser)
     parser.add_argument("--led-roi", type=options.roi, metavar="X,Y,W,H", help="region the LED swings in (pixels)")
     parser.add_argument("--sphere-roi", type=options.roi, metavar="X,Y,W,H", help="region the sphere moves in (pixels)")
 

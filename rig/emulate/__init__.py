@@ -16,11 +16,13 @@ from typing import Callable
 
 import numpy as np
 
+from declared import Flag, Range, check, setting
 from predictors import quaternion, read_trace
 from rig.devices.trackers.profile import load_profile
 from rig.emulate.encode import RecordEncoder
 from rig.emulate.sinks import LslSink, PtySink, TcpSink
-from rig.emulate.streamer import SENT_COLUMNS, SentCounts, Sink, stream
+from rig.devices.trackers.serial_tracker import DEFAULT_PROFILE
+from rig.emulate.streamer import READER_TIMEOUT_S, SENT_COLUMNS, SentCounts, Sink, stream
 from rig.errors import ConfigError
 from rig.writers import CsvRecord
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -40,20 +42,27 @@ def quiet_tracker(rate_hz: float) -> TrackerConfig:
 @dataclass(frozen=True)
 class EmulatorConfig:
     """One emulated tracker: where it sends (a pty link path, a TCP port, or an LSL name), what it
-    measures (`tracker`: rate, noise, transport), for how long, in which format, with which faults."""
+    measures (`tracker`: rate, noise, transport), for how long, in which format (the serial tracker's
+    default profile unless told: what `rig record-tracker --tracker serial:PORT` reads), with which
+    faults, and how long it waits for a reader."""
 
     transport: str
     address: str
     tracker: TrackerConfig = quiet_tracker(1000.0)
     duration_s: float = 10.0
-    profile: str = "binary-pose"
+    profile: str = DEFAULT_PROFILE
     trace: Path | None = None
     faults: FaultPlan = FaultPlan()
     seed: int = 0
     drift_ppm: float = 0.0
     log: Path | None = None
+    idle_timeout_s: float = setting(
+        READER_TIMEOUT_S, "seconds", "end when no reader has connected this long after the emulator is ready",
+        Range(0.0, 86400.0, False, True), flag=Flag("--idle-timeout", metavar="SECONDS"),
+    )  # fmt: skip
 
     def __post_init__(self) -> None:
+        check(self, ConfigError)
         if self.transport == "lsl" and self.faults.damages_bytes:
             raise ConfigError("an LSL stream carries no bytes to damage: corrupt, drop and garbage are serial faults")
 
@@ -129,7 +138,8 @@ def run_emulator(
         device_clock = lambda t: DEVICE_EPOCH_S + (t - started) * (1.0 + config.drift_ppm * 1e-6)
     log = CsvRecord(config.log, SENT_COLUMNS, overwrite=True, flush_each_row=False) if config.log else None
     try:
-        return stream(samples, rates, sink, config.tracker.rate_hz, config.faults.disconnect, device_clock, log, on_event, on_start)
+        return stream(samples, rates, sink, config.tracker.rate_hz, config.faults.disconnect, device_clock, log, on_event, on_start,
+                      config.idle_timeout_s)  # fmt: skip
     finally:
         if log is not None:
             log.close()

@@ -4,6 +4,12 @@ Each sink waits for a reader before it streams (`wait_for_reader`), as a tracker
 its host would, so a recording can hold every record sent. `disconnect` takes the port away (the
 pty is destroyed, the socket and its listener closed, the outlet deleted) and `reconnect` brings
 it back at the same address and waits for the reader to return.
+
+A serial sink never queues records for a reader that does not take them: it writes through an
+`Outbox` (outbox.py), which waits a bounded time for a slow reader and then sends no more until the
+reader takes bytes again (the streamer logs those records `unread`), and never tears a record. Once its reader has hung up
+(the pty's slave closed by everyone, the TCP client gone) `send` raises ReaderGone and the emulator
+ends: nothing is written for a reader that has not connected.
 """
 
 from __future__ import annotations
@@ -14,10 +20,11 @@ import socket
 import time
 import tty
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from rig.devices.trackers.lsl_tracker import CHANNELS, pylsl
 from rig.emulate.encode import Emission, RecordEncoder
+from rig.emulate.outbox import WRITE_WAIT_S, Outbox
 from rig.emulate.streamer import ReaderGone
 from rig.errors import RigError
 from rig.sim.tracker_faults import ByteFaults
@@ -30,11 +37,16 @@ POLL_S = 0.02
 class PtySink:
     """A pseudo-terminal whose slave is reachable at `link` (a symlink kept pointing at the live one)."""
 
-    def __init__(self, link: Path, encoder: RecordEncoder, faults: ByteFaults) -> None:
+    def __init__(
+        self, link: Path, encoder: RecordEncoder, faults: ByteFaults, *, sleep: Callable[[float], None] = time.sleep,
+        write_wait_s: float = WRITE_WAIT_S,
+    ) -> None:  # fmt: skip
         self.link = Path(link)
         self.address = str(self.link)
         self._encoder = encoder
         self._faults = faults
+        self._sleep = sleep
+        self._write_wait_s = write_wait_s
         self._master = -1
         self._terminal = ""
         self._open()
@@ -44,6 +56,7 @@ class PtySink:
         tty.setraw(slave)
         name = os.ttyname(slave)
         os.close(slave)
+        os.set_blocking(master, False)
         try:
             self._link_to(name)
         except OSError as error:
@@ -51,6 +64,7 @@ class PtySink:
             raise RigError(f"--pty {self.link}: {_why_not(error, self.link)}") from None
         self._master = master
         self._terminal = name
+        self._outbox = Outbox(lambda data: os.write(master, data), self._writable, self._write_wait_s)
 
     def _link_to(self, terminal: str) -> None:
         """Point the link at `terminal`: made where nothing is the first time (never replacing a
@@ -73,23 +87,37 @@ class PtySink:
         poller.register(self._master, select.POLLHUP)
         return not any(event & select.POLLHUP for _, event in poller.poll(0))
 
+    def _writable(self, timeout_s: float) -> bool:
+        """Whether the terminal has room within `timeout_s`; ReaderGone if its reader hangs up meanwhile."""
+        poller = select.poll()
+        poller.register(self._master, select.POLLOUT | select.POLLHUP)
+        events = [event for _, event in poller.poll(max(0, round(timeout_s * 1e3)))]
+        if any(event & select.POLLHUP for event in events):
+            raise ReaderGone
+        return bool(events)
+
     def wait_for_reader(self, stop_at: float) -> bool:
         while not self._reader_present():
             if time.monotonic() >= stop_at:
                 return False
-            time.sleep(POLL_S)
-        time.sleep(READER_GRACE_S)
+            self._sleep(POLL_S)
+        self._sleep(READER_GRACE_S)
         return True
 
     def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
-        """Writes the records at once; (damaged per record, the monotonic time of the write). ReaderGone
-        once nobody reads: the write would block for good when the terminal's buffer is full."""
+        """Writes the records at once, as many as the terminal takes: (damaged per record written, the
+        first ones of `emissions`; the monotonic time of the write). ReaderGone once nobody has the
+        terminal open."""
         if not self._reader_present():
             raise ReaderGone
         chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
         written = time.monotonic()
-        os.write(self._master, b"".join(chunks))
-        return list(damaged), written
+        return list(damaged[: self._outbox.send(chunks)]), written
+
+    def linger(self, seconds: float) -> None:
+        poller = select.poll()
+        poller.register(self._master, select.POLLHUP)
+        poller.poll(round(seconds * 1e3))
 
     def disconnect(self) -> None:
         os.close(self._master)
@@ -117,12 +145,20 @@ def _why_not(error: OSError, link: Path) -> str:
 
 
 class TcpSink:
-    """A TCP server on 127.0.0.1 (port 0: any free one) that streams to one client at a time."""
+    """A TCP server on 127.0.0.1 (port 0: any free one) that streams to one client at a time, through
+    a send buffer of `send_buffer_bytes` (None: the system's, which grows to megabytes)."""
 
-    def __init__(self, port: int, encoder: RecordEncoder, faults: ByteFaults) -> None:
+    def __init__(
+        self, port: int, encoder: RecordEncoder, faults: ByteFaults, *, sleep: Callable[[float], None] = time.sleep,
+        write_wait_s: float = WRITE_WAIT_S, send_buffer_bytes: int | None = None,
+    ) -> None:  # fmt: skip
         self._encoder = encoder
         self._faults = faults
+        self._sleep = sleep
+        self._write_wait_s = write_wait_s
+        self._send_buffer = send_buffer_bytes
         self._client: socket.socket | None = None
+        self._outbox: Outbox | None = None
         self._listener = self._listen(port)
         self.port = self._listener.getsockname()[1]
         self.address = f"socket://127.0.0.1:{self.port}"
@@ -143,20 +179,47 @@ class TcpSink:
         while time.monotonic() < stop_at:
             ready, _, _ = select.select([self._listener], [], [], POLL_S)
             if ready:
-                self._client, _ = self._listener.accept()
-                self._client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-                time.sleep(READER_GRACE_S)
+                client, _ = self._listener.accept()
+                client.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                if self._send_buffer is not None:
+                    client.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, self._send_buffer)
+                client.setblocking(False)
+                self._client = client
+                self._outbox = Outbox(client.send, lambda timeout_s: bool(select.select([], [client], [], timeout_s)[1]),
+                                      self._write_wait_s)  # fmt: skip
+                self._sleep(READER_GRACE_S)
                 return True
         return False
 
+    def _client_gone(self) -> bool:
+        """Whether the client has closed its end: a reader sends nothing, so anything to read is its end."""
+        client = self._client
+        if client is None:
+            return True
+        if not select.select([client], [], [], 0)[0]:
+            return False
+        try:
+            return client.recv(1, socket.MSG_PEEK) == b""
+        except BlockingIOError:
+            return False
+        except OSError:
+            return True
+
     def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
+        """As PtySink.send: as many records as the socket takes; ReaderGone once the client has gone."""
+        if self._client_gone():
+            raise ReaderGone
         chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
         written = time.monotonic()
         try:
-            self._client.sendall(b"".join(chunks))
-        except OSError:
-            self._client = None
-        return list(damaged), written
+            taken = self._outbox.send(chunks)
+        except OSError:  # reset or a broken pipe: the client went between the check and the write
+            raise ReaderGone from None
+        return list(damaged[:taken]), written
+
+    def linger(self, seconds: float) -> None:
+        if self._client is not None:
+            select.select([self._client], [], [], seconds)  # readable once the client has closed its end
 
     def disconnect(self) -> None:
         for sock in (self._client, self._listener):
@@ -204,6 +267,9 @@ class LslSink:
         for emission in emissions:
             self._outlet.push_sample([*emission.position, *emission.orientation], emission.device_time)
         return [False] * len(emissions), written
+
+    def linger(self, seconds: float) -> None:
+        time.sleep(seconds)  # an outlet does not say when its consumers have pulled what it holds
 
     def disconnect(self) -> None:
         self._outlet = None

@@ -4,8 +4,9 @@ disconnect acted out on the sink, and a log of what became of every record (`SEN
 as it goes.
 
 A record's fate is `intact` (sent as encoded; garbage bytes before it leave it so), `damaged`
-(sent with bytes changed or left out) or `lost` (dropped by the tracker, or due while the port was
-away, never sent). `t_write` is the monotonic time (s, `time.monotonic`) just before the write (for
+(sent with bytes changed or left out), `lost` (dropped by the tracker, or due while the port was
+away, never sent) or `unread` (not sent: the reader was not taking records and the port's buffer
+was full; a sink queues nothing for a reader that does not read). `t_write` is the monotonic time (s, `time.monotonic`) just before the write (for
 a lost record, when it was due), which the tracker bench compares with the rig's arrival times.
 """
 
@@ -22,14 +23,15 @@ from rig.writers import CsvRecord
 from rig.sim.tracker import TrackerSamples
 
 SENT_COLUMNS = ("seq", "device_time", "t_write", "fate")
-# How long a sink waits for its first reader before the emulator gives up.
+# How long a sink waits for its first reader before the emulator gives up, unless told otherwise.
 READER_TIMEOUT_S = 60.0
 # How long after its last record the emulator waits for a reader to come back from a disconnect.
 READER_RETURN_S = 2.0
-# At the end the emulator lets the reader take what is in flight; before a disconnect, longer (up
-# to half the time the port is away), as a closed pty loses what its reader has not read yet and a
-# reader on a loaded machine may wait that long for the CPU.
-DRAIN_S = 0.05
+# At the end the emulator keeps the port open up to this long for the reader to take what is in
+# flight (less once the reader hangs up), as a closed pty loses what its reader has not read yet and
+# a reader on a loaded machine may wait that long for the CPU; before a disconnect, up to half the
+# time the port is away.
+DRAIN_S = 1.0
 DISCONNECT_DRAIN_S = 0.25
 
 
@@ -48,6 +50,9 @@ class Sink(Protocol):
 
     def reconnect(self, stop_at: float) -> bool: ...
 
+    def linger(self, seconds: float) -> None:
+        """Keeps the port open up to `seconds` for the reader to take what is in flight, less once it hangs up."""
+
     def close(self) -> None: ...
 
 
@@ -56,6 +61,7 @@ class SentCounts:
     intact: int = 0
     damaged: int = 0
     lost: int = 0
+    unread: int = 0
 
     @property
     def sent(self) -> int:
@@ -72,14 +78,16 @@ def stream(
     log: CsvRecord | None,
     on_event: Callable[[str], None] = lambda message: None,
     on_start: Callable[[float], None] = lambda t: None,
+    idle_timeout_s: float = READER_TIMEOUT_S,
 ) -> SentCounts:
-    """Sends `samples` (with their angular `rates`) through `sink` once a reader is there;
+    """Sends `samples` (with their angular `rates`) through `sink` once a reader is there (given up
+    after `idle_timeout_s` without one), until they are all sent or the reader hangs up;
     `device_clock` turns the monotonic time a sample was measured at into the device's own time,
     which its record carries; `disconnect` (when, for how long, in s from the start) is the one the
     fault plan holds, if any. Returns what was sent."""
     counts = SentCounts()
-    if not sink.wait_for_reader(time.monotonic() + READER_TIMEOUT_S):
-        on_event("no reader came; nothing sent")
+    if not sink.wait_for_reader(time.monotonic() + idle_timeout_s):
+        on_event(f"no reader came in {idle_timeout_s:g} s; nothing sent")
         return counts
     on_event(f"reader connected; sending {int(np.count_nonzero(~samples.lost))} records at {rate_hz:g} Hz")
     seqs, due, lost = samples.seq.tolist(), samples.t_arrival.tolist(), samples.lost.tolist()
@@ -128,8 +136,9 @@ def stream(
             damaged, t_write = sink.send(emissions, rate_hz)
         except ReaderGone:
             on_event("the reader went away; stopping")
-            break
-        record(emissions, ["damaged" if d else "intact" for d in damaged], t_write)
+            return counts
+        fates = ["damaged" if d else "intact" for d in damaged]
+        record(emissions, fates + ["unread"] * (len(emissions) - len(fates)), t_write)
         k = group
-    time.sleep(DRAIN_S)
+    sink.linger(DRAIN_S)
     return counts

@@ -58,9 +58,11 @@ def record_tracker(
     progress: Callable[[float, float], None] = lambda done, total: None,
     on_batch: Callable[[list[TrackerRecord]], None] = lambda records: None,
     clock: MonotonicClock | None = None,
+    until: Callable[[], bool] = lambda: False,
 ) -> TrackerRecording:
     """Records the tracker `spec` for `duration_s` seconds (None: until interrupted) into `out_dir`,
-    on `clock` (a new MonotonicClock by default).
+    on `clock` (a new MonotonicClock by default), or until `until()` says to end sooner (asked at
+    every write).
 
     `on_batch(records)` sees every batch as it is written.
     """
@@ -88,7 +90,7 @@ def record_tracker(
 
         tracker.connect(clock)
         try:
-            while (now := clock.now()) < end:
+            while (now := clock.now()) < end and not until():
                 clock.wait_until(min(now + WRITE_INTERVAL_S, end))
                 records = _queued(tracker)
                 if records:

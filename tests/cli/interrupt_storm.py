@@ -73,7 +73,7 @@ def _commands(folder: Path) -> dict[str, tuple[float, object]]:
                                    "400", "--out", str(out / "params.json")]),  # fmt: skip
         "bench": (6.0, lambda out: ["bench", "predictors", "--duration", "10", "--json", str(out / "bench.json")]),
         "sweep": (10.0, lambda out: ["sweep", str(spec), "--out", str(out)]),
-        "record-tracker": (3.0, lambda out: ["record-tracker", "--tracker", f"serial:{out}.tty?profile=binary-pose", "--out", str(out)]),
+        "record-tracker": (3.0, lambda out: ["record-tracker", "--tracker", f"serial:{out}.tty", "--out", str(out)]),
         "record": (4.0, lambda out: ["record", "--camera", f"camera:{video}", "--duration", "30", "--out", str(out)]),
     }
 

@@ -230,6 +230,8 @@ CASES = [
     ("record-corrupt-video", "record --camera camera:{lab}/corrupt.avi --duration 1 --out {lab}/film", "corrupt.avi"),
     ("measure-without-devices", "measure --out {lab}/measured", "--tracker"),
     ("measure-out-is-a-file", "measure --tracker serial:loop:// --camera camera:0 --out {lab}/a-file", "is a file"),
+    ("check-unknown-tracker", "check --tracker teleport:x --external", "unknown tracker"),
+    ("check-out-is-a-file", "check --external --out {lab}/a-file", "is a file"),
     # the board
     ("board-latency-missing-recording", "board latency {lab}/nothing", "nothing"),
     ("board-latency-plot-unknown-format", "board latency {lab}/old-run --plot {lab}/fit.jpgx", "--plot"),

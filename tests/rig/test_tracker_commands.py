@@ -4,12 +4,16 @@ line and exit status 2; a recording feeds `rig bench predictors --trace` and `ri
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 import threading
 from pathlib import Path
 
 import pytest
 
 from rig.cli import main
+from rig.devices.trackers.serial_tracker import DEFAULT_PROFILE
+from rig.service.tracker_recording import record_tracker
 
 
 @pytest.mark.parametrize(
@@ -47,14 +51,26 @@ def test_a_tracker_that_sends_nothing_is_a_failed_recording_that_leaves_nothing(
     assert not out.exists()
 
 
+def test_a_recording_ends_when_told_to_before_its_duration(tmp_path: Path) -> None:
+    recording = record_tracker("serial:loop://", 600.0, tmp_path / "out", until=lambda: True)
+    assert recording.samples == 0 and recording.sidecar["partial"] is False
+
+
 def test_emulator_faults_are_checked(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as exit:
         main(["emulate-tracker", "serial", "--tcp", "0", "--faults", "corrupt=2"])
     assert exit.value.code == 2 and "probability" in capsys.readouterr().err
 
 
+def test_an_emulator_with_no_reader_ends_after_its_idle_timeout() -> None:
+    done = subprocess.run([sys.executable, "-m", "rig.cli", "emulate-tracker", "serial", "--tcp", "0", "--idle-timeout", "0.2",
+                           "--rate", "10", "--duration", "1"], capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "no reader came in 0.2 s; nothing sent" in done.stderr and "sent 0," in done.stdout
+
+
 @pytest.mark.slow
-def test_a_recording_feeds_the_predictor_bench_and_tuning(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_recording_with_the_default_profiles_feeds_the_predictor_bench_and_tuning(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     link = tmp_path / "tracker"
     emulator = threading.Thread(
         target=main,
@@ -65,12 +81,12 @@ def test_a_recording_feeds_the_predictor_bench_and_tuning(tmp_path: Path, capsys
         while not link.exists():
             threading.Event().wait(0.01)
         out = tmp_path / "recording"
-        assert main(["record-tracker", "--tracker", f"serial:{link}?profile=binary-pose", "--duration", "5", "--out", str(out), "--json"]) == 0
+        assert main(["record-tracker", "--tracker", f"serial:{link}", "--duration", "5", "--out", str(out), "--json"]) == 0
     finally:
         emulator.join()
     sidecar = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert sidecar["samples"] == 600 and sidecar["counters"]["corrupt"] == 0
-    assert sidecar["profile"]["name"] == "binary-pose" and sidecar["clock_mapping"]["kind"] == "one-way"
+    assert sidecar["profile"]["name"] == DEFAULT_PROFILE and sidecar["clock_mapping"]["kind"] == "one-way"
     assert json.loads((out / "tracker.json").read_text())["samples"] == 600
     assert main(["bench", "predictors", "--trace", str(out / "tracker.csv"), "--predictor", "hold", "--horizons-ms", "0,10",
                  "--plot-horizon-ms", "10", "--timing-repeats", "0"]) == 0  # fmt: skip

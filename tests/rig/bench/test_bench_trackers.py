@@ -48,3 +48,16 @@ def test_the_cpu_a_host_took_is_its_share_of_the_ticks_between_two_readings() ->
     if ticks is not None:
         stolen, total = ticks
         assert 0 <= stolen <= total
+
+
+def test_a_case_that_could_not_run_is_a_failed_row_with_its_reason(tmp_path: Path) -> None:
+    case = trackers.Case("serial", "tcp", "binary-pose", "none")
+    failed = {**trackers.failed_case(case, 1000.0, 10.0, RigError("the tracker emulator did not start: no pty")), "load_average_1min": 1.0}
+    assert trackers.table([failed]).splitlines()[2] == "| serial | tcp | binary-pose | none | failed: the tracker emulator did not start: no pty |"
+    assert trackers.targets([failed])["every case ran"] is False
+    assert set(trackers.targets([failed]).values()) == {None, False}
+    assert trackers.BENCH.all_failed([failed]) == "every one of the 1 cases failed or recorded nothing (the first: the tracker emulator did not start: no pty)"
+    assert "1-minute load average 1.00 to 1.00" in trackers.machine_noise([failed])
+    trackers.plot([failed], tmp_path / "trackers.png")
+    assert (tmp_path / "trackers.png").exists()
+

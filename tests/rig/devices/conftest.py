@@ -26,9 +26,14 @@ class EmulatedTracker:
     def _run(self) -> None:
         self.counts = run_emulator(self.config, self.sink, self.events.append)
 
+    def join(self, timeout_s: float) -> bool:
+        """Waits up to `timeout_s` for the emulator to end; whether it has."""
+        self._thread.join(timeout_s)
+        return not self._thread.is_alive()
+
     def fates(self) -> dict[str, list[int]]:
         """The emulator's log (config.log): record numbers by fate."""
-        fates: dict[str, list[int]] = {"intact": [], "damaged": [], "lost": []}
+        fates: dict[str, list[int]] = {"intact": [], "damaged": [], "lost": [], "unread": []}
         with self.config.log.open() as stream:
             for row in csv.DictReader(stream):
                 fates[row["fate"]].append(int(row["seq"]))

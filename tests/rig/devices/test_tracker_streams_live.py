@@ -49,6 +49,21 @@ def test_a_clean_serial_stream_is_recorded_whole_and_in_order(tmp_path: Path, em
     assert np.all(arrivals - sensor >= 0.0)
 
 
+@pytest.mark.parametrize("transport", ["pty", "tcp"])
+def test_the_emulator_ends_when_its_reader_hangs_up_and_sends_what_the_default_recorder_reads(
+    tmp_path: Path, emulated_tracker, transport: str
+) -> None:
+    address = str(tmp_path / "tracker") if transport == "pty" else "0"
+    sending_s = 20.0  # far longer than the recording: the emulator ends early only if it sees the reader go
+    config = EmulatorConfig(transport, address, quiet_tracker(RATE_HZ), sending_s, log=tmp_path / "sent.csv")
+    with emulated_tracker(config) as emulator:
+        recording = record_tracker(f"serial:{emulator.sink.address}", DURATION_S + MARGIN_S, tmp_path / "out")
+        assert emulator.join(timeout_s=sending_s / 2), "the emulator was still sending once its reader had gone"
+    assert emulator.events[-1] == "the reader went away; stopping"
+    assert 0 < recording.samples <= emulator.counts.intact < RATE_HZ * sending_s
+    assert recording.sidecar["counters"]["corrupt"] == 0, "the recorder's default profile reads the emulator's default records"
+
+
 def test_corrupt_bytes_and_a_disconnect_lose_no_intact_record_and_fabricate_none(tmp_path: Path, emulated_tracker) -> None:
     faults = parse_faults("corrupt=0.01,garbage=20,disconnect=0.7:0.3")
     config = EmulatorConfig("pty", str(tmp_path / "tracker"), quiet_tracker(RATE_HZ), DURATION_S, "binary-pose", faults=faults, seed=3,

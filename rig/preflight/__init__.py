@@ -1,0 +1,89 @@
+"""`rig check`: a pre-flight check of the devices a live run would use, in a few seconds.
+
+The tracker and the camera are listened to on threads of their own for LISTEN_S after each opens,
+while the window is opened and images presented on this one, as a run does (`display.py`); then the
+disk is checked for the film. Each check is a row (`rows.CheckRow`): pass, warn or fail, what was
+measured, and what to fix. A device that will not open is a failed row, not an error: the others are
+still checked. A malformed spec is the user's error (ConfigError), raised before anything opens.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rig.clock import Clock, MonotonicClock
+from rig.devices.window import FrameClock
+from rig.preflight.camera import CameraProbe
+from rig.preflight.display import check_display
+from rig.preflight.disk import check_disk
+from rig.preflight.rows import CheckRow, worst
+from rig.preflight.tracker import TrackerProbe
+
+LISTEN_S = 3.0
+"""How long the tracker and the camera are listened to, each from when it opens."""
+
+
+@dataclass(frozen=True)
+class CheckPlan:
+    """The devices a run would use (None: the run has none of that kind; `display` None: an external
+    renderer draws), the planned run's duration, and an existing folder on the disk it is written to."""
+
+    tracker: str | None
+    camera: str | None
+    display: str | None
+    duration_s: float
+    disk_folder: Path
+    accept_camera_settings: bool = False
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    rows: list[CheckRow]
+    seconds: float
+    """How long the check took, start to end."""
+
+    @property
+    def status(self) -> str:
+        return worst(self.rows)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"status": self.status, "seconds": self.seconds, "checks": [row.to_dict() for row in self.rows]}
+
+
+class _Listening:
+    """A probe's `run(clock, until)` on a thread of its own, for LISTEN_S after its device opens."""
+
+    def __init__(self, probe: TrackerProbe | CameraProbe, clock: Clock) -> None:
+        self.probe = probe
+        self._thread = threading.Thread(target=self._run, args=(clock,), name=f"rig check {type(probe).__name__}", daemon=True)
+        self._thread.start()
+
+    def _run(self, clock: Clock) -> None:
+        self.probe.run(clock, LISTEN_S)
+
+    def join(self) -> None:
+        self._thread.join()
+
+
+def run_checks(plan: CheckPlan, *, frame_clock: FrameClock | None = None, clock: MonotonicClock | None = None) -> CheckReport:
+    """Check every device of `plan` (see the module docstring); `frame_clock` paces the window instead
+    of the monitor (under a virtual X server)."""
+    clock = clock or MonotonicClock()
+    started = clock.now()
+    tracker = TrackerProbe(plan.tracker) if plan.tracker else None
+    camera = CameraProbe(plan.camera.removeprefix("camera:"), plan.accept_camera_settings) if plan.camera else None
+    listening = [_Listening(probe, clock) for probe in (tracker, camera) if probe is not None]
+    try:
+        rows = check_display(plan.display, clock, frame_clock) if plan.display is not None else []
+    finally:
+        for listener in listening:
+            listener.join()
+    if tracker is not None:
+        rows += tracker.rows(LISTEN_S)
+    if camera is not None:
+        rows += camera.rows(LISTEN_S)
+    rows.append(check_disk(plan.disk_folder, camera.fps if camera else None, camera.frame_bytes() if camera else None, plan.duration_s))
+    return CheckReport(rows, clock.now() - started)
