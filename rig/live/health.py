@@ -6,12 +6,13 @@ connected to when it ended):
 
 * the display: refreshes presented (a new image swapped in) against those the measured refresh
   rate expects over the span, late swaps (landed after the refresh they were aimed at) and missed
-  refreshes (the display repeated its image), and the longest pause between new images, the
-  span's start and end included (a run that stalls after two images has one long pause to its end);
+  refreshes (the display repeated its image), how long the first image took, and the longest
+  pause between new images from the first to the span's end (a run that stalls after two images
+  has one long pause to its end);
 * the pose's age at each swap (swap time minus the sensor time of the newest sample behind its
   image): median, 95th percentile and largest;
-* the tracker: its typical sample interval, its dropouts (a gap over `DROPOUT_INTERVALS` of them)
-  and its longest silence, in sensor time;
+* the tracker: its typical sample interval, its dropouts (a gap over `DROPOUT_INTERVALS` of them),
+  how long its first sample in the span took and its longest silence from there, in sensor time;
 * the camera: frames dropped, with when (runs of consecutive drops), and its stalls.
 
 `judge` turns those into a `Verdict` against the thresholds below: `invalid` when the rig or its
@@ -33,6 +34,10 @@ STALL_S = 0.25
 """A pause longer than this with no new image (or no tracker sample) makes the run invalid: the
 sphere froze for an eighth or more of a pendulum swing (1 to 2 s), far longer than any latency the
 rig measures, so neither the video nor the log shows the system's latency there."""
+WARM_UP_S = 1.0
+"""The first image (and the first tracker sample) may come this long after the devices connected: a
+renderer compiles its shaders on its first frames, and neither the log's latency nor a camera that
+starts with the swing uses the run's first moments. Later than that, the run stalled at its start."""
 HITCH_S = 0.1
 """A pause longer than this (six refreshes at 60 Hz) degrades the run: the latency it measures
 includes hitches the system shows only under load."""
@@ -83,13 +88,17 @@ def _table(path: Path) -> dict[str, np.ndarray] | None:
     return {name: np.array([number(row.get(name)) for row in rows], dtype=np.float64) for name in names}
 
 
-def longest_gap(times: np.ndarray, t_begin: float, t_end: float) -> tuple[float, float]:
-    """The longest pause (s) between consecutive `times`, the span's start and end included, and
-    when it began (s into the span)."""
-    edges = np.concatenate([[t_begin], np.sort(times[(times >= t_begin) & (times <= t_end)]), [t_end]])
+def pauses(times: np.ndarray, t_begin: float, t_end: float) -> dict[str, float]:
+    """When the first of `times` in the span came (s into it; the span's length if none did), and
+    the longest pause (ms) from it to the span's end, the end included, with when it began."""
+    inside = np.sort(times[(times >= t_begin) & (times <= t_end)])
+    if not len(inside):
+        return {"first_s": t_end - t_begin, "longest_gap_ms": 0.0, "longest_gap_at_s": 0.0}
+    edges = np.concatenate([inside, [t_end]])
     steps = np.diff(edges)
-    i = int(np.argmax(steps))
-    return float(steps[i]), float(edges[i] - t_begin)
+    i = int(np.argmax(steps)) if len(steps) else 0
+    gap = float(steps[i]) if len(steps) else 0.0
+    return {"first_s": float(inside[0] - t_begin), "longest_gap_ms": gap * 1e3, "longest_gap_at_s": float(edges[i] - t_begin)}
 
 
 def slow_spans(swap_times: np.ndarray, slow_s: float = SLOW_GAP_S) -> list[tuple[float, float]]:
@@ -126,7 +135,6 @@ def display_health(swaps: dict[str, np.ndarray], refresh_hz: float, t_begin: flo
     """Refreshes presented against expected, late swaps, missed refreshes and the longest pause."""
     expected = int(round(max(0.0, t_end - t_begin) * refresh_hz))
     presented = int(np.count_nonzero((swaps["t"] >= t_begin) & (swaps["t"] <= t_end)))
-    gap, at = longest_gap(swaps["t"], t_begin, t_end)
     late = swaps["late"]
     return {
         "refresh_hz": refresh_hz,
@@ -135,8 +143,7 @@ def display_health(swaps: dict[str, np.ndarray], refresh_hz: float, t_begin: flo
         "presented_share": presented / expected if expected else 0.0,
         "missed_refreshes": max(0, expected - presented),
         "late_swaps": None if np.all(np.isnan(late)) else int(np.count_nonzero(late > 0)),
-        "longest_gap_ms": gap * 1e3,
-        "longest_gap_at_s": at,
+        **pauses(swaps["t"], t_begin, t_end),
         "slow_moments": len(slow_spans(swaps["t"])),
     }
 
@@ -156,15 +163,13 @@ def pose_age(swaps: dict[str, np.ndarray], poses: dict[str, np.ndarray] | None) 
 def tracker_health(tracker: dict[str, np.ndarray] | None, t_begin: float, t_end: float) -> dict[str, Any]:
     """The tracker's typical interval, dropouts and longest silence over the span, in sensor time."""
     if tracker is None or len(tracker["t_sensor"]) < 3:
-        return {"samples": 0 if tracker is None else len(tracker["t_sensor"]), "longest_gap_ms": (t_end - t_begin) * 1e3,
-                "longest_gap_at_s": 0.0, "dropouts": None, "interval_ms": None}  # fmt: skip
+        return {"samples": 0 if tracker is None else len(tracker["t_sensor"]), "interval_ms": None, "dropouts": None,
+                **pauses(np.array([]), t_begin, t_end)}  # fmt: skip
     t = np.unique(tracker["t_sensor"])
     interval = float(np.median(np.diff(t)))
     inside = t[(t >= t_begin) & (t <= t_end)]
-    gap, at = longest_gap(inside, t_begin, t_end)
     return {"samples": int(len(tracker["t_sensor"])), "interval_ms": interval * 1e3,
-            "dropouts": int(np.count_nonzero(np.diff(inside) > DROPOUT_INTERVALS * interval)),
-            "longest_gap_ms": gap * 1e3, "longest_gap_at_s": at}  # fmt: skip
+            "dropouts": int(np.count_nonzero(np.diff(inside) > DROPOUT_INTERVALS * interval)), **pauses(t, t_begin, t_end)}  # fmt: skip
 
 
 def camera_health(frames: dict[str, np.ndarray] | None, film: dict[str, Any] | None, t_begin: float) -> dict[str, Any] | None:
@@ -194,6 +199,8 @@ def judge(health: dict[str, Any]) -> Verdict:
         invalid.append("the rig stalled: the display showed no image")
     else:
         gap, at = display["longest_gap_ms"], display["longest_gap_at_s"]
+        if display["first_s"] > WARM_UP_S:
+            invalid.append(f"the rig stalled: its first image came {display['first_s'] * 1e3:.0f} ms after the run began")
         if gap > STALL_S * 1e3:
             invalid.append(f"the rig stalled: no new image for {gap:.0f} ms from {at:.1f} s into the run")
         elif gap > HITCH_S * 1e3:
@@ -205,6 +212,8 @@ def judge(health: dict[str, Any]) -> Verdict:
         if late is not None and late > MAX_LATE_SHARE * display["refreshes_presented"]:
             degraded.append(f"{late} of {display['refreshes_presented']} swaps were late")
     gap, at = tracker["longest_gap_ms"], tracker["longest_gap_at_s"]
+    if tracker["first_s"] > WARM_UP_S:
+        invalid.append(f"the tracker stalled: its first sample came {tracker['first_s'] * 1e3:.0f} ms after the run began")
     if gap > STALL_S * 1e3:
         invalid.append(f"the tracker stalled: no sample for {gap:.0f} ms from {at:.1f} s into the run")
     elif gap > HITCH_S * 1e3:

@@ -6,6 +6,7 @@ with both numbers."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ import pytest
 
 from predictors import SAMPLE_COLUMNS, PoseSample, sample_row
 from rig.devices.window import SWAP_COLUMNS
+from rig.live import health as thresholds
 from rig.live.health import DEGRADED, INVALID, VALID, run_health
 from rig.live.log_latency import log_latency
 from rig.live.video_vs_log import video_against_log
@@ -89,7 +91,16 @@ def test_a_rig_that_draws_two_images_then_stalls_to_the_end_is_invalid(tmp_path:
     _write_run(tmp_path, np.array([0.01, 0.03]))
     health = _health(tmp_path)
     assert health["status"] == INVALID
-    assert "no new image for 7970 ms from 0.0 s" in health["verdict"]
+    assert health["reasons"] == ["the rig stalled: no new image for 7970 ms from 0.0 s into the run"]
+
+
+def test_a_first_image_after_the_warm_up_is_a_stall_and_one_within_it_is_not(tmp_path: Path) -> None:
+    (late := tmp_path / "late").mkdir()
+    _write_run(late, _every_refresh(start=1.5))
+    assert _health(late)["reasons"] == ["the rig stalled: its first image came 1500 ms after the run began"]
+    (warming := tmp_path / "warming").mkdir()
+    _write_run(warming, _every_refresh(start=0.6))
+    assert _health(warming)["verdict"] == VALID
 
 
 def test_a_tracker_silent_for_half_a_second_is_invalid(tmp_path: Path) -> None:
@@ -150,3 +161,11 @@ def test_a_camera_that_kept_every_frame_agrees_with_the_whole_run(tmp_path: Path
     compared = video_against_log(tmp_path, video, log)
     assert compared["whole_run_in_interval"] is True and compared["warning"] is None
     assert compared["log_filmed_ms"] == pytest.approx(compared["log_whole_run_ms"], abs=1.0)
+
+
+def test_the_documented_thresholds_are_the_declared_ones() -> None:
+    page = (Path(__file__).resolve().parents[3] / "docs" / "run-health.md").read_text(encoding="utf-8")
+    documented = dict(re.findall(r"^\| `([A-Z_]+)` \| ([0-9.]+)", page, flags=re.MULTILINE))
+    assert documented.keys() == {"STALL_S", "WARM_UP_S", "HITCH_S", "MIN_PRESENTED_SHARE", "MAX_LATE_SHARE",
+                                  "MAX_CAMERA_DROP_SHARE"}
+    assert all(float(value) == getattr(thresholds, name) for name, value in documented.items())
