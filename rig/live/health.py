@@ -30,6 +30,9 @@ from typing import Any
 
 import numpy as np
 
+from rig.live.files import MARKERS_FILE, PUBLISHED_FILE, SWAPS_FILE
+from rig.session.run_record import FRAMES_FILE, TRACKER_FILE
+
 STALL_S = 0.25
 """A pause longer than this with no new image (or no tracker sample) makes the run invalid: the
 sphere froze for an eighth or more of a pendulum swing (1 to 2 s), far longer than any latency the
@@ -96,9 +99,9 @@ def pauses(times: np.ndarray, t_begin: float, t_end: float) -> dict[str, float]:
         return {"first_s": t_end - t_begin, "longest_gap_ms": 0.0, "longest_gap_at_s": 0.0}
     edges = np.concatenate([inside, [t_end]])
     steps = np.diff(edges)
-    i = int(np.argmax(steps)) if len(steps) else 0
-    gap = float(steps[i]) if len(steps) else 0.0
-    return {"first_s": float(inside[0] - t_begin), "longest_gap_ms": gap * 1e3, "longest_gap_at_s": float(edges[i] - t_begin)}
+    i = int(np.argmax(steps))
+    return {"first_s": float(inside[0] - t_begin), "longest_gap_ms": float(steps[i]) * 1e3,
+            "longest_gap_at_s": float(edges[i] - t_begin)}  # fmt: skip
 
 
 def slow_spans(swap_times: np.ndarray, slow_s: float = SLOW_GAP_S) -> list[tuple[float, float]]:
@@ -120,10 +123,10 @@ def swaps_of(out_dir: Path) -> dict[str, np.ndarray] | None:
     """Each new image's swap: `t` (rig clock), `image` (its published frame) and `late` (NaN where
     not known: an external renderer's markers do not say), from the window's swap log or an external
     renderer's markers; None where the run kept neither."""
-    swaps = _table(out_dir / "display_swaps.csv")
+    swaps = _table(out_dir / SWAPS_FILE)
     if swaps is not None:
         return {"t": swaps["t_swap"], "image": swaps["image"], "late": swaps["late"]}
-    markers = _table(out_dir / "renderer_markers.csv")
+    markers = _table(out_dir / MARKERS_FILE)
     if markers is None:
         return None
     frames = markers["frame"]
@@ -235,9 +238,9 @@ def run_health(out_dir: Path, refresh_hz: float, t_begin: float, t_end: float, f
     health: dict[str, Any] = {
         "span_s": t_end - t_begin,
         "display": display_health(swaps, refresh_hz, t_begin, t_end) if swaps is not None else None,
-        "pose_age": pose_age(swaps, _table(out_dir / "published_poses.csv")) if swaps is not None else None,
-        "tracker": tracker_health(_table(out_dir / "tracker.csv"), t_begin, t_end),
-        "camera": camera_health(_table(out_dir / "camera_frames.csv"), film, t_begin),
+        "pose_age": pose_age(swaps, _table(out_dir / PUBLISHED_FILE)) if swaps is not None else None,
+        "tracker": tracker_health(_table(out_dir / TRACKER_FILE), t_begin, t_end),
+        "camera": camera_health(_table(out_dir / FRAMES_FILE), film, t_begin),
     }
     verdict = judge(health)
     return {**health, "status": verdict.status, "reasons": list(verdict.reasons), "verdict": str(verdict)}

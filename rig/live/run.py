@@ -33,6 +33,7 @@ from rig.devices.registry import make_tracker
 from rig.devices.tap import TappedTracker
 from rig.devices.window import SWAP_COLUMNS, FrameClock, WindowDisplay, WindowSettings
 from rig.errors import ConfigError, RigError
+from rig.live.files import LIVE_FILE, MARKERS_FILE, PUBLISHED_FILE, SWAPS_FILE
 from rig.live.health import run_health
 from rig.live.still import RunEnded, SwingWatch
 from rig.live.view import View, view_from_positions
@@ -43,10 +44,6 @@ from rig.render import RenderSetup, make_renderer
 from rig.session import PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
 from rig.session.session import Progress
 
-LIVE_FILE = "live.json"
-PUBLISHED_FILE = "published_poses.csv"
-SWAPS_FILE = "display_swaps.csv"
-MARKERS_FILE = "renderer_markers.csv"
 FRAMING_S = 2.0
 TRACKER_SILENCE_S = 1.0
 """A tracker silent this long after its link was lost has been unplugged: the run ends."""
