@@ -8,11 +8,11 @@ The run's folder gets what a simulated run writes (`tracker.csv`, `app_frames.cs
 newest sample behind it, also pushed on the `RigPose` LSL outlet), the display's own log
 (`display_swaps.csv` for a window, `renderer_markers.csv` for an external renderer) and at the end
 `live.json` (each device's report, the film's, why the run ended, and the run's health with its
-verdict, `rig.live.health`). Every row is written as it
-happens; samples that arrive after the session last took any are written when it ends. A
-`Watchdog` instrument ends the run with a clear message when the tracker or the camera goes away
-(`fault()`; what was recorded stays); so does closing the window. With `until_still` the run also
-ends, normally, once the pendulum has stopped swinging.
+verdict, `rig.live.health`). Every row is written as it happens; samples that arrive after the
+session last took any are written when it ends. A `Watchdog` instrument ends the run with a clear
+message when the tracker or the camera goes away (`fault()`; what was recorded stays); so does
+closing the window. With `until_still` the run also ends, normally, once the pendulum has stopped
+swinging.
 """
 
 from __future__ import annotations
