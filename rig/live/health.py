@@ -11,8 +11,10 @@ connected to when it ended):
   has one long pause to its end);
 * the pose's age at each swap (swap time minus the sensor time of the newest sample behind its
   image): median, 95th percentile and largest;
-* the tracker: its typical sample interval, its dropouts (a gap over `DROPOUT_INTERVALS` of them),
-  how long its first sample in the span took and its longest silence from there, in sensor time;
+* the tracker: its typical sample interval and its dropouts (a gap over `DROPOUT_INTERVALS` of
+  them) and longest gap in sensor time, and, as the rig received them, how long its first sample in
+  the span took and its longest silence from there (a tracker, or its link, that held samples back
+  and sent them late in a burst left the rig extrapolating as surely as one that measured nothing);
 * the camera: frames dropped, with when (runs of consecutive drops), and its stalls.
 
 `judge` turns those into a `Verdict` against the thresholds below: `invalid` when the rig or its
@@ -164,15 +166,18 @@ def pose_age(swaps: dict[str, np.ndarray], poses: dict[str, np.ndarray] | None) 
 
 
 def tracker_health(tracker: dict[str, np.ndarray] | None, t_begin: float, t_end: float) -> dict[str, Any]:
-    """The tracker's typical interval, dropouts and longest silence over the span, in sensor time."""
+    """The tracker's typical interval, dropouts and longest gap in sensor time over the span, and its
+    first sample and longest silence as they arrived."""
     if tracker is None or len(tracker["t_sensor"]) < 3:
         return {"samples": 0 if tracker is None else len(tracker["t_sensor"]), "interval_ms": None, "dropouts": None,
-                **pauses(np.array([]), t_begin, t_end)}  # fmt: skip
+                "longest_sensor_gap_ms": None, **pauses(np.array([]), t_begin, t_end)}  # fmt: skip
     t = np.unique(tracker["t_sensor"])
     interval = float(np.median(np.diff(t)))
-    inside = t[(t >= t_begin) & (t <= t_end)]
+    steps = np.diff(t[(t >= t_begin) & (t <= t_end)])
     return {"samples": int(len(tracker["t_sensor"])), "interval_ms": interval * 1e3,
-            "dropouts": int(np.count_nonzero(np.diff(inside) > DROPOUT_INTERVALS * interval)), **pauses(t, t_begin, t_end)}  # fmt: skip
+            "dropouts": int(np.count_nonzero(steps > DROPOUT_INTERVALS * interval)),
+            "longest_sensor_gap_ms": float(steps.max()) * 1e3 if len(steps) else None,
+            **pauses(tracker["t_arrival"], t_begin, t_end)}  # fmt: skip
 
 
 def camera_health(frames: dict[str, np.ndarray] | None, film: dict[str, Any] | None, t_begin: float) -> dict[str, Any] | None:
@@ -218,9 +223,9 @@ def judge(health: dict[str, Any]) -> Verdict:
     if tracker["first_s"] > WARM_UP_S:
         invalid.append(f"the tracker stalled: its first sample came {tracker['first_s'] * 1e3:.0f} ms after the run began")
     if gap > STALL_S * 1e3:
-        invalid.append(f"the tracker stalled: no sample for {gap:.0f} ms from {at:.1f} s into the run")
+        invalid.append(f"the tracker stalled: no sample arrived for {gap:.0f} ms from {at:.1f} s into the run")
     elif gap > HITCH_S * 1e3:
-        degraded.append(f"the tracker dropped out for {gap:.0f} ms from {at:.1f} s into the run")
+        degraded.append(f"the tracker dropped out: no sample arrived for {gap:.0f} ms from {at:.1f} s into the run")
     if camera is not None and camera["dropped_share"] > MAX_CAMERA_DROP_SHARE:
         worst = max(camera["drops"], key=lambda drop: drop["frames"])
         degraded.append(f"the camera dropped {camera['dropped']} frames ({camera['dropped_share']:.1%}), "

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 import pytest
@@ -36,14 +37,17 @@ def _swing(t: np.ndarray) -> np.ndarray:
 
 
 def _write_run(folder: Path, swap_times: np.ndarray, delay_s: np.ndarray | float = 0.02, tracker_times: np.ndarray | None = None,
-               camera_dropped: np.ndarray | None = None) -> None:  # fmt: skip
+               camera_dropped: Callable[[np.ndarray], np.ndarray] | None = None,
+               tracker_arrivals: np.ndarray | None = None) -> None:  # fmt: skip
     """A window run's files: a swap at each of `swap_times` showing the pose sampled `delay_s`
-    before it, the tracker sampling at `tracker_times`, the camera filming at CAMERA_FPS over the
-    run with the frames at `camera_dropped` (a mask) filled in as dropped."""
+    before it, the tracker sampling at `tracker_times` (arriving 1 ms later, or at `tracker_arrivals`),
+    the camera filming at CAMERA_FPS over the run with the frames `camera_dropped(t)` says filled in
+    as dropped."""
     tracker_times = np.arange(0.0, RUN_S, 1.0 / TRACKER_HZ) if tracker_times is None else tracker_times
+    arrivals = tracker_times + 0.001 if tracker_arrivals is None else tracker_arrivals
     with CsvRecord(folder / "tracker.csv", SAMPLE_COLUMNS) as record:
-        for t, position in zip(tracker_times, _swing(tracker_times)):
-            record.write(sample_row(PoseSample(t, t + 0.001, position, IDENTITY)))
+        for t, arrival, position in zip(tracker_times, arrivals, _swing(tracker_times)):
+            record.write(sample_row(PoseSample(t, arrival, position, IDENTITY)))
     sensor = swap_times - delay_s
     with CsvRecord(folder / "display_swaps.csv", SWAP_COLUMNS) as swaps, CsvRecord(folder / "published_poses.csv",
                                                                                      PUBLISHED_COLUMNS) as poses:  # fmt: skip
@@ -108,8 +112,18 @@ def test_a_tracker_silent_for_half_a_second_is_invalid(tmp_path: Path) -> None:
     _write_run(tmp_path, _every_refresh(), tracker_times=t[(t < 5.0) | (t > 5.5)])
     health = _health(tmp_path)
     assert health["status"] == INVALID
-    assert health["reasons"] == ["the tracker stalled: no sample for 504 ms from 5.0 s into the run"]
-    assert health["tracker"]["dropouts"] == 1
+    assert health["reasons"] == ["the tracker stalled: no sample arrived for 504 ms from 5.0 s into the run"]
+    assert health["tracker"]["dropouts"] == 1 and health["tracker"]["longest_sensor_gap_ms"] == pytest.approx(504.0)
+
+
+def test_a_tracker_whose_samples_arrive_late_in_a_burst_is_a_stall_though_none_is_missing(tmp_path: Path) -> None:
+    """Samples measured on time but held back 400 ms and delivered together: the rig extrapolated."""
+    t = np.arange(0.0, RUN_S, 1.0 / TRACKER_HZ)
+    arrival = np.where((t > 5.0) & (t < 5.4), 5.4, t) + 0.001
+    _write_run(tmp_path, _every_refresh(), tracker_times=t, tracker_arrivals=arrival)
+    health = _health(tmp_path)
+    assert health["tracker"]["dropouts"] == 0
+    assert health["reasons"] == ["the tracker stalled: no sample arrived for 400 ms from 5.0 s into the run"]
 
 
 def test_hitches_and_a_camera_that_drops_frames_degrade_the_run(tmp_path: Path) -> None:
