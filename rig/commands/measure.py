@@ -11,6 +11,11 @@ run's logs as they were written, the video, and measure.json and measure.png wit
 --guided says what to do and checks the first seconds of video before the long run. --self-test
 runs the whole chain with stand-ins (an emulated tracker, a frame clock, a camera twin reading the
 window back) under an X display such as xvfb-run, and checks that the video and the log agree.
+
+The run's health verdict comes first: valid, degraded (exit 3, the number with its caveats) or
+invalid (exit 4: the rig or its tracker stalled, so the stall is printed and no latency). A video
+whose interval misses the whole run's latency by the log is a warning (exit 3) with both numbers.
+A self-test whose video and log disagree exits 1.
 """
 
 from __future__ import annotations
@@ -23,11 +28,13 @@ from pathlib import Path
 from typing import Any
 
 from analysis import AnalysisOptions
+from rig.cli import EXIT_INVALID_RUN, EXIT_WARNINGS
 from rig.commands import choices, options, outputs
 from rig.commands.device_options import add_device_options
 from rig.commands.record import add_camera_options
 from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
+from rig.live.health import VALID
 from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, measure
 from rig.live.camera_recording import check_first_seconds, record_camera
 from rig.live.run import EXTERNAL, LiveConfig
@@ -48,9 +55,26 @@ def _interval(ci: Any) -> str:
     return f", 95% CI [{ci[0]:.1f}, {ci[1]:.1f}] ms" if ci else ", no interval"
 
 
+INVALID_ADVICE = (
+    "no latency: the run's own timing cannot be trusted, so its video would not show the system's latency; close "
+    "other programs that load the machine (or give the rig a machine of its own) and measure again"
+)
+
+
+def _verdict_lines(report: MeasureReport) -> list[str]:
+    health = report.health
+    if not health["reasons"]:
+        return [f"run: {health['status']}"]
+    return [f"run: {health['status']}:", *(f"  {reason}" for reason in health["reasons"])]
+
+
 def _lines(report: MeasureReport, kept: bool) -> list[str]:
     video, log = report.video, report.log
+    if report.invalid:
+        return [*_verdict_lines(report), INVALID_ADVICE, f"the run's records are in {report.out_dir}" if kept
+                else "(the run was in a temporary folder; --out DIR keeps it)"]  # fmt: skip
     lines = [
+        *_verdict_lines(report),
         f"latency (video): {video['latency_ms']:.1f} ms{_interval(video['ci95_ms'])} by {video['method']}",
         f"latency (rig log): {log['latency_ms']:.1f} ms (sensor to photon per frame: mean {log['sensor_to_photon_ms']['mean']:.1f} ms, "
         f"sd {log['sensor_to_photon_ms']['sd']:.1f} ms, {log['frames']} frames)",
@@ -58,6 +82,9 @@ def _lines(report: MeasureReport, kept: bool) -> list[str]:
     if report.board:
         lines.append(f"latency (photodiode): {report.board['latency_ms']:.1f} +- {report.board['sd_ms']:.1f} ms")
     lines += [f"warning: {warning}" for warning in video.get("warnings", [])]
+    against = report.run["video_vs_log"]["warning"]
+    if against:
+        lines += [f"warning: {against['cause']}", f"  remedy: {against['remedy']}"]
     check = report.run.get("self_test")
     if check:
         verdict = "agree" if check["agree"] else "DISAGREE"
@@ -70,9 +97,17 @@ def _lines(report: MeasureReport, kept: bool) -> list[str]:
 
 
 def _print(report: MeasureReport, as_json: bool, kept: bool = True) -> int:
+    """Print the report; the exit status: invalid run, then a self-test's disagreement, then a
+    degraded run or a video that misses the whole run, then 0."""
     print(json.dumps(report.to_dict(), default=str) if as_json else "\n".join(_lines(report, kept)))
+    if report.invalid:
+        return EXIT_INVALID_RUN
     check = report.run.get("self_test")
-    return EXIT_DISAGREE if check and not check["agree"] else 0
+    if check and not check["agree"]:
+        return EXIT_DISAGREE
+    if report.health["status"] != VALID or report.run["video_vs_log"]["warning"]:
+        return EXIT_WARNINGS
+    return 0
 
 
 def _self_test(args: argparse.Namespace) -> int:
@@ -136,7 +171,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "measure",
         help="measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
-        description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[2].replace("\n", " "),
+        description=" ".join(__doc__.split("\n\n")[i].replace("\n", " ") for i in (0, 2, 3)),
         epilog="\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
     )
     add_device_options(parser)

@@ -2,11 +2,15 @@
 
 1. the video's: the analyser (`rig.service.analyse`) on the camera's video, with its 95 % interval;
 2. the rig's own log's: the latency its logged swaps and tracker samples imply (`rig.live.log_latency`),
-   at the instants the camera filmed (so that both weight the run alike) and over the whole run;
+   at the instants the camera filmed (so that both weight the run alike) and over the whole run,
+   compared with the video's (`rig.live.video_vs_log`: a warning when the whole run's lies outside
+   the video's interval; the comparison is added to the run's `live.json`);
 3. with the rig board (`--board PORT`: it records beside the run into `board/`, an instrument of
    the session, `rig.board.instrument`), the photodiode's (`analysis.board.photodiode_latency`).
 
-All three go into `measure.json` and `measure.png`, beside the run's files.
+All three go into `measure.json` and `measure.png`, beside the run's files. The run's health
+verdict (`rig.live.health`) comes first: a run that is invalid (the rig or its tracker stalled) is
+not analysed, since its video would not show the system's latency; its report holds the verdict.
 """
 
 from __future__ import annotations
@@ -25,8 +29,10 @@ from rig.board.instrument import BoardInstrument
 from rig.devices.camera.opencv_camera import opencv_camera
 from rig.errors import RigError
 from rig.fresh_outputs import removed_unless_recorded
+from rig.live.health import INVALID
 from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
-from rig.live.run import EXTERNAL, LiveConfig, run_live
+from rig.live.run import EXTERNAL, LiveConfig, run_live, write_summary
+from rig.live.video_vs_log import video_against_log
 from rig.live.view import View
 from rig.render.protocol import RenderSetup
 from rig.service.analyse import AnalysisRequest, analyse
@@ -38,17 +44,28 @@ PLOT_FILE = "measure.png"
 
 @dataclass
 class MeasureReport:
+    """A measured run's answers; `video` and `log` are None where the run was invalid (not analysed)."""
+
     out_dir: Path
-    video: dict[str, Any]
-    log: dict[str, Any]
+    video: dict[str, Any] | None
+    log: dict[str, Any] | None
     board: dict[str, Any] | None
     run: dict[str, Any] = field(default_factory=dict)
 
+    @property
+    def health(self) -> dict[str, Any]:
+        return self.run["health"]
+
+    @property
+    def invalid(self) -> bool:
+        return self.health["status"] == INVALID
+
     def to_dict(self) -> dict[str, Any]:
         return {
-            "latency_ms": self.video["latency_ms"],
-            "ci95_ms": self.video["ci95_ms"],
-            "log_latency_ms": self.log["latency_ms"],
+            "verdict": self.health["verdict"],
+            "latency_ms": self.video["latency_ms"] if self.video else None,
+            "ci95_ms": self.video["ci95_ms"] if self.video else None,
+            "log_latency_ms": self.log["latency_ms"] if self.log else None,
             "board_latency_ms": self.board["latency_ms"] if self.board else None,
             "video": self.video,
             "log": self.log,
@@ -83,10 +100,17 @@ def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[s
 def analyse_run(out_dir: Path, fps: float | None, options: AnalysisOptions, board: Path | None, run: dict[str, Any],
                 progress: Callable[[int, int], object] | None = None) -> MeasureReport:  # fmt: skip
     """The three answers for a filmed live run in `out_dir` (its video analysed as `options` say, at
-    the frame rate the camera measured); written to measure.json and measure.png."""
+    the frame rate the camera measured); written to measure.json and measure.png. An invalid run
+    (`run`'s health) is not analysed: its report holds the verdict only."""
+    if run["health"]["status"] == INVALID:
+        report = MeasureReport(out_dir, None, None, None, run)
+        write_report(report)
+        return report
     request = AnalysisRequest(out_dir / "video.avi", replace(options, fps=fps), tracks_csv=out_dir / "tracks.csv")
     video = analyse(request, progress).to_dict()
     log = logged_latency(out_dir, run["renderer"] == EXTERNAL, run)
+    run["video_vs_log"] = video_against_log(out_dir, video, log)
+    write_summary(out_dir, run)
     board_result = None
     if board is not None:
         latency = estimate_from_recording(board)
@@ -150,6 +174,8 @@ def measure(
     with removed_unless_recorded(out_dir):
         result = run_live(config, out_dir, view=view, camera=camera, instruments=board, overwrite=overwrite, progress=progress)
         film = result.summary["film"]
+        if result.summary["health"]["status"] == INVALID:
+            return analyse_run(out_dir, None, options, None, result.summary)
         if film is None or film["frames"] < 2:
             raise RigError(f"the camera {camera_spec} recorded no video; check it films while the run goes")
     return analyse_run(out_dir, film["measured_fps"], options, out_dir / BOARD_FOLDER if board else None, result.summary)

@@ -7,11 +7,12 @@ The run's folder gets what a simulated run writes (`tracker.csv`, `app_frames.cs
 `published_poses.csv` (every display frame's pose with the photon time it was predicted for and the
 newest sample behind it, also pushed on the `RigPose` LSL outlet), the display's own log
 (`display_swaps.csv` for a window, `renderer_markers.csv` for an external renderer) and at the end
-`live.json` (each device's report, the film's, why the run ended). Every row is written as it
-happens; samples that arrive after the session last took any are written when it ends. A
-`Watchdog` instrument ends the run with a clear message when the tracker or the camera goes away
-(`fault()`; what was recorded stays); so does closing the window. With `until_still` the run also
-ends, normally, once the pendulum has stopped swinging.
+`live.json` (each device's report, the film's, why the run ended, and the run's health with its
+verdict, `rig.live.health`). Every row is written as it happens; samples that arrive after the
+session last took any are written when it ends. A `Watchdog` instrument ends the run with a clear
+message when the tracker or the camera goes away (`fault()`; what was recorded stays); so does
+closing the window. With `until_still` the run also ends, normally, once the pendulum has stopped
+swinging.
 """
 
 from __future__ import annotations
@@ -32,6 +33,8 @@ from rig.devices.registry import make_tracker
 from rig.devices.tap import TappedTracker
 from rig.devices.window import SWAP_COLUMNS, FrameClock, WindowDisplay, WindowSettings
 from rig.errors import ConfigError, RigError
+from rig.live.files import LIVE_FILE, MARKERS_FILE, PUBLISHED_FILE, SWAPS_FILE
+from rig.live.health import run_health
 from rig.live.still import RunEnded, SwingWatch
 from rig.live.view import View, view_from_positions
 from rig.lsl import MARKER_COLUMNS, PUBLISHED_COLUMNS, ExternalRenderer, LslPublisher, MarkerDisplay, PublishingRenderer
@@ -41,10 +44,6 @@ from rig.render import RenderSetup, make_renderer
 from rig.session import PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
 from rig.session.session import Progress
 
-LIVE_FILE = "live.json"
-PUBLISHED_FILE = "published_poses.csv"
-SWAPS_FILE = "display_swaps.csv"
-MARKERS_FILE = "renderer_markers.csv"
 FRAMING_S = 2.0
 TRACKER_SILENCE_S = 1.0
 """A tracker silent this long after its link was lost has been unplugged: the run ends."""
@@ -123,6 +122,13 @@ class Watchdog:
         """Nothing to release."""
 
 
+def write_summary(out_dir: Path, summary: dict[str, Any]) -> Path:
+    """The run's summary as `live.json` in `out_dir` (rewritten when the analysis adds to it)."""
+    path = Path(out_dir) / LIVE_FILE
+    path.write_text(json.dumps(summary, indent=1, default=str) + "\n", encoding="utf-8")
+    return path
+
+
 def frame_view(tracker_spec: str, clock: MonotonicClock, width: int, height: int, mirror: bool, seconds: float = FRAMING_S) -> View:
     """The view framing the swing the tracker sees for `seconds` (`rig.live.view`)."""
     tracker = make_tracker(tracker_spec)
@@ -197,8 +203,9 @@ def run_live(
             target=PhotonTarget(config.photon_target, config.persistence),
         )
         record = files.enter_context(RunRecord(out_dir, overwrite=overwrite))
+        session = Session(parts, clock.now(), clock.now() + config.duration_s, record, progress, live=True)
         try:
-            Session(parts, clock.now(), clock.now() + config.duration_s, record, progress, live=True).run()
+            session.run()
             ended = "completed"
         except RunEnded as reason:
             ended = str(reason)
@@ -216,5 +223,7 @@ def run_live(
                 if config.streams else None,
                 "view": {"world_to_clip": view.world_to_clip.tolist(), "sphere_radius_m": view.sphere_radius_m},
             }  # fmt: skip
-            (out_dir / LIVE_FILE).write_text(json.dumps(result.summary, indent=1, default=str) + "\n", encoding="utf-8")
+            result.summary["health"] = run_health(out_dir, display.refresh_hz, session.t_begin,
+                                                  min(session.t_end, clock.now()), result.summary["film"])  # fmt: skip
+            write_summary(out_dir, result.summary)
     return result

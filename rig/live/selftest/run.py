@@ -6,7 +6,8 @@ monotonic clock with its renderer in a real window paced by a frame clock (`Fixe
 or, with `external`, the example external renderer (`examples/external_renderer.py`) runs as a
 separate process that speaks only LSL; the camera twin (`ScreenCamera`) films the window and the
 emulator's LED; then the run is analysed as `rig measure` analyses one. The video's latency must
-agree with the rig's own log's (`AGREEMENT_MS`): that is what the self-test checks.
+agree with the rig's own log's (`AGREEMENT_MS`): that is what the self-test checks, unless the run
+was invalid (the rig stalled: `rig.live.health`), which the report then says instead.
 """
 
 from __future__ import annotations
@@ -96,11 +97,12 @@ def self_test(
             renderer.terminate()
             renderer.wait(timeout=10)
         emulator.close()
-    fps = result.summary["film"]["measured_fps"]
+    film = result.summary["film"]
     options = AnalysisOptions(led_roi=layout.led_roi, sphere_roi=layout.sphere_roi)
-    report = analyse_run(out_dir, fps, options, None, result.summary)
-    report.run["self_test"] = _agreement(report)
-    write_report(report)
+    report = analyse_run(out_dir, film["measured_fps"] if film else None, options, None, result.summary)
+    if not report.invalid:
+        report.run["self_test"] = _agreement(report)
+        write_report(report)
     return report
 
 

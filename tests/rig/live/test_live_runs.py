@@ -1,8 +1,10 @@
 """Live runs end to end on the real clock, under a virtual X server: `rig measure --self-test` with
-the rig's warp renderer and with the external-renderer example speaking only LSL (the video's
-latency must agree with the rig's own log within 2 ms, and nothing is lost), a tracker unplugged
-mid-run, and the one-line errors of a missing display or camera. Only what holds on a slow shared
-machine is asserted: agreement between two measurements of the same run, and counts."""
+the rig's warp renderer and with the external-renderer example speaking only LSL (a valid run's
+video latency must agree with the rig's own log within 2 ms, nothing is lost, and the exit status
+says the run's health verdict; an invalid run names the stall), a tracker unplugged mid-run, and the
+one-line errors of a missing display or camera. Only what holds on a slow shared machine is
+asserted: the verdict and the exit status agree, agreement between two measurements of a valid run,
+and counts."""
 
 from __future__ import annotations
 
@@ -17,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rig.cli import EXIT_INVALID_RUN, EXIT_WARNINGS
 from rig.devices.window import WindowSettings
 from rig.emulate import EmulatorConfig, make_sink, quiet_tracker, run_emulator
 from rig.errors import RigError
@@ -39,11 +42,26 @@ def _rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(stream))
 
 
+def _expected_exit(report: dict) -> int:
+    """The exit status `rig measure` documents for this report: an invalid run 4, a self-test's
+    disagreement 1, a degraded run or a video that misses the whole run 3, else 0."""
+    run = report["run"]
+    if run["health"]["status"] == "invalid":
+        return EXIT_INVALID_RUN
+    if not run["self_test"]["agree"]:
+        return 1
+    return EXIT_WARNINGS if run["health"]["status"] == "degraded" or run["video_vs_log"]["warning"] else 0
+
+
 def _self_test(out: Path, *extra: str) -> dict:
+    """The self-test's report, its exit status checked against its verdict."""
     done = subprocess.run([*RIG, "measure", "--self-test", "--json", "--duration", str(SELF_TEST_S), "--out", str(out), *extra],
                           capture_output=True, text=True, timeout=300)  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout)
+    assert done.stdout, done.stderr
+    report = json.loads(done.stdout)
+    assert done.returncode == _expected_exit(report), done.stderr
+    assert json.loads((out / "live.json").read_text())["health"]["verdict"] == report["verdict"]
+    return report
 
 
 def _nothing_lost(out: Path, report: dict) -> None:
@@ -57,8 +75,12 @@ def _nothing_lost(out: Path, report: dict) -> None:
 @pytest.mark.parametrize("renderer", ["warp", "external"])
 def test_the_self_test_video_agrees_with_the_rigs_own_log(tmp_path: Path, x_display: str, renderer: str) -> None:
     report = _self_test(tmp_path, *(["--external"] if renderer == "external" else []))
+    if report["run"]["health"]["status"] == "invalid":
+        assert "stalled" in report["verdict"] and report["latency_ms"] is None
+        return
     assert {"latency_ms", "ci95_ms", "log_latency_ms"} <= report.keys()
-    assert abs(report["latency_ms"] - report["log_latency_ms"]) <= AGREEMENT_MS
+    if report["run"]["health"]["status"] == "valid":
+        assert abs(report["latency_ms"] - report["log_latency_ms"]) <= AGREEMENT_MS
     assert report["ci95_ms"][0] <= report["latency_ms"] <= report["ci95_ms"][1]
     _nothing_lost(tmp_path, report)
     poses = {row["frame"] for row in _rows(tmp_path / "published_poses.csv")}

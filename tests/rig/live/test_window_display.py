@@ -1,11 +1,13 @@
 """The window display against a fake window on a virtual clock: images reach the refresh they were
 aimed at (never one already accounted for as shown), swaps that overrun are late (the display
 repeated its image), every swap is logged, and a closed window ends the run. Measured refreshes
-come from the swaps' own times."""
+come from the swaps' own times. A frame clock that stalls on purpose makes the run's health
+invalid, the stall named."""
 
 from __future__ import annotations
 
 import contextlib
+from pathlib import Path
 from typing import Iterator
 
 import numpy as np
@@ -14,8 +16,12 @@ import pytest
 from rig.clock import VirtualClock
 from rig.devices.protocols import NO_IMAGE
 from rig.devices.window import SwapRecord, WindowDisplay, WindowSettings
+from predictors import SAMPLE_COLUMNS, PoseSample, sample_row
+from rig.devices.window import SWAP_COLUMNS
 from rig.errors import RigError
-from rig.live.selftest.frame_clock import FixedRateFrameClock
+from rig.live.health import INVALID, run_health
+from rig.live.selftest.frame_clock import START_DELAY_S, FixedRateFrameClock
+from rig.writers import CsvRecord
 
 PERIOD = 1.0 / 60.0
 
@@ -145,3 +151,47 @@ def test_closing_the_window_ends_the_run() -> None:
         display.present(_image(1), clock.now(), 1)
     display.close()
     assert window.closed
+
+
+class StallingFrameClock(FixedRateFrameClock):
+    """Refreshes at 60 Hz, but none for `stall_s` before refresh `at` (a display or a rig that froze)."""
+
+    def __init__(self, at: int, stall_s: float) -> None:
+        super().__init__(60.0)
+        self.at, self.stall_s = at, stall_s
+
+    def vblank(self, k: int) -> float:
+        return super().vblank(k) + (self.stall_s if k >= self.at else 0.0)
+
+    def refresh_after(self, t: float) -> int:
+        k = super().refresh_after(t)
+        return k if k < self.at else max(self.at, super().refresh_after(t - self.stall_s))
+
+
+STALLS = [(60, 1.0), (300, 0.3), (10, 6.0), (90, 0.26), (200, 0.5), (350, 2.0), (420, 0.4), (120, 3.5), (30, 0.75), (250, 1.2)]
+"""(refresh before which the frame clock stalls, for how long): early, late, barely over the
+threshold, and to past the run's end."""
+
+
+@pytest.mark.parametrize(("at", "stall_s"), STALLS)
+def test_a_frame_clock_that_stalls_makes_the_run_invalid_naming_the_stall(tmp_path: Path, at: int, stall_s: float) -> None:
+    clock, run_s, frame_clock = VirtualClock(), 8.0, StallingFrameClock(at, stall_s)
+    t_begin = clock.now()
+    with CsvRecord(tmp_path / "display_swaps.csv", SWAP_COLUMNS) as swaps:
+        display = WindowDisplay(WindowSettings(size=(64, 48)), frame_clock=frame_clock, swap_log=lambda swap: swaps.write(swap.row()),
+                                open_window=lambda settings: FakeWindow(clock, swap_s=2e-4))  # fmt: skip
+        display.connect(clock)
+        image = 0
+        while clock.now() < t_begin + run_s:
+            display.present(_image(image % 200), clock.now(), image)
+            image += 1
+    with CsvRecord(tmp_path / "tracker.csv", SAMPLE_COLUMNS) as tracker:
+        for t in np.arange(t_begin, t_begin + run_s, 0.002):
+            tracker.write(sample_row(PoseSample(t, t, np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))))
+    health = run_health(tmp_path, display.refresh_hz, t_begin, t_begin + run_s, None)
+    gap_ms = (stall_s + PERIOD) * 1e3
+    stalled_at = frame_clock.vblank(at - 1) - t_begin
+    assert health["status"] == INVALID
+    assert health["reasons"] == [f"the rig stalled: no new image for {gap_ms:.0f} ms from {stalled_at:.1f} s into the run"]
+    # the refreshes the stall and the frame clock's start took were not presented
+    assert health["display"]["missed_refreshes"] == pytest.approx((stall_s + START_DELAY_S) * 60.0, abs=1.0)
