@@ -8,9 +8,9 @@ imported once the handlers are in place.
 Exit statuses: 0 a clean result; EXIT_WARNINGS (3) measured, but read the warnings (`rig analyse`:
 an interval widened or corrected for how the camera samples the display, a model misfit, missing
 frames; `rig measure`: a run whose health is degraded, or a video that misses the whole run's
-latency; the number stands, with its caveats printed); EXIT_INVALID_RUN (4) `rig measure`: the
+latency; the number stands, with its caveats printed); EXIT_UNTRUSTED (4) `rig measure`: the
 run's own health makes it invalid (the rig or its tracker stalled), so the stall is printed and no
-latency; EXIT_USER_ERROR (2) bad input, or a video that cannot be measured; EXIT_INTERRUPTED (130)
+latency; `rig check`: a device failed its check; EXIT_USER_ERROR (2) bad input, or a video that cannot be measured; EXIT_INTERRUPTED (130)
 and EXIT_TERMINATED (143) a run stopped, its records kept; EXIT_FAULT (1) a fault of the rig's own,
 printed with its traceback. A few commands give 1 a meaning of their own: `rig demo` and
 `rig measure` a disagreement, `rig tune` parameters not written, `rig plan` no setting that reaches
@@ -61,8 +61,9 @@ REPORT_A_FAULT = (
 )
 EXIT_USER_ERROR = 2
 EXIT_WARNINGS = 3
-EXIT_INVALID_RUN = 4
-"""A live run that cannot be trusted (it stalled): distinct from a bench or input at fault (2)."""
+EXIT_UNTRUSTED = 4
+"""A live run that cannot be trusted (it stalled), or a device that failed `rig check`: distinct
+from a bench or input at fault (2)."""
 EXIT_INTERRUPTED = 130
 EXIT_TERMINATED = 143
 

@@ -19,15 +19,13 @@ import argparse
 import json
 from pathlib import Path
 
-from rig.cli import EXIT_WARNINGS
+from rig.cli import EXIT_UNTRUSTED, EXIT_WARNINGS
 from rig.commands import choices, options, outputs
 from rig.commands.device_options import add_device_options
 from rig.commands.record import add_accept_camera_settings
 from rig.preflight import CheckPlan, CheckReport, run_checks
 from rig.preflight.rows import FAIL, PASS, STATUSES, WARN
 
-EXIT_FAILED = 4
-"""A check failed: the run would not measure what it should."""
 PLANNED_S = 60.0
 """The planned run's duration unless given: `rig measure`'s own."""
 
@@ -49,7 +47,7 @@ def table(report: CheckReport) -> str:
 
 
 def exit_status(status: str) -> int:
-    return {PASS: 0, WARN: EXIT_WARNINGS, FAIL: EXIT_FAILED}[status]
+    return {PASS: 0, WARN: EXIT_WARNINGS, FAIL: EXIT_UNTRUSTED}[status]
 
 
 def _run(args: argparse.Namespace) -> int:

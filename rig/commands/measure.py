@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from analysis import AnalysisOptions
-from rig.cli import EXIT_INVALID_RUN, EXIT_WARNINGS
+from rig.cli import EXIT_UNTRUSTED, EXIT_WARNINGS
 from rig.commands import choices, options, outputs
 from rig.commands.device_options import add_device_options
 from rig.commands.record import add_camera_options
@@ -101,7 +101,7 @@ def _print(report: MeasureReport, as_json: bool, kept: bool = True) -> int:
     degraded run or a video that misses the whole run, then 0."""
     print(json.dumps(report.to_dict(), default=str) if as_json else "\n".join(_lines(report, kept)))
     if report.invalid:
-        return EXIT_INVALID_RUN
+        return EXIT_UNTRUSTED
     check = report.run.get("self_test")
     if check and not check["agree"]:
         return EXIT_DISAGREE

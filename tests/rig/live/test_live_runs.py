@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rig.cli import EXIT_INVALID_RUN, EXIT_WARNINGS
+from rig.cli import EXIT_UNTRUSTED, EXIT_WARNINGS
 from rig.devices.window import WindowSettings
 from rig.emulate import EmulatorConfig, make_sink, quiet_tracker, run_emulator
 from rig.errors import RigError
@@ -47,7 +47,7 @@ def _expected_exit(report: dict) -> int:
     disagreement 1, a degraded run or a video that misses the whole run 3, else 0."""
     run = report["run"]
     if run["health"]["status"] == "invalid":
-        return EXIT_INVALID_RUN
+        return EXIT_UNTRUSTED
     if not run["self_test"]["agree"]:
         return 1
     return EXIT_WARNINGS if run["health"]["status"] == "degraded" or run["video_vs_log"]["warning"] else 0

@@ -13,7 +13,8 @@ import pytest
 
 from predictors import PoseSample
 from rig.clock import VirtualClock
-from rig.commands.check import EXIT_FAILED, exit_status, table
+from rig.cli import EXIT_UNTRUSTED
+from rig.commands.check import exit_status, table
 from rig.preflight import CheckReport
 from rig.preflight import disk as disk_check
 from rig.preflight.rows import FAIL, PASS, WARN, CheckRow, graded, worst
@@ -117,7 +118,7 @@ def test_a_run_without_a_camera_needs_no_room_for_a_film(tmp_path: Path, free_by
 def test_the_worst_row_decides_and_the_exit_status_follows() -> None:
     rows = [CheckRow("a", "x", PASS, "fine"), CheckRow("b", "y", WARN, "meh", "do this")]
     assert worst(rows) == WARN and exit_status(WARN) == 3
-    assert worst([*rows, CheckRow("c", "z", FAIL, "no", "fix that")]) == FAIL and exit_status(FAIL) == EXIT_FAILED
+    assert worst([*rows, CheckRow("c", "z", FAIL, "no", "fix that")]) == FAIL and exit_status(FAIL) == EXIT_UNTRUSTED
     assert worst([]) == PASS and exit_status(PASS) == 0
     assert [graded(v, 0.95, 0.5) for v in (1.0, 0.95, 0.7, 0.49)] == [PASS, PASS, WARN, FAIL]
     with pytest.raises(ValueError, match="status"):
