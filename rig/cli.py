@@ -50,6 +50,26 @@ COMMANDS = {
     "measure": "measure",
 }
 """Each command and its module in rig.commands, in the order `rig --help` lists them."""
+SUMMARIES = {
+    "demo": "simulate the rig end to end and check the analyser against the known latency",
+    "simulate": "simulate the rig and write a video with known latency",
+    "analyse": "measure latency from a video of the LED and the sphere",
+    "calibrate-camera": "measure a camera's readout and exposure from a film of a flashing light",
+    "plan": "recommend the camera setting, film length and layout that reach a latency accuracy",
+    "sweep": "simulate and analyse a grid of simulated rigs into one summary",
+    "report": "write a self-contained HTML report (and Markdown) of a run or of a summary of many",
+    "bench": "benchmarks: speed against error, as JSON and a plot",
+    "tune": "fit a predictor's parameters to recorded motion; keep them only if they beat the defaults on motion held out",
+    "board": "the rig's microcontroller: identity, clock sync, recording, blink, latency",
+    "record-tracker": "record a serial, HID or LSL tracker's samples on the host's clock, as they arrive",
+    "devices": "list the serial ports, HID devices and LSL streams this machine sees",
+    "emulate-tracker": "an emulated tracker (serial over a pty or TCP, or LSL) for tests and demos, with faults on demand",
+    "record": "film with a camera (device, file or stream), every frame written as it comes",
+    "measure": "measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
+}
+"""Each command's line in `rig --help`, kept here so that listing the commands imports none of them."""
+PACKAGE = "latency-rig"
+"""The distribution whose installed metadata `rig --version` reads."""
 EXIT_FAULT = 1
 """A fault of the rig's own (not of the input): its traceback is printed, with REPORT_A_FAULT."""
 REPORT_A_FAULT = (
@@ -100,17 +120,43 @@ def user_errors() -> tuple[type[Exception], ...]:
     return (RigError, PredictorError, AnalysisError)
 
 
+class VersionAction(argparse.Action):
+    """`--version`: the installed package's version, read from its metadata only when asked."""
+
+    def __init__(self, option_strings: list[str], dest: str = argparse.SUPPRESS, **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs=0, help="print the rig's version and exit")
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: object) -> NoReturn:
+        print(f"{parser.prog} {installed_version()}")
+        parser.exit(0)
+
+
+def installed_version() -> str:
+    """The version pip installed, or what to do when the rig runs from a tree that is not installed."""
+    from importlib import metadata  # here, not above: reading it costs as much as the rest of `rig --help`
+
+    try:
+        return metadata.version(PACKAGE)
+    except metadata.PackageNotFoundError:
+        return "(version unknown: not installed; run `pip install -e .` in the rig's folder)"
+
+
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
-    """The whole command line; or, when `argv` names a command, that command alone, so that a
-    command starts without importing every other command's libraries."""
+    """The command line. When `argv` names a command, that command's parser alone is built from
+    its module; otherwise every command is listed by its summary (SUMMARIES) and no command module
+    is imported, so `rig --help` answers at once."""
     parser = OneLineParser(
         prog="rig",
         description="Measure motion-to-photon latency with a pendulum, an LED and a camera; simulate the rig.",
     )
+    parser.add_argument("--version", action=VersionAction)
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     named = next((word for word in argv or () if not word.startswith("-")), None)
-    for module in (COMMANDS[named],) if named in COMMANDS else COMMANDS.values():
-        importlib.import_module(f"rig.commands.{module}").add_parser(subparsers)
+    if named in COMMANDS:
+        importlib.import_module(f"rig.commands.{COMMANDS[named]}").add_parser(subparsers)
+    else:
+        for name in COMMANDS:
+            subparsers.add_parser(name, help=SUMMARIES[name])
     return parser
 
 

@@ -61,7 +61,6 @@ def _run(args: argparse.Namespace) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "analyse",
-        help="measure latency from a video of the LED and the sphere",
         description="Track the LED and the rendered sphere and measure by how much the sphere lags. "
         "Without ROIs the two moving blobs are found and told apart by physical evidence (the display's refresh "
         "steps, the LED's saturation, size, side); when that does not decide, the command stops and asks for the "

@@ -47,7 +47,7 @@ BOARD_CLOCK_LIMIT_S = 10.0
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Registers `board info|sync|record|blink|latency`; each sets func(args) -> exit code."""
-    board = subparsers.add_parser("board", help="the rig's microcontroller: identity, clock sync, recording, blink, latency")
+    board = subparsers.add_parser("board",)
     commands = board.add_subparsers(dest="board_command", required=True, metavar="BOARD_COMMAND")
 
     info = commands.add_parser("info", help="identify the board; show its counters and the clock offset")

@@ -75,7 +75,6 @@ def result_lines(result: ShutterResult) -> list[str]:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "calibrate-camera",
-        help="measure a camera's readout and exposure from a film of a flashing light",
         description="Film a light flashing at a known frequency (an LED lighting a white card, or out of focus so "
         "that it fills the view), or a display flashing full-field, for a few seconds; this measures the "
         "camera's rolling-shutter readout (0 for a global shutter) and its exposure from the bands the flash "

@@ -3,7 +3,6 @@ line saying what it is, for the commands' --help."""
 
 from __future__ import annotations
 
-import predictors
 from rig.commands.options import choices_listing, first_sentence
 
 TRACKER_SPECS = {
@@ -16,6 +15,8 @@ TRACKER_SPECS = {
 
 def predictors_listing() -> str:
     """Every predictor, a line each."""
+    import predictors
+
     lines = {name: first_sentence(type(predictors.make(name))) for name in predictors.names()}
     lines[predictors.DEFAULT] = f"the one used when none is named: {predictors.resolve(predictors.DEFAULT)}"
     return choices_listing("predictors (NAME[:key=value,...] or NAME:FILE.json)", lines)
@@ -50,6 +51,7 @@ def methods_listing() -> str:
 
 def tunable_listing() -> str:
     """The predictors `rig tune` fits, a line each."""
+    import predictors
     from predictors.tuning import TUNABLE
 
     return choices_listing("tunable predictors", {name: first_sentence(type(predictors.make(name))) for name in TUNABLE})

@@ -80,7 +80,6 @@ def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "demo",
-        help="simulate the rig end to end and check the analyser against the known latency",
         description="Simulate the default rig (pendulum, tracker, predictor, OpenGL renderer, display, camera), "
         "analyse the video it writes, and print the measured latency beside the true one. "
         f"Exits with {EXIT_MISMATCH} if they differ by more than {AGREEMENT_MS:g} ms.",

@@ -7,10 +7,11 @@ import argparse
 import json
 
 from rig.commands import options
-from rig.devices.trackers.discovery import hid_devices, lsl_streams, serial_ports
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.devices.trackers.discovery import hid_devices, lsl_streams, serial_ports
+
     found = {"serial": serial_ports(), "hid": hid_devices(), "lsl": lsl_streams(args.lsl_wait)}
     if args.json:
         print(json.dumps(found))
@@ -30,7 +31,7 @@ def _run(args: argparse.Namespace) -> int:
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `devices`."""
-    parser = subparsers.add_parser("devices", help="list the serial ports, HID devices and LSL streams this machine sees", description=__doc__)
+    parser = subparsers.add_parser("devices", description=__doc__)
     parser.add_argument("--lsl-wait", type=options.non_negative_float, default=1.0, metavar="S",
                         help="seconds to listen for LSL streams (default: %(default)s)")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print one JSON object")

@@ -96,7 +96,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `emulate-tracker serial|lsl`."""
     parser = subparsers.add_parser(
         "emulate-tracker",
-        help="an emulated tracker (serial over a pty or TCP, or LSL) for tests and demos, with faults on demand",
         description=__doc__.split("\n\n")[0],
     )
     transports = parser.add_subparsers(dest="transport", required=True, metavar="TRANSPORT")

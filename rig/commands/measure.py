@@ -134,7 +134,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `measure`."""
     parser = subparsers.add_parser(
         "measure",
-        help="measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[2].replace("\n", " "),
         epilog="\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
     )

@@ -99,7 +99,6 @@ def profile_line(path: Path, changes: dict[str, dict[str, Any]]) -> str:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "plan",
-        help="recommend the camera setting, film length and layout that reach a latency accuracy",
         description="Simulate each camera frame rate and exposure on offer filming the display, analyse each as a "
         "lab would (the settings given), and recommend the one that reaches the wanted 95 % half-width with the "
         "shortest film, checked by a simulation; print every setting's expected half-width and the bias a "

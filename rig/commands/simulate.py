@@ -41,7 +41,6 @@ def _run(args: argparse.Namespace) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "simulate",
-        help="simulate the rig and write a video with known latency",
         description="Simulate pendulum, tracker, predictor, renderer, display and camera on a virtual clock. "
         "Writes DIR/video.avi, DIR/camera_frames.csv, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and "
         "DIR/display_frames.csv, "

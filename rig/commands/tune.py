@@ -83,8 +83,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `tune`."""
     parser = subparsers.add_parser(
         "tune",
-        help="fit a predictor's parameters (Kalman noise ratios and damping, DESP's smoothing, auto's "
-        "choice) to recorded motion; keep them only if they beat the defaults on motion held out",
         description=__doc__.split("\n\n")[0],
         epilog=choices.tunable_listing(),
     )
