@@ -25,7 +25,7 @@ import re
 import sys
 import textwrap
 import traceback
-from typing import NoReturn, Sequence
+from typing import Callable, NoReturn, Sequence
 
 from rig import interrupts
 from rig.compile_cache import keep_compiled_fits
@@ -99,11 +99,21 @@ class ListingFormatter(argparse.HelpFormatter):
 
 class OneLineParser(argparse.ArgumentParser):
     """The rig's parser: help that lists choices a line each, and a usage error in one line (the
-    option as typed, what was wrong, where the help is), exit status 2."""
+    option as typed, what was wrong, where the help is), exit status 2.
 
-    def __init__(self, *args: object, **kwargs: object) -> None:
+    `listings` makes the help's epilog (the predictors, renderers or methods a command takes) when
+    the help is shown, not when the parser is built: listing a registry imports what it lists.
+    """
+
+    def __init__(self, *args: object, listings: Callable[[], str] | None = None, **kwargs: object) -> None:
         kwargs.setdefault("formatter_class", ListingFormatter)
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+        self.listings = listings
+
+    def format_help(self) -> str:
+        if self.listings is not None:
+            self.epilog = self.listings()
+        return super().format_help()
 
     def error(self, message: str) -> NoReturn:
         option = re.match(r"argument (--[\w-]+).*: expected one argument", message)

@@ -67,7 +67,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         "ROIs. The interval allows for the camera's sampling of the display and for model misfit. Exit status: 0 "
         "clean, 3 measured with warnings (read them), 2 user error. Compiled fits are kept between runs "
         "(JAX_COMPILATION_CACHE_DIR chooses the folder).",
-        epilog=methods_listing(),
+        listings=methods_listing,
     )
     parser.add_argument(
         "videos",

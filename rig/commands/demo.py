@@ -9,19 +9,23 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rig.commands import outputs
-from rig.commands.formatting import summary_line
 from rig.commands.simulation_options import add_simulation_options, simulation_config
+from rig.demo_settings import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
 from rig.progress import ProgressBar
-from rig.service import compare_renderers, comparison_config, demo
-from rig.service.demo import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
-from rig.sim.config import SimulationConfig
+
+if TYPE_CHECKING:
+    from rig.sim.config import SimulationConfig
 
 EXIT_MISMATCH = 1
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.commands.formatting import summary_line
+    from rig.service import comparison_config, demo
+
     config = simulation_config(args)
     if args.compare:
         return _run_comparison(args, comparison_config(config))
@@ -52,6 +56,8 @@ def _cost_text(ms: float | None, what: str) -> str:
 
 
 def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
+    from rig.service import compare_renderers
+
     if not args.json:
         print(
             f"comparing {' and '.join(COMPARE_RENDERERS)} on one scene: {config.scene_triangles} load triangles, "

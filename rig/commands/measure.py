@@ -135,7 +135,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "measure",
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[2].replace("\n", " "),
-        epilog="\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
+        listings=lambda: "\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
     )
     parser.add_argument("--tracker", metavar="SPEC", help="the tracker on the pendulum (listed below)")
     parser.add_argument("--camera", metavar="SPEC", help=f"the camera filming the LED and the screen: {CAMERA_SPECS}")

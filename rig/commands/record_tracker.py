@@ -58,7 +58,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "record-tracker",
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[1].replace("\n", " "),
-        epilog=choices.trackers_listing(),
+        listings=choices.trackers_listing,
     )
     parser.add_argument("--tracker", required=True, metavar="SPEC", help="the tracker (listed below)")
     parser.add_argument("--duration", type=options.positive_float, metavar="S", help="seconds to record (default: until Ctrl-C)")

@@ -84,7 +84,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "tune",
         description=__doc__.split("\n\n")[0],
-        epilog=choices.tunable_listing(),
+        listings=choices.tunable_listing,
     )
     parser.add_argument("predictor", type=options.predictor_spec, metavar="PREDICTOR[:key=value,...]",
                         help="predictor to tune, with starting or fixed parameters (e.g. the tracker's noise)")

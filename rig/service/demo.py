@@ -10,16 +10,12 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
+from rig.demo_settings import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
 from rig.errors import RigError
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
 from rig.service.simulate import TRUTH_FILE, SimulationResult, simulate
 from rig.session.session import Progress
 from rig.sim.config import SimulationConfig
-
-AGREEMENT_MS = 1.0
-COMPARE_RENDERERS = ("direct", "warp")
-COMPARE_TRIANGLES = 100_000
-COMPARE_APP_FRAME_MS = 100.0
 
 ProgressFactory = Callable[[str], Progress]
 """Makes the progress callback of one stage ("simulating", "analysing")."""

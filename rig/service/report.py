@@ -27,7 +27,7 @@ from rig.report.figures import latency_over_time_figure, residuals_figure, summa
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
 from rig.service.batch import RESULT_COLUMNS
 from rig.service.compare import Z95, differences, group_latencies
-from rig.session.run_record import BOARD_FOLDER
+from rig.session.run_files import BOARD_FOLDER
 
 PACKAGES = ("latency-rig", "numpy", "scipy", "opencv-contrib-python-headless", "jax", "jaxopt", "emcee", "matplotlib", "moderngl")
 RUN_VIDEO = "video.avi"
