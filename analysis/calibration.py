@@ -44,7 +44,6 @@ SWING_MIN_PX = 4.0
 SWING_SAMPLES = 32
 
 PROVISIONAL_RULE = "auto: left blob, until the evidence decides"
-SIDES = ("left", "right")
 
 
 @dataclass(frozen=True)

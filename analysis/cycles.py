@@ -35,9 +35,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from analysis.options import DEFAULT_LATENCY_RANGE_S
 from analysis.windows import WindowPhases
 
-DEFAULT_LATENCY_RANGE_S = (-0.2, 0.6)
 DECISIVE_CHI2 = 25.0
 MIN_SEPARATION_S = 0.002
 # Passes of per-signal reweighting of the window phases.

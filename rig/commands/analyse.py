@@ -10,20 +10,22 @@ import argparse
 import json
 from pathlib import Path
 
-from analysis import AnalysisError, AnalysisOptions
+from analysis.errors import AnalysisError
+from analysis.options import AnalysisOptions
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options, outputs
-from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
 from rig.commands.choices import methods_listing
 from rig.commands.declared_options import add_declared_options, config_from_args
-from rig.commands.formatting import board_line, hints_line, summary_line
 from rig.progress import ProgressBar
-from rig.service import AnalysisRequest, analyse
-from rig.service.batch import find_videos
-from rig.service.bench_profile import read_profile, with_profile
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
+    from rig.commands.formatting import board_line, hints_line, summary_line
+    from rig.service import AnalysisRequest, analyse
+    from rig.service.batch import find_videos
+    from rig.service.bench_profile import read_profile, with_profile
+
     videos = find_videos(args.videos)
     how = config_from_args(AnalysisOptions, args, AnalysisError)
     if args.bench is not None:

@@ -41,7 +41,7 @@ def test_listing_the_commands_imports_none_of_them() -> None:
     assert "importlib.metadata" not in modules
 
 
-LIGHT = ("demo", "simulate", "report", "sweep", "record", "record-tracker", "devices")
+LIGHT = ("demo", "simulate", "analyse", "report", "sweep", "record", "record-tracker", "devices")
 """The commands whose parser is made from light declarations alone (the others' still load numpy)."""
 
 
