@@ -2,8 +2,11 @@
 
 This module imports only the standard library, the rig's error types and its interrupt handling
 (`rig.interrupts`), so that an interrupt or a signal at any moment, imports included, ends in the
-rig's own message and exit status: the command modules (and numpy, OpenCV, JAX behind them) are
-imported once the handlers are in place.
+rig's own message and exit status: the command modules are imported once the handlers are in place.
+`rig --help` lists the commands from SUMMARIES and imports none of them; `rig COMMAND` imports that
+command's module alone, whose parser is made from light declarations (settings dataclasses, the
+help's listings): numpy, OpenCV, JAX, SciPy, matplotlib and the analysis load only once the command
+runs, so that any help answers at once. `rig --version` is the installed package's.
 
 Exit statuses: 0 a clean result; EXIT_WARNINGS (3) measured, but read the warnings (`rig analyse`:
 an interval widened or corrected for how the camera samples the display, a model misfit, missing

@@ -11,7 +11,7 @@ from rig.bench.batch import BatchBenchOptions
 from rig.bench.predictors import PredictorBenchOptions
 from rig.bench.renderers import BenchGrid
 from rig.bench.trackers import TrackerBenchOptions
-from rig.service.tune import TuneSettings
+from rig.tune_settings import TuneSettings
 from rig.service.bench_profile import BenchProfile
 from rig.sim.config import SimulationConfig
 

@@ -13,7 +13,7 @@ received (without recording.json). `rig measure --board PORT` records one beside
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any, Callable
 
@@ -23,23 +23,7 @@ from rig.board.recorder import BoardRecorder
 from rig.clock import Clock
 from rig.errors import RigError
 from rig.fresh_outputs import removed_unless_recorded
-
-DEFAULT_RISE = 512
-DEFAULT_FALL = 256
-
-
-@dataclass(frozen=True)
-class BoardSettings:
-    """What the board records: encoder reports per second (0: every edge), the photodiode's rising
-    and falling thresholds (ADC counts) and every how many raw samples to send (0: none), and how
-    often to synchronise the clocks while recording."""
-
-    encoder_rate_hz: float = 0.0
-    rise: int = DEFAULT_RISE
-    fall: int = DEFAULT_FALL
-    raw_every: int = 0
-    resync_every_s: float = 5.0
-
+from rig.board.settings import BoardSettings
 
 class BoardInstrument:
     """The board at `url` recording into `out_dir`; see the module docstring. `options` go into

@@ -12,19 +12,24 @@ import sys
 from datetime import date
 from pathlib import Path
 
-from analysis import AnalysisError
-from analysis.shutter import ShutterOptions, ShutterResult
-from analysis.shutter.options import DISPLAY_GROUP
+from typing import TYPE_CHECKING
+
+from analysis.errors import AnalysisError
+from analysis.shutter.options import DISPLAY_GROUP, ShutterOptions
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options, outputs
 from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.progress import ProgressBar
-from rig.service import CalibrationRequest, calibrate_camera
-from rig.service.bench_profile import read_profile, shutter_display, write_profile
-from rig.service.calibrate import bench_changes
+
+if TYPE_CHECKING:
+    from analysis.shutter import ShutterResult
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service import CalibrationRequest, calibrate_camera
+    from rig.service.bench_profile import read_profile, shutter_display, write_profile
+    from rig.service.calibrate import bench_changes
+
     if args.bench is not None and args.bench.exists():
         profile = read_profile(args.bench)
         if args.source == "display" and args.display_hz is None:

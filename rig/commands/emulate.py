@@ -19,10 +19,9 @@ from dataclasses import replace
 from pathlib import Path
 
 from rig.commands import options, outputs
-from rig.emulate import EmulatorConfig, make_sink, run_emulator
 from rig.errors import ConfigError
-from rig.sim.tracker import TrackerConfig
-from rig.sim.tracker_faults import FaultPlan, parse_faults
+from rig.sim.fault_plan import FaultPlan, parse_faults
+from rig.sim.tracker_config import TrackerConfig
 
 
 def _faults(text: str) -> FaultPlan:
@@ -33,6 +32,8 @@ def _faults(text: str) -> FaultPlan:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.emulate import EmulatorConfig, make_sink, run_emulator
+
     if args.transport == "lsl":
         transport, address = "lsl", args.name
     else:

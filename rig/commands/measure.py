@@ -20,19 +20,17 @@ import json
 import sys
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from analysis import AnalysisOptions
+from analysis.options import AnalysisOptions
 from rig.commands import choices, options, outputs
 from rig.commands.record import CAMERA_SPECS, add_camera_options
-from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
-from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, measure
-from rig.live.camera_recording import check_first_seconds, record_camera
-from rig.live.run import EXTERNAL, LiveConfig
-from rig.lsl import StreamNames
+from rig.lsl.streams import StreamNames
 from rig.progress import ProgressBar
-from rig.service.bench_profile import read_profile, with_profile
+
+if TYPE_CHECKING:
+    from rig.live.measure import MeasureReport
 
 CHECK_SECONDS = 3.0
 EXIT_DISAGREE = 1
@@ -48,6 +46,8 @@ def _interval(ci: Any) -> str:
 
 
 def _lines(report: MeasureReport, kept: bool) -> list[str]:
+    from rig.live.measure import MEASURE_FILE, PLOT_FILE
+
     video, log = report.video, report.log
     lines = [
         f"latency (video): {video['latency_ms']:.1f} ms{_interval(video['ci95_ms'])} by {video['method']}",
@@ -86,6 +86,8 @@ def _self_test(args: argparse.Namespace) -> int:
 
 
 def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:
+    from rig.live.camera_recording import check_first_seconds, record_camera
+
     for step in GUIDE:
         print(step, file=sys.stderr)
     while True:
@@ -104,6 +106,11 @@ def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.devices.window.spec import parse_window_address
+    from rig.live.measure import measure
+    from rig.live.run import EXTERNAL, LiveConfig
+    from rig.service.bench_profile import read_profile, with_profile
+
     if args.self_test:
         return _self_test(args)
     missing = [name for name in ("tracker", "camera", "out") if getattr(args, name) is None]

@@ -13,14 +13,15 @@ import json
 import sys
 from datetime import date
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rig.commands import options, outputs
 from rig.commands.declared_options import add_declared_option
-from rig.service import Plan, PlanRequest, plan
-from rig.service.bench_profile import BenchProfile, read_profile, write_profile
-from rig.sim.display import DisplayConfig
-from rig.sim.pendulum import PendulumConfig
+from rig.sim.display_config import DisplayConfig
+from rig.sim.pendulum_config import PendulumConfig
+
+if TYPE_CHECKING:
+    from rig.service import Plan
 
 EXIT_UNREACHABLE = 1
 
@@ -65,6 +66,9 @@ def _print(result: Plan) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service import PlanRequest, plan
+    from rig.service.bench_profile import BenchProfile, read_profile, write_profile
+
     request = PlanRequest(
         display_hz=args.display_hz,
         camera_fps=args.camera_fps,
