@@ -7,6 +7,7 @@ from pathlib import Path
 
 from rig.commands import outputs
 from rig.errors import ConfigError
+from rig.progress import ProgressBar
 
 SUMMARY_SUFFIXES = (".csv", ".json")
 
@@ -21,7 +22,7 @@ def _run(args: argparse.Namespace) -> int:
     if source.is_file() and source.suffix.lower() in SUMMARY_SUFFIXES:
         report = summary_report(source, args.group)
     else:
-        report, _ = run_report(source)
+        report, _ = run_report(source, ProgressBar("analysing"))
     page, markdown = write_report(report, args.out)
     print(f"{report.headline}; {report.verdict}")
     print(f"wrote {page} and {markdown}")

@@ -17,7 +17,7 @@ import platform
 import subprocess
 from importlib import metadata
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from analysis import LatencyResult
 from analysis.board.recording import METADATA
@@ -113,8 +113,9 @@ def read_truth(path: Path) -> dict[str, Any]:
     return truth
 
 
-def run_report(path: Path) -> tuple[Report, Measurement]:
-    """The report of a video, or of a run folder holding video.avi (and maybe truth.json, board/)."""
+def run_report(path: Path, progress: Callable[[int, int], object] | None = None) -> tuple[Report, Measurement]:
+    """The report of a video, or of a run folder holding video.avi (and maybe truth.json, board/);
+    `progress(done, total)` as its frames are tracked."""
     path = Path(path)
     folder = path if path.is_dir() and (path / RUN_VIDEO).exists() else None
     video = folder / RUN_VIDEO if folder is not None else path
@@ -122,7 +123,7 @@ def run_report(path: Path) -> tuple[Report, Measurement]:
     truth = read_truth(truth_path) if truth_path.exists() else None
     board = (folder or video.parent) / BOARD_FOLDER
     request = AnalysisRequest(video, board=board if (board / METADATA).exists() else None)
-    measurement = analyse(request)
+    measurement = analyse(request, progress)
     result = measurement.result
     report = Report(f"Latency of {video}", _headline(result), _run_verdict(result, truth))
     report.sections.append(Section("Warnings", list(result.warnings) or ["none"]))
