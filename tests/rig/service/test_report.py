@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import re
 from pathlib import Path
 
@@ -87,3 +88,33 @@ def test_a_report_needs_an_html_file_in_an_existing_folder(small_runs, tmp_path:
         from rig.service.report import read_summary
 
         read_summary(tmp_path / "missing.csv")
+
+
+def _sweep_summary(path: Path) -> Path:
+    """A sweep's summary as `rig sweep` writes it: two periods, two predictors, the truth beside each row."""
+    columns = ("index", "video", "status", "latency_ms", "ci95_low_ms", "ci95_high_ms", "frequency_hz", "truth_ms", "error_ms", "warnings", "error",
+               "predictor", "pendulum.period_s", "camera.impairments.mirrored", "span")  # fmt: skip
+    rows = []
+    for index, (predictor, period, measured, truth) in enumerate(
+        (("hold", 1.0, 1.05, 1.0), ("hold", 1.0, 0.95, 1.0), ("hold", 2.0, 3.1, 3.0), ("slerp", 1.0, 0.5, 0.45), ("slerp", 2.0, 2.2, 2.25))
+    ):
+        rows.append((index, f"point{index:03d}/video.avi", "ok", measured, measured - 0.2, measured + 0.2, 1 / period, truth, measured - truth, "", "",
+                     predictor, period, False, "[0.0, 9.991666666666667]"))  # fmt: skip
+    with open(path, "w", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow(columns)
+        writer.writerows(rows)
+    return path
+
+
+def test_a_sweeps_report_shows_truth_error_and_every_swept_setting_for_people(tmp_path: Path) -> None:
+    assert main(["report", str(_sweep_summary(tmp_path / "summary.csv")), "--group", "predictor", "--out", str(tmp_path / "sweep.html")]) == 0
+    markdown = (tmp_path / "sweep.md").read_text()
+    for header in ("true (ms)", "error (ms)", "predictor", "pendulum.period_s", "camera.impairments.mirrored", "span"):
+        assert f" {header} |" in markdown
+    assert "False" not in markdown and "9.991666666666667" not in markdown and "[0.0" not in markdown
+    assert "| point000/video.avi | ok | hold | 1 | no | 0, 9.992 | 1.05 | 0.85 | 1.25 | 1 | 0.05 |" in markdown
+    by_predictor = markdown.split("## By predictor")[1].split("## ")[0]
+    assert "| hold | 1 | no | 0, 9.992 | 2 | 1 | " in by_predictor  # the two 1 s runs pooled, truth 1 ms
+    assert "| hold | 2 | no | 0, 9.992 | 1 | 3.1 | " in by_predictor  # the 2 s run apart
+    assert by_predictor.count("slerp - hold") == 2  # compared under each period, never across them
