@@ -7,7 +7,6 @@ import re
 from pathlib import Path
 
 import pytest
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from rig.cli import main
 from rig.errors import ConfigError
@@ -21,23 +20,9 @@ def result(small_runs):
     return analyse(AnalysisRequest(small_runs["fast"])).result
 
 
-def _assert_legend_clear_of_data(figure) -> None:
-    """Every axis is labelled, and every legend lies outside its axes (so it covers no data)."""
-    FigureCanvasAgg(figure).draw()
-    renderer = figure.canvas.get_renderer()
-    for axes in figure.axes:
-        if axes.get_label() == "<colorbar>" or not axes.get_visible():
-            continue
-        assert axes.get_xlabel() and axes.get_ylabel(), axes.get_title()
-        legend = axes.get_legend()
-        if legend is not None:
-            box, area = legend.get_window_extent(renderer), axes.get_window_extent(renderer)
-            assert box.x0 >= area.x1 - 1 or box.y1 <= area.y0 + 1 or box.x1 <= area.x0 + 1 or box.y0 >= area.y1 - 1
-
-
-def test_run_figures_label_their_axes_and_keep_legends_off_the_data(result) -> None:
+def test_run_figures_label_their_axes_and_keep_legends_off_the_data(result, legends_clear_of_data) -> None:
     for make in (tracks_figure, latency_over_time_figure, residuals_figure):
-        _assert_legend_clear_of_data(make(result))
+        legends_clear_of_data(make(result))
 
 
 def test_the_tracks_show_the_whole_film(result) -> None:
@@ -59,7 +44,7 @@ def test_a_run_report_is_one_self_contained_page_and_markdown(small_runs, tmp_pa
     assert "wrote" in capsys.readouterr().out
 
 
-def test_a_summary_report_compares_the_runs(small_runs, tmp_path: Path) -> None:
+def test_a_summary_report_compares_the_runs(small_runs, tmp_path: Path, legends_clear_of_data) -> None:
     items = [BatchItem(AnalysisRequest(small_runs[name]), {"system": name}) for name in ("fast", "slow", "broken")]
     run_batch(items, tmp_path / "summary.csv")
     assert main(["report", str(tmp_path / "summary.csv"), "--out", str(tmp_path / "summary.html")]) == 0
@@ -69,7 +54,7 @@ def test_a_summary_report_compares_the_runs(small_runs, tmp_path: Path) -> None:
              "frequency_hz": frequency, "system": n} for n, value, frequency in (("fast", 40.0, 1.4), ("slow", 42.0, 0.8))]  # fmt: skip
     figure = summary_figure(rows, "system")
     assert len(figure.axes) == 2
-    _assert_legend_clear_of_data(figure)
+    legends_clear_of_data(figure)
 
 
 def test_a_group_whose_first_video_failed_keeps_its_legend_entry_and_an_all_failed_batch_has_none() -> None:
