@@ -21,7 +21,7 @@ from rig.progress import ProgressBar
 
 def _run(args: argparse.Namespace) -> int:
     from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
-    from rig.commands.formatting import board_line, hints_line, summary_line
+    from rig.commands.formatting import board_line, hints_line, summary_line, warning_text
     from rig.service import AnalysisRequest, analyse
     from rig.service.batch import find_videos
     from rig.service.bench_profile import read_profile, with_profile
@@ -50,7 +50,7 @@ def _run(args: argparse.Namespace) -> int:
                 ci = f" (95% {estimate.ci95_ms[0]:.2f} to {estimate.ci95_ms[1]:.2f})" if estimate.ci95_ms else ""
                 print(f"  {name}: {estimate.latency_ms:.2f} ms{ci}")
         for warning in result.warnings:
-            print(f"warning: {warning}")
+            print(warning_text(warning))
     if args.plot is not None:
         from analysis.plots import plot_tracks
 

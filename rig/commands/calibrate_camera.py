@@ -51,6 +51,8 @@ def _run(args: argparse.Namespace) -> int:
 
 def result_lines(result: ShutterResult) -> list[str]:
     """The readout, the exposure and what the film showed, a line each, then the warnings."""
+    from rig.commands.formatting import warning_text
+
     low, high = (v * 1e3 for v in result.readout_ci95_s)
     if result.global_shutter:
         readout = f"readout 0 ms: a global shutter (95% at most {high:.3f} ms)"
@@ -73,7 +75,7 @@ def result_lines(result: ShutterResult) -> list[str]:
         f"{result.flash_hz_seen:.4g} Hz (given {result.flash_hz:g}), on {result.duty:.1%} of each period, over rows "
         f"{result.rows[0]}-{result.rows[1]} ({result.row_count} used, {result.saturated_pixels} saturated pixels left out); "
         f"{bands}; frames agree with the bands to {result.timing_rms_s * 1e3:.3f} ms; misfit {result.misfit:.1%} of the swing",
-        *(f"warning: {warning}" for warning in result.warnings),
+        *(warning_text(warning) for warning in result.warnings),
     ]
 
 

@@ -23,7 +23,7 @@ EXIT_MISMATCH = 1
 
 
 def _run(args: argparse.Namespace) -> int:
-    from rig.commands.formatting import summary_line
+    from rig.commands.formatting import summary_line, warning_text
     from rig.service import comparison_config, demo
 
     config = simulation_config(args)
@@ -47,7 +47,7 @@ def _run(args: argparse.Namespace) -> int:
         print(f"difference        {report.difference_ms:+8.2f} ms  {verdict}: the analyser should agree within {AGREEMENT_MS:g} ms")
         print(f"plot of both trajectories: {report.plot}")
         for warning in result.warnings:
-            print(f"warning: {warning}")
+            print(warning_text(warning))
     return 0 if report.agrees else EXIT_MISMATCH
 
 
@@ -56,6 +56,7 @@ def _cost_text(ms: float | None, what: str) -> str:
 
 
 def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
+    from rig.commands.formatting import warning_text
     from rig.service import compare_renderers
 
     if not args.json:
@@ -78,7 +79,7 @@ def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
                 f"{report.difference_ms:+9.2f} ms  {verdict}"
             )
             for warning in report.measurement.result.warnings:
-                print(f"warning ({name}): {warning}")
+                print(warning_text(warning, f"warning ({name})"))
         print(f"plots: {', '.join(str(report.plot) for report in reports.values())}")
     return 0 if agrees else EXIT_MISMATCH
 

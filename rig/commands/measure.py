@@ -46,6 +46,7 @@ def _interval(ci: Any) -> str:
 
 
 def _lines(report: MeasureReport, kept: bool) -> list[str]:
+    from rig.commands.formatting import warning_text
     from rig.live.measure import MEASURE_FILE, PLOT_FILE
 
     video, log = report.video, report.log
@@ -56,7 +57,7 @@ def _lines(report: MeasureReport, kept: bool) -> list[str]:
     ]
     if report.board:
         lines.append(f"latency (photodiode): {report.board['latency_ms']:.1f} +- {report.board['sd_ms']:.1f} ms")
-    lines += [f"warning: {warning}" for warning in video.get("warnings", [])]
+    lines += [warning_text(warning) for warning in video.get("warnings", [])]
     check = report.run.get("self_test")
     if check:
         verdict = "agree" if check["agree"] else "DISAGREE"
