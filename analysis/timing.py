@@ -118,9 +118,10 @@ def implausible_period_warning(period_s: float, times: FrameTimes) -> str | None
     low, high = PLAUSIBLE_PERIOD_S
     if low <= period_s <= high:
         return None
-    return (
-        f"the pendulum period comes out as {period_s:.3g} s at {times.fps:g} fps ({times.source}), which is "
-        "implausible; if the video is slow motion or its frame rate is wrong, pass --fps with the capture rate"
+    return caveat(
+        f"the pendulum period comes out as {period_s:.3g} s at {times.fps:g} fps ({times.source}), unlike any lab "
+        "pendulum's: the frame rate may be wrong",
+        "if the video is slow motion or its frame rate is wrong, give --fps with the rate it was filmed at",
     )
 
 
@@ -145,4 +146,7 @@ def check_count(decoded: int, stated: int, name: str) -> str | None:
     """A warning when a file decodes to a different number of frames than its container states."""
     if stated <= 0 or abs(decoded - stated) <= max(1, math.ceil(0.001 * stated)):
         return None
-    return f"{name} states {stated} frames but {decoded} were decoded; its metadata may be wrong"
+    return caveat(
+        f"{name} states {stated} frames but {decoded} were decoded, so its metadata may be wrong",
+        "check the frame count and rate the camera reports, or record the film again",
+    )

@@ -127,10 +127,10 @@ class SamplingBias:
         """What a lab can do: give the options named, film at a rate that walks through the refresh,
         or (where a refresh fits in a frame interval) expose for whole refreshes."""
         ways = [f"give {' and '.join(options)}"] if options else []
-        if not walks(self.camera_fps):
+        whole = [f"expose for {_whole_refreshes(refresh_hz)}"] if refresh_hz >= self.camera_fps else []
+        if not walks(self.camera_fps) or not ways + whole:
             ways.append(f"film at {suggested_fps(self.camera_fps)} fps (no common display rate is a simple fraction of it)")
-        if refresh_hz >= self.camera_fps:
-            ways.append(f"expose for {_whole_refreshes(refresh_hz)}")
+        ways += whole
         return ", ".join(ways[:-1]) + f" or {ways[-1]}" if len(ways) > 1 else ways[0]
 
     def _phases_text(self) -> str:
@@ -163,8 +163,8 @@ FEW_PHASES = 10
 
 def walks(camera_fps: float) -> bool:
     """Whether no common display rate is a simple fraction of the camera's: it then walks through
-    every phase of any of their refreshes."""
-    return all(commensurate(camera_fps / rate, FEW_PHASES) is None for rate in COMMON_REFRESH_HZ)
+    every phase of any of their refreshes. A rate measured from a film counts to the hundredth of a frame."""
+    return all(commensurate(round(camera_fps, 2) / rate, FEW_PHASES) is None for rate in COMMON_REFRESH_HZ)
 
 
 def suggested_fps(camera_fps: float) -> int:

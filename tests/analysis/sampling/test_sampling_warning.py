@@ -70,3 +70,11 @@ def test_a_caveat_is_two_lines_or_refused() -> None:
     for cause, remedy in (("two\nlines", "remedy"), ("cause", ""), ("", "remedy")):
         with pytest.raises(ValueError):
             caveat(cause, remedy)
+
+
+def test_a_frame_rate_measured_from_a_film_is_told_as_the_rate_it_is() -> None:
+    assert not walks(119.9999) and not walks(120.0001)
+    locked = SamplingBias(**{**UNSEEN, "camera_fps": 119.9999, "refresh_source": "given", "rates_hz": (60.0,), "worst_hz": 60.0,
+                             "exposure": Exposure(4e-3, 4e-3, "given")})  # fmt: skip
+    _, remedy = _lines(locked.warning(*WIDENED))
+    assert remedy == "film at 118 fps (no common display rate is a simple fraction of it)"
