@@ -12,23 +12,31 @@ TEST_STAMP := $(VENV)/.installed-test
 .PHONY: demo test test-all system test-system venv clean
 
 system:
+	@echo "== checking the Debian packages the rig needs (system-packages.txt)"
 	@scripts/install-system-packages.sh system-packages.txt
 
 test-system:
+	@echo "== checking the Debian packages the tests need (system-packages.txt, firmware/ and tests/)"
 	@scripts/install-system-packages.sh system-packages.txt firmware/system-packages.txt tests/system-packages.txt
 
 venv: $(STAMP)
 
+# pip's own lines (each package as it is collected, downloaded and installed) show while it works:
+# the first install takes minutes.
 $(STAMP): pyproject.toml setup.py analysis/_jpeg_region.c rig/devices/trackers/_readers.c constraints.txt
+	@echo "== making a Python virtual environment in $(VENV)"
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet -c constraints.txt -e .
+	@echo "== installing the rig and the Python packages pinned in constraints.txt into $(VENV) (minutes the first time: numpy, OpenCV, JAX, SciPy, matplotlib, and compiling the rig's two C extensions)"
+	$(BIN)/pip install --progress-bar on -c constraints.txt -e .
 	touch $(STAMP)
 
 $(TEST_STAMP): $(STAMP)
-	$(BIN)/pip install --quiet -c constraints.txt -e '.[test,docs]'
+	@echo "== installing the test tools pinned in constraints.txt (pytest, pytest-timeout, hypothesis and the notebook runner, and MkDocs for the documentation) into $(VENV)"
+	$(BIN)/pip install --progress-bar on -c constraints.txt -e '.[test,docs]'
 	touch $(TEST_STAMP)
 
 demo: system $(STAMP)
+	@echo "== running the demo: a simulated rig filmed and measured, into out/demo"
 	$(BIN)/rig demo --out out/demo
 
 # `make test` is what CI runs: every test but those marked slow (heavier variants of what the others

@@ -12,15 +12,27 @@ its ``hints`` carry what a lab says of its bench (``Hint``), each checked agains
 (sinefit, bayes) is asked for, and no import changes a JAX setting.
 """
 
-from analysis.errors import AnalysisError
-from analysis.estimation import estimate
-from analysis.estimators.contract import EstimationContext, Estimator
-from analysis.estimators.registry import methods, register_estimator, unregister_estimator
-from analysis.hints import Hint
-from analysis.options import AnalysisOptions
-from analysis.pipeline import analyse
-from analysis.result import LatencyResult, MethodResult
-from analysis.tracks import Tracks, track
+from declared.lazy import lazy_exports
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "AnalysisError": "analysis.errors",
+        "estimate": "analysis.estimation",
+        "EstimationContext": "analysis.estimators.contract",
+        "Estimator": "analysis.estimators.contract",
+        "methods": "analysis.estimators.registry",
+        "register_estimator": "analysis.estimators.registry",
+        "unregister_estimator": "analysis.estimators.registry",
+        "Hint": "analysis.hints",
+        "AnalysisOptions": "analysis.options",
+        "analyse": "analysis.pipeline",
+        "LatencyResult": "analysis.result",
+        "MethodResult": "analysis.result",
+        "Tracks": "analysis.tracks",
+        "track": "analysis.tracks",
+    },
+)
 
 __all__ = [
     "AnalysisError",

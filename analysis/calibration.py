@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from analysis.caveat import caveat
 from analysis.errors import AnalysisError
 from analysis.blobs import BlobModel, Roi, calibrate_blob, find_moving_regions
 from analysis.video.frames import Frame
@@ -44,7 +45,6 @@ SWING_MIN_PX = 4.0
 SWING_SAMPLES = 32
 
 PROVISIONAL_RULE = "auto: left blob, until the evidence decides"
-SIDES = ("left", "right")
 
 
 @dataclass(frozen=True)
@@ -83,10 +83,10 @@ def _auto_models(images: Sequence[np.ndarray], led_side: str | None, warnings: l
             "or give both regions (--led-roi and --sphere-roi)"
         )
     if len(regions) > 2:
-        warnings.append(
-            f"found {len(regions)} moving regions; used the two largest, "
-            f"{regions[0].as_list()} and {regions[1].as_list()}"
-        )
+        warnings.append(caveat(
+            f"found {len(regions)} moving regions, and used the two largest, {regions[0].as_list()} and {regions[1].as_list()}",
+            "keep other moving or bright things out of view, or give --led-roi and --sphere-roi",
+        ))  # fmt: skip
     first, second = (calibrate_blob(roi, images, "auto-detected") for roi in regions[:2])
     left, right = (first, second) if first.roi.x <= second.roi.x else (second, first)
     if led_side == "right":

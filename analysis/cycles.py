@@ -35,9 +35,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from analysis.caveat import caveat
+from analysis.options import DEFAULT_LATENCY_RANGE_S
 from analysis.windows import WindowPhases
 
-DEFAULT_LATENCY_RANGE_S = (-0.2, 0.6)
 DECISIVE_CHI2 = 25.0
 MIN_SEPARATION_S = 0.002
 # Passes of per-signal reweighting of the window phases.
@@ -168,17 +169,18 @@ def _event_choice(
     listed = ", ".join(f"the {name} {lag * 1e3:.0f} ms" for name, lag in event_lags_s.items())
     off = [name for name, lag in event_lags_s.items() if abs(lag - picks[name]) > EVENT_TOLERANCE_PERIODS * period_s]
     if off or len({round(pick / period_s) for pick in picks.values()}) > 1:
-        return None, (
+        return None, caveat(
             f"the swing's events ({listed} from LED to sphere) do not agree with each other or with the phase "
-            f"(latency {latency_s * 1e3:.1f} ms modulo {period_s * 1e3:.1f} ms); they were not used. Check the tracks "
-            "at the start and end of the clip"
+            f"(latency {latency_s * 1e3:.1f} ms modulo {period_s * 1e3:.1f} ms), and were not used",
+            "check the tracks at the start and end of the clip (--plot)",
         )
     chosen = next(iter(picks.values()))
     low, high = latency_range_s
     if not low <= chosen <= high:
-        return chosen, (
+        return chosen, caveat(
             f"the swing's events ({listed}) put the latency at {chosen * 1e3:.1f} ms, outside the range "
-            f"{low * 1e3:g} to {high * 1e3:g} ms; reported it"
+            f"{low * 1e3:g} to {high * 1e3:g} ms, and it was reported",
+            "widen --latency-range if such a latency is possible, or check the tracks at the start and end of the clip",
         )
     return chosen, None
 
@@ -216,13 +218,11 @@ def resolve_cycles(
         return CycleResolution(best, False, "chirp", candidates, separation, runner_up, event_warning, events)
     reference = min(candidates, key=abs)
     low, high = latency_range_s
-    warning = (
-        f"the latency is known only modulo the swing period ({period_s * 1e3:.1f} ms): it may be any of "
-        f"{listed} ms (all within the plausible range {low * 1e3:g} to {high * 1e3:g} ms), and the swing's "
-        f"chirp cannot tell them apart (it separates them by {separation * 1e3:.2f} ms of latency drift, "
-        f"chi-square {runner_up:.1f}); reported the one nearest zero. Film a wider swing of a more "
-        "damped pendulum, use a longer pendulum, or narrow the range if you know better"
+    unsettled = ", nor do the swing's events, which do not agree with each other" if event_warning else ""
+    warning = caveat(
+        f"the latency is known only modulo the swing period ({period_s * 1e3:.1f} ms): it may be any of {listed} ms "
+        f"(all within {low * 1e3:g} to {high * 1e3:g} ms), the swing's chirp cannot tell them apart{unsettled}, and the "
+        "one nearest zero was reported",
+        "film a wider swing of a more damped pendulum, use a longer pendulum, or narrow --latency-range if the lab knows better",
     )
-    if event_warning:
-        warning = f"{warning}. Also, {event_warning[0].lower()}{event_warning[1:]}"
     return CycleResolution(reference, True, "unresolved", candidates, separation, runner_up, warning, events)

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.caveat import caveat
 from analysis.longrun import long_run_variance
 from analysis.sampling.residuals import TimingResiduals
 from analysis.swing import Swing
@@ -95,14 +96,14 @@ class MisfitReport:
         if not failed:
             return None
         widened = (
-            f"; the interval was widened to the spread of the per-swing latencies (+-{self.between_swings_s * 1e3:.2f} ms)"
+            f", and the interval was widened to the spread of the per-swing latencies (+-{self.between_swings_s * 1e3:.2f} ms)"
             if self.between_swings_s is not None
             else ""
         )
-        return (
-            f"the model does not fit the swing: {'; '.join(f'{c.name}: {c.detail}' for c in failed)}{widened}. "
-            "Check the plot (--plot) for a latency that changes over the clip, a blob that is partly hidden or merges "
-            "with another, or a display that drops or repeats frames"
+        return caveat(
+            f"the model does not fit the swing ({'; '.join(f'{c.name}: {c.detail}' for c in failed)}){widened}",
+            "check the plot (--plot) for a latency that changes over the clip, a blob partly hidden or merging with "
+            "another, or a display that drops or repeats frames",
         )
 
     def to_dict(self) -> dict[str, object]:

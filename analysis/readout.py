@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.caveat import caveat
 from analysis.errors import AnalysisError
 from analysis.blobs import Track
 
@@ -96,14 +97,12 @@ class RollingShutter:
         if abs(bound) <= max(WIDENING_NOTICE * half_width, WIDENING_NOTICE_S):
             return None
         where, later, longer = ("below", "later", "longer") if bound > 0 else ("above", "earlier", "shorter")
-        return (
-            f"the sphere sits {abs(self.sphere_row - self.led_row):.0f} rows {where} the LED (rows {self.sphere_row:.0f} "
-            f"and {self.led_row:.0f} of {self.frame_height}): if the camera has a rolling shutter, reading rows top to "
-            f"bottom, it films the sphere up to {abs(bound) * 1e3:.2f} ms {later} in each frame than the LED (for a "
-            f"readout up to the frame interval, {self.readout_s * 1e3:.3g} ms), so the latency may be up to that much "
-            f"{longer} than measured, and the interval was widened by it on that side. To avoid it, film the LED at "
-            "the sphere's height, or give the camera's readout time (--readout-ms; 0 for a global shutter), or "
-            "measure it (rig calibrate-camera)"
+        return caveat(
+            f"the sphere sits {abs(self.sphere_row - self.led_row):.0f} rows {where} the LED, so a rolling shutter may film "
+            f"it up to {abs(bound) * 1e3:.2f} ms {later} than the LED: the latency may be that much {longer} than "
+            "measured, and the interval was widened by it on that side",
+            "film the LED at the sphere's height, give the camera's readout (--readout-ms; 0 for a global shutter), or "
+            "measure it (rig calibrate-camera)",
         )
 
     def to_dict(self) -> dict[str, object]:

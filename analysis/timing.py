@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.caveat import caveat
 from analysis.errors import AnalysisError
 
 # A stamp this far from its constant-rate slot (fraction of the interval, or absolute seconds,
@@ -67,7 +68,10 @@ def frame_times(
                 "unusable; pass --fps (fps=) with the camera's frame rate"
             )
         if count >= 2 and np.all(np.isfinite(stamps)):
-            warnings.append(f"the {stamp_origin} timestamps do not increase; frame times are taken as i / {rate:g} fps")
+            warnings.append(caveat(
+                f"the {stamp_origin} timestamps do not increase, so frame i was taken at i / {rate:g} fps",
+                "give --fps with the camera's frame rate if that is not it, or film with an app that stamps each frame",
+            ))  # fmt: skip
         return _uniform(count, rate, "frame rate given" if user_fps is not None else "stated frame rate", warnings)
 
     relative = stamps - stamps[0]
@@ -83,21 +87,24 @@ def frame_times(
             break
     stamp_fps = 1.0 / slope if constant else 1.0 / median
     if stated_fps is not None and abs(stamp_fps - stated_fps) > RATE_AGREEMENT * stated_fps:
-        warnings.append(
-            f"the file states {stated_fps:g} fps but its timestamps are {stamp_fps:.4g} fps apart; "
-            f"used the timestamps{'' if user_fps is None else ' (rescaled to the frame rate given)'}"
-        )
+        warnings.append(caveat(
+            f"the file states {stated_fps:g} fps but its timestamps are {stamp_fps:.4g} fps apart, and the timestamps "
+            f"were used{'' if user_fps is None else ' (rescaled to the frame rate given)'}",
+            "give --fps with the camera's true frame rate if the timestamps are wrong",
+        ))  # fmt: skip
     dropped = int(slots[-1]) - (count - 1) if constant else 0
     if dropped > 0:
-        warnings.append(
-            f"{dropped} frame(s) were dropped by the recorder (gaps in the {stamp_origin} timestamps); "
-            "the analysis uses the true frame times"
-        )
+        warnings.append(caveat(
+            f"{dropped} frame(s) were dropped by the recorder (gaps in the {stamp_origin} timestamps); the analysis "
+            "used the true frame times",
+            "film at a rate, size or quality the recorder keeps up with, so that it keeps every frame",
+        ))  # fmt: skip
     if not constant:
-        warnings.append(
-            f"the frame rate varies (timestamps stray up to {jitter * 1e3:.2f} ms from a constant rate); "
-            "frame times are taken from the timestamps"
-        )
+        warnings.append(caveat(
+            f"the frame rate varies (timestamps stray up to {jitter * 1e3:.2f} ms from a constant rate), so each "
+            "frame's time was taken from its timestamp",
+            "fix the camera's frame rate and exposure (no automatic modes) if the timestamps may be wrong",
+        ))  # fmt: skip
     unit = stamp_fps / user_fps if user_fps is not None else 1.0
     times = (slots * slope if constant else relative) * unit
     fps = user_fps if user_fps is not None else stamp_fps
@@ -111,9 +118,10 @@ def implausible_period_warning(period_s: float, times: FrameTimes) -> str | None
     low, high = PLAUSIBLE_PERIOD_S
     if low <= period_s <= high:
         return None
-    return (
-        f"the pendulum period comes out as {period_s:.3g} s at {times.fps:g} fps ({times.source}), which is "
-        "implausible; if the video is slow motion or its frame rate is wrong, pass --fps with the capture rate"
+    return caveat(
+        f"the pendulum period comes out as {period_s:.3g} s at {times.fps:g} fps ({times.source}), unlike any lab "
+        "pendulum's: the frame rate may be wrong",
+        "if the video is slow motion or its frame rate is wrong, give --fps with the rate it was filmed at",
     )
 
 
@@ -138,4 +146,7 @@ def check_count(decoded: int, stated: int, name: str) -> str | None:
     """A warning when a file decodes to a different number of frames than its container states."""
     if stated <= 0 or abs(decoded - stated) <= max(1, math.ceil(0.001 * stated)):
         return None
-    return f"{name} states {stated} frames but {decoded} were decoded; its metadata may be wrong"
+    return caveat(
+        f"{name} states {stated} frames but {decoded} were decoded, so its metadata may be wrong",
+        "check the frame count and rate the camera reports, or record the film again",
+    )

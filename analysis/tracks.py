@@ -34,6 +34,7 @@ from analysis.calibration import (
     calibration_plan,
     calibration_window,
 )
+from analysis.caveat import caveat
 from analysis.errors import AnalysisError
 from analysis.identity import Identity, identify
 from analysis.options import AnalysisOptions
@@ -212,9 +213,12 @@ def check_track(track: Track, name: str, warnings: list[str]) -> None:
         if cut:
             reasons.append(f"{cut} cut off by the ROI's edge")
         detail = f", of them {' and '.join(reasons)}" if reasons else ""
-        warnings.append(
-            f"the {name} was missing in {missing} frames ({1 - found:.1%}){detail}; those frames were left out"
-        )
+        remedies = [f"keep the {name} lit and in view while filming"] if dark or not cut else []
+        remedies += [f"give a larger {name} ROI that holds its whole swing"] if cut else []
+        warnings.append(caveat(
+            f"the {name} was missing in {missing} frames ({1 - found:.1%}){detail}; those frames were left out",
+            ", and ".join(remedies),
+        ))  # fmt: skip
 
 
 def _identity(first: Track, second: Track, fps: float) -> Identity:
@@ -284,10 +288,11 @@ def track(
             warnings.append(count_warning)
     repeats = recorder_repeats(noted.mask(stamps.size), times)
     if np.any(repeats):
-        warnings.append(
+        warnings.append(caveat(
             f"{int(np.count_nonzero(repeats))} frame(s) repeat the one before exactly, whole (inserted by the recorder); "
-            "they were left out"
-        )
+            "they were left out",
+            "film at a rate, size or quality the recorder keeps up with, so that it inserts no copies",
+        ))  # fmt: skip
     led = tracked.track_of(0, times.t, repeats)
     sphere = tracked.track_of(1, times.t, repeats)
     led_roi, sphere_roi, rule = calibration.led.roi, calibration.sphere.roi, calibration.led_rule

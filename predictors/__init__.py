@@ -19,13 +19,33 @@ filters (`predictors.jax_filters`) import JAX, so they are imported only by name
 the real-time path stays free of it.
 """
 
-from predictors import quaternion
-from predictors.errors import PredictorError
-from predictors.evaluation import Evaluation, HorizonScore, evaluate
-from predictors.params_file import read_params, write_params
-from predictors.pose import Pose, PoseSample
-from predictors.registry import DEFAULT, Predictor, make, names, resolve
-from predictors.trace import SAMPLE_COLUMNS, Trace, read_samples, read_trace, sample_row, write_trace
+from declared.lazy import lazy_exports
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "quaternion": "predictors.quaternion",
+        "PredictorError": "predictors.errors",
+        "Evaluation": "predictors.evaluation",
+        "HorizonScore": "predictors.evaluation",
+        "evaluate": "predictors.evaluation",
+        "read_params": "predictors.params_file",
+        "write_params": "predictors.params_file",
+        "Pose": "predictors.pose",
+        "PoseSample": "predictors.pose",
+        "DEFAULT": "predictors.registry",
+        "Predictor": "predictors.registry",
+        "make": "predictors.registry",
+        "names": "predictors.registry",
+        "resolve": "predictors.registry",
+        "SAMPLE_COLUMNS": "predictors.trace",
+        "Trace": "predictors.trace",
+        "read_samples": "predictors.trace",
+        "read_trace": "predictors.trace",
+        "sample_row": "predictors.trace",
+        "write_trace": "predictors.trace",
+    },
+)
 
 __all__ = [
     "DEFAULT",

@@ -2,17 +2,20 @@
 
 This module imports only the standard library, the rig's error types and its interrupt handling
 (`rig.interrupts`), so that an interrupt or a signal at any moment, imports included, ends in the
-rig's own message and exit status: the command modules (and numpy, OpenCV, JAX behind them) are
-imported once the handlers are in place.
+rig's own message and exit status: the command modules are imported once the handlers are in place.
+`rig --help` lists the commands from SUMMARIES and imports none of them; `rig COMMAND` imports that
+command's module alone, whose parser is made from light declarations (settings dataclasses, the
+help's listings): numpy, OpenCV, JAX, SciPy, matplotlib and the analysis load only once the command
+runs, so that any help answers at once. `rig --version` is the installed package's.
 
 Exit statuses: 0 a clean result; EXIT_WARNINGS (3) measured, but read the warnings (`rig analyse`:
 an interval widened or corrected for how the camera samples the display, a model misfit, missing
 frames; `rig measure`: a run whose health is degraded, or a video that misses the whole run's
 latency; the number stands, with its caveats printed); EXIT_UNTRUSTED (4) `rig measure`: the
 run's own health makes it invalid (the rig or its tracker stalled), so the stall is printed and no
-latency; `rig check`: a device failed its check; EXIT_USER_ERROR (2) bad input, or a video that cannot be measured; EXIT_INTERRUPTED (130)
-and EXIT_TERMINATED (143) a run stopped, its records kept; EXIT_FAULT (1) a fault of the rig's own,
-printed with its traceback. A few commands give 1 a meaning of their own: `rig demo` and
+latency; `rig check`: a device failed its check; EXIT_USER_ERROR (2) bad input, or a video that
+cannot be measured; EXIT_INTERRUPTED (130) and EXIT_TERMINATED (143) a run stopped, its records
+kept; EXIT_FAULT (1) a fault of the rig's own, printed with its traceback. A few commands give 1 a meaning of their own: `rig demo` and
 `rig measure` a disagreement, `rig tune` parameters not written, `rig plan` no setting that reaches
 the accuracy. A sweep, a batch (`rig analyse` of many videos) or a bench whose every item failed
 exits EXIT_USER_ERROR, after writing its summary with why each failed: there is no number to read.
@@ -27,7 +30,7 @@ import re
 import sys
 import textwrap
 import traceback
-from typing import NoReturn, Sequence
+from typing import Callable, NoReturn, Sequence
 
 from rig import interrupts
 from rig.compile_cache import keep_compiled_fits
@@ -53,6 +56,27 @@ COMMANDS = {
     "check": "check",
 }
 """Each command and its module in rig.commands, in the order `rig --help` lists them."""
+SUMMARIES = {
+    "demo": "simulate the rig end to end and check the analyser against the known latency",
+    "simulate": "simulate the rig and write a video with known latency",
+    "analyse": "measure latency from a video of the LED and the sphere",
+    "calibrate-camera": "measure a camera's readout and exposure from a film of a flashing light",
+    "plan": "recommend the camera setting, film length and layout that reach a latency accuracy",
+    "sweep": "simulate and analyse a grid of simulated rigs into one summary",
+    "report": "write a self-contained HTML report (and Markdown) of a run or of a summary of many",
+    "bench": "benchmarks: speed against error, as JSON and a plot",
+    "tune": "fit a predictor's parameters to recorded motion; keep them only if they beat the defaults on motion held out",
+    "board": "the rig's microcontroller: identity, clock sync, recording, blink, latency",
+    "record-tracker": "record a serial, HID or LSL tracker's samples on the host's clock, as they arrive",
+    "devices": "list the serial ports, HID devices and LSL streams this machine sees",
+    "emulate-tracker": "an emulated tracker (serial over a pty or TCP, or LSL) for tests and demos, with faults on demand",
+    "record": "film with a camera (device, file or stream), every frame written as it comes",
+    "measure": "measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
+    "check": "check the devices a run would use (display refresh and pacing, camera rate and exposure, tracker, disk) in about 10 s",
+}
+"""Each command's line in `rig --help`, kept here so that listing the commands imports none of them."""
+PACKAGE = "latency-rig"
+"""The distribution whose installed metadata `rig --version` reads."""
 EXIT_FAULT = 1
 """A fault of the rig's own (not of the input): its traceback is printed, with REPORT_A_FAULT."""
 REPORT_A_FAULT = (
@@ -85,11 +109,21 @@ class ListingFormatter(argparse.HelpFormatter):
 
 class OneLineParser(argparse.ArgumentParser):
     """The rig's parser: help that lists choices a line each, and a usage error in one line (the
-    option as typed, what was wrong, where the help is), exit status 2."""
+    option as typed, what was wrong, where the help is), exit status 2.
 
-    def __init__(self, *args: object, **kwargs: object) -> None:
+    `listings` makes the help's epilog (the predictors, renderers or methods a command takes) when
+    the help is shown, not when the parser is built: listing a registry imports what it lists.
+    """
+
+    def __init__(self, *args: object, listings: Callable[[], str] | None = None, **kwargs: object) -> None:
         kwargs.setdefault("formatter_class", ListingFormatter)
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+        self.listings = listings
+
+    def format_help(self) -> str:
+        if self.listings is not None:
+            self.epilog = self.listings()
+        return super().format_help()
 
     def error(self, message: str) -> NoReturn:
         option = re.match(r"argument (--[\w-]+).*: expected one argument", message)
@@ -106,17 +140,43 @@ def user_errors() -> tuple[type[Exception], ...]:
     return (RigError, PredictorError, AnalysisError)
 
 
+class VersionAction(argparse.Action):
+    """`--version`: the installed package's version, read from its metadata only when asked."""
+
+    def __init__(self, option_strings: list[str], dest: str = argparse.SUPPRESS, **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs=0, help="print the rig's version and exit")
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: object) -> NoReturn:
+        print(f"{parser.prog} {installed_version()}")
+        parser.exit(0)
+
+
+def installed_version() -> str:
+    """The version pip installed, or what to do when the rig runs from a tree that is not installed."""
+    from importlib import metadata  # here, not above: reading it costs as much as the rest of `rig --help`
+
+    try:
+        return metadata.version(PACKAGE)
+    except metadata.PackageNotFoundError:
+        return "(version unknown: not installed; run `pip install -e .` in the rig's folder)"
+
+
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
-    """The whole command line; or, when `argv` names a command, that command alone, so that a
-    command starts without importing every other command's libraries."""
+    """The command line. When `argv` names a command, that command's parser alone is built from
+    its module; otherwise every command is listed by its summary (SUMMARIES) and no command module
+    is imported, so `rig --help` answers at once."""
     parser = OneLineParser(
         prog="rig",
         description="Measure motion-to-photon latency with a pendulum, an LED and a camera; simulate the rig.",
     )
+    parser.add_argument("--version", action=VersionAction)
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     named = next((word for word in argv or () if not word.startswith("-")), None)
-    for module in (COMMANDS[named],) if named in COMMANDS else COMMANDS.values():
-        importlib.import_module(f"rig.commands.{module}").add_parser(subparsers)
+    if named in COMMANDS:
+        importlib.import_module(f"rig.commands.{COMMANDS[named]}").add_parser(subparsers)
+    else:
+        for name in COMMANDS:
+            subparsers.add_parser(name, help=SUMMARIES[name])
     return parser
 
 

@@ -21,11 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from rig.errors import ConfigError, RigError
+from rig.film_formats import STAMPED_CONTAINERS, check_film_format
 from rig.writers import MJPEG_AVI_MAX_FPS, CsvRecord, check_avi_rate
 
-CONTAINERS = ("avi", "mp4", "mov")
-CODECS = ("mjpeg", "h264", "hevc")
-STAMPED_CONTAINERS = ("mp4", "mov")
 TIME_BASE = Fraction(1, 90_000)
 FRAME_TIMES_FILE = "frame_times.csv"
 FRAME_TIME_COLUMNS = ("frame", "t_start", "pts", "t_presented")
@@ -37,23 +35,6 @@ _ENCODERS = {
 }
 _FULL_RANGE = 2  # AVCOL_RANGE_JPEG: luma 0..255
 _NEUTRAL_CHROMA = 128
-
-
-def check_film_format(container: str, codec: str, stamped: bool) -> None:
-    """ConfigError unless `codec` goes in `container` here, and (`stamped`) the container stamps each
-    frame with its own time."""
-    if container not in CONTAINERS:
-        raise ConfigError(f"a film's container is one of {', '.join(CONTAINERS)}, got {container!r}")
-    if codec not in CODECS:
-        raise ConfigError(f"a film's codec is one of {', '.join(CODECS)}, got {codec!r}")
-    if (container == "avi") != (codec == "mjpeg"):
-        raise ConfigError(
-            f"{codec} in {container} is not written here: an AVI holds MJPEG, an MP4 or a MOV holds h264 or hevc"
-        )
-    if stamped and container not in STAMPED_CONTAINERS:
-        raise ConfigError(
-            "a film with variable frame timing needs a container that stamps each frame: give --container mp4 or mov"
-        )
 
 
 STAMPED_MAX_FPS = 10_000.0
@@ -80,11 +61,6 @@ def film_holding(fps: float) -> tuple[str, str]:
     film = ("avi", "mjpeg") if fps <= MJPEG_AVI_MAX_FPS else ("mp4", "h264")
     check_film_rate(fps, film[0])
     return film
-
-
-def default_codec(container: str) -> str:
-    """The codec a film in `container` is written with unless another is asked for."""
-    return "mjpeg" if container == "avi" else "h264"
 
 
 def video_file_name(container: str) -> str:

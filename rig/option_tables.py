@@ -11,12 +11,13 @@ from rig.bench.batch import BatchBenchOptions
 from rig.bench.predictors import PredictorBenchOptions
 from rig.bench.renderers import BenchGrid
 from rig.bench.trackers import TrackerBenchOptions
-from rig.board.instrument import BoardSettings
+from rig.board.settings import BoardSettings
 from rig.commands.board import BlinkOptions, SyncOptions
 from rig.commands.devices import Listing
 from rig.commands.emulate import EmulatorOptions
+from rig.emulator_settings import ReaderWait
 from rig.live.run import LiveConfig
-from rig.service.tune import TuneSettings
+from rig.tune_settings import TuneSettings
 from rig.service.bench_profile import BenchProfile
 from rig.service.plan import PlanRequest
 from rig.sim.config import SimulationConfig
@@ -53,6 +54,7 @@ SECTIONS = (
     ("The tracker bench", TrackerBenchOptions, True, "`rig bench trackers`'s options."),
     ("The batch bench", BatchBenchOptions, True, "`rig bench batch`'s options; a batch that would take more than a day is refused with its estimate."),
     ("The tracker emulator", EmulatorOptions, True, "`rig emulate-tracker`'s numeric options (`--drift-ppm`: `serial` only)."),
+    ("The tracker emulator's wait for a reader", ReaderWait, True, "`rig emulate-tracker --idle-timeout`."),
     (
         "A live run",
         LiveConfig,

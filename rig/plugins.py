@@ -18,6 +18,9 @@ from typing import Any, Mapping
 
 from rig.errors import ConfigError, RigError
 
+RENDERER_GROUP = "rig.renderers"
+"""The entry-point group of renderers (`rig.render.registry`)."""
+
 
 def plugin_names(group: str, built_in: Mapping[str, Any]) -> list[str]:
     """Every name `load_plugin` accepts for `group`, sorted: built-in and installed third-party."""

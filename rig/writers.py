@@ -23,7 +23,6 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any, Sequence
 
-import cv2
 import numpy as np
 
 from rig.errors import RigError
@@ -126,6 +125,8 @@ def check_avi_rate(fps: float, advice: str = "") -> None:
 
 def avi_frame_count(path: Path) -> int:
     """The frames an AVI's index holds, as a reader finds them."""
+    import cv2  # here, not above: a run's tables are written without OpenCV
+
     capture = cv2.VideoCapture(str(path))
     try:
         return max(int(capture.get(cv2.CAP_PROP_FRAME_COUNT)), 0) if capture.isOpened() else 0
@@ -146,6 +147,8 @@ class VideoRecord:
     QUALITY = 95
 
     def __init__(self, path: str | os.PathLike[str], fps: float, width: int, height: int) -> None:
+        import cv2
+
         check_avi_rate(fps)
         self.path = Path(path)
         self._writer: cv2.VideoWriter | None = cv2.VideoWriter(
@@ -161,6 +164,8 @@ class VideoRecord:
         so that every film writer takes the same frames, `rig.film_file`)."""
         if self._writer is None:
             raise RigError(f"the film {self.path} is closed; frame {self.frames} cannot be added")
+        import cv2
+
         if not self._writer.write(cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR)):
             raise RigError(
                 f"frame {self.frames} could not be written to {self.path} (is the disk full?); "

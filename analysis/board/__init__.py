@@ -7,9 +7,19 @@ needs the rig. `photodiode_latency` (with scipy and matplotlib behind it) is imp
 module, so that using a recording as the camera path's reference does not load them.
 """
 
-from analysis.board.blink_code import BlinkAlignment, BlinkSchedule, align_blink_code, lfsr_bits
-from analysis.board.recording import load_table
-from analysis.board.reference import BoardReference
+from declared.lazy import lazy_exports
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "BlinkAlignment": "analysis.board.blink_code",
+        "BlinkSchedule": "analysis.board.blink_code",
+        "align_blink_code": "analysis.board.blink_code",
+        "lfsr_bits": "analysis.board.blink_code",
+        "load_table": "analysis.board.recording",
+        "BoardReference": "analysis.board.reference",
+    },
+)
 
 __all__ = [
     "BlinkAlignment",

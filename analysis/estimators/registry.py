@@ -8,26 +8,34 @@ and with ``method="all"``, after the built-in ones, and the command line offers 
 
 from __future__ import annotations
 
+import importlib
+from typing import TYPE_CHECKING
+
 from analysis.errors import AnalysisError
-from analysis.estimators.bayes import BayesEstimator
-from analysis.estimators.contract import Estimator
-from analysis.estimators.fft import FftPhaseEstimator
-from analysis.estimators.sinefit import SineFitEstimator
-from analysis.estimators.xcorr import CrossCorrelationEstimator
+
+if TYPE_CHECKING:
+    from analysis.estimators.contract import Estimator
 
 DEFAULT_METHOD = "sinefit"
 # The method that asks for every estimator; its result is the default method's.
 ALL = "all"
 
-_estimators: dict[str, Estimator] = {
-    estimator.name: estimator
-    for estimator in (
-        FftPhaseEstimator(),
-        CrossCorrelationEstimator(),
-        SineFitEstimator(),
-        BayesEstimator(),
-    )
+_estimators: dict[str, Estimator | str] = {
+    "fft": "analysis.estimators.fft:FftPhaseEstimator",
+    "xcorr": "analysis.estimators.xcorr:CrossCorrelationEstimator",
+    "sinefit": "analysis.estimators.sinefit:SineFitEstimator",
+    "bayes": "analysis.estimators.bayes:BayesEstimator",
 }
+"""Every estimator by name, in the order they run: a built-in one as "module:Class" until it is
+first asked for, so that naming the methods (the command line's options) imports none of them."""
+
+
+def _made(name: str) -> Estimator:
+    estimator = _estimators[name]
+    if isinstance(estimator, str):
+        module, _, kind = estimator.partition(":")
+        estimator = _estimators[name] = getattr(importlib.import_module(module), kind)()
+    return estimator
 
 
 def methods() -> tuple[str, ...]:
@@ -39,10 +47,10 @@ def estimators_for(method: str) -> tuple[Estimator, ...]:
     """The estimators ``method`` asks for: the one of that name, or every one for ALL.
     AnalysisError for a name no estimator has."""
     if method == ALL:
-        return tuple(_estimators.values())
+        return tuple(map(_made, _estimators))
     if method not in _estimators:
         raise AnalysisError(f"unknown method {method!r}; choose one of {', '.join(_estimators)} or {ALL}")
-    return (_estimators[method],)
+    return (_made(method),)
 
 
 def register_estimator(estimator: Estimator) -> None:

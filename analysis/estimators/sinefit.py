@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 
+from analysis.caveat import caveat
 from analysis.estimators.contract import EstimationContext
 from analysis.fit.least_squares import Guess, SineFit, fit_sine
 from analysis.result import MethodResult
@@ -18,10 +19,11 @@ def joint_fit(context: EstimationContext) -> SineFit:
     guess = Guess(swing.frequency_hz, swing.damping, 0.0, reference, gain_ratio(swing.windows))
     fit = fit_sine(swing.signals, (swing.windows.led_noise, swing.windows.sphere_noise), guess)
     if abs(fit.latency_s - reference) > swing.period_s / 4:
-        context.warnings.append(
-            f"the fit moved the latency from {reference * 1e3:.1f} to {fit.latency_s * 1e3:.1f} ms; "
-            "check the tracks and the plot"
-        )
+        context.warnings.append(caveat(
+            f"the fit moved the latency from {reference * 1e3:.1f} to {fit.latency_s * 1e3:.1f} ms, more than a quarter "
+            "of a swing from where the phases put it",
+            "check the tracks in the plot (--plot), and give --latency-range LOW,HIGH if the lab knows the latency's range",
+        ))  # fmt: skip
     return fit
 
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from analysis.blobs import Track
+from analysis.caveat import caveat
 from analysis.errors import AnalysisError
 from analysis.hints.hint import AGREES, CANNOT_CHECK, CONTRADICTS, IDENTITY, OVERRULED, Hint, HintCheck, in_words
 from analysis.identity import DECISION_MARGIN, identify
@@ -100,9 +101,11 @@ class HintReview:
         shows = f"shows refreshes at {untold.refresh_hz:.4g} Hz" if seen else f"rules out {hz:g} Hz (it allows {rates} Hz)"
         self.note(
             hint, video, CONTRADICTS, "what the video shows",
-            f"the display refreshes at {hz:g} Hz by the bench's description ({hint.source}), but the sphere's timing "
-            f"{shows}: the analysis allows for what the video shows instead. Check the display's refresh rate and "
-            "correct the description",
+            caveat(
+                f"the display refreshes at {hz:g} Hz by the bench's description ({hint.source}), but the sphere's timing "
+                f"{shows}: the analysis allowed for what the video shows instead",
+                "check the display's refresh rate and correct the description",
+            ),
         )  # fmt: skip
         return untold
 
@@ -150,10 +153,13 @@ def _frame_rate(hint: Hint, tracks: Tracks, checks: HintReview) -> bool:
         return True
     checks.note(
         hint, video, CONTRADICTS, "the frame times",
-        f"the camera films at {hinted:g} fps by the bench's description ({hint.source}), but the video's frames are "
-        f"{fps:.4g} fps apart ({tracks.times.source}): the frame times were used, and the description's exposure and "
-        f"readout, which are for another camera setting, were left out. Describe this camera setting (measure it: rig "
-        f"calibrate-camera), or, if the file plays slow motion back slower than it was filmed, give --fps {hinted:g}",
+        caveat(
+            f"the camera films at {hinted:g} fps by the bench's description ({hint.source}), but the video's frames are "
+            f"{fps:.4g} fps apart ({tracks.times.source}): the frame times were used, and the description's exposure and "
+            "readout, for another camera setting, were left out",
+            f"describe this camera setting (measure it: rig calibrate-camera), or, if the file plays slow motion back "
+            f"slower than it was filmed, give --fps {hinted:g}",
+        ),
     )  # fmt: skip
     return False
 
@@ -169,10 +175,12 @@ def _camera_value(hint: Hint, stale: bool, interval: float, tracks: Tracks, chec
     if value_ms / 1e3 > (1 + READOUT_TOLERANCE) * interval:
         checks.note(
             hint, f"at most {interval * 1e3:.4g} ms (a frame interval)", CONTRADICTS, "left out",
-            f"the camera's {what} is {value_ms:g} ms by the bench's description ({hint.source}), longer than the "
-            f"video's frame interval ({interval * 1e3:.4g} ms): the description is for another camera setting, and the "
-            f"{what} was left out ({'bounded by the frame interval' if what == 'readout' else 'taken from the LED blur'}). "
-            "Measure this camera setting (rig calibrate-camera) and describe it",
+            caveat(
+                f"the camera's {what} is {value_ms:g} ms by the bench's description ({hint.source}), longer than the "
+                f"video's frame interval ({interval * 1e3:.4g} ms): the description is for another camera setting, and the "
+                f"{what} was left out ({'bounded by the frame interval' if what == 'readout' else 'taken from the LED blur'})",
+                "measure this camera setting (rig calibrate-camera) and describe it",
+            ),
         )  # fmt: skip
         return False
     if what == "readout":
@@ -189,9 +197,11 @@ def _camera_value(hint: Hint, stale: bool, interval: float, tracks: Tracks, chec
         return True
     checks.note(
         hint, video, CONTRADICTS, "the LED's blur",
-        f"the camera exposes {value_ms:g} ms by the bench's description ({hint.source}), but the LED's motion blur "
-        f"shows {blur.low_s * 1e3:.3g} to {blur.high_s * 1e3:.3g} ms: the exposure was taken from the blur. Measure "
-        "the camera's exposure at this setting (rig calibrate-camera) and correct the description",
+        caveat(
+            f"the camera exposes {value_ms:g} ms by the bench's description ({hint.source}), but the LED's motion blur "
+            f"shows {blur.low_s * 1e3:.3g} to {blur.high_s * 1e3:.3g} ms: the exposure was taken from the blur",
+            "measure the camera's exposure at this setting (rig calibrate-camera) and correct the description",
+        ),
     )  # fmt: skip
     return False
 
@@ -225,10 +235,11 @@ def _identity(hints: list[Hint], tracks: Tracks, checks: HintReview) -> Tracks:
         checks.note(hint, video, AGREES if agrees else CONTRADICTS, f"the hint's {in_words(hint.value)}" if agrees else "the evidence")
         if not agrees and not (hint.name == "sphere_roi" and any(each.name == "led_roi" for each in hints)):  # one warning for both regions
             said = f"the LED is on the {hint.value}" if hint.name == "led_side" else f"the {_blob(hint.name)} is in {list(hint.value)}"
-            checks.warnings.append(
+            checks.warnings.append(caveat(
                 f"by the bench's description ({hint.source}) {said}, but the video's evidence says {video}: the evidence "
-                "was followed. Correct the description, or give --led-side (or the regions) to overrule the evidence"
-            )
+                "was followed",
+                "correct the description, or give --led-side (or the regions) to overrule the evidence",
+            ))  # fmt: skip
     if tracked_is_led:
         return tracks
     diagnostics = {
@@ -256,9 +267,11 @@ def _row(hint: Hint, blob: Track, height: int, checks: HintReview) -> None:
         return
     checks.note(
         hint, video, CONTRADICTS, "the rows in the video",
-        f"the {name} sits at {float(hint.value):.2f} of the frame's height by the bench's description ({hint.source}), "
-        f"but at {row:.2f} in the video: the camera or the bench has moved since it was described. The analysis measures "
-        "the rows itself; correct the description (its regions too, if it gives them)",
+        caveat(
+            f"the {name} sits at {float(hint.value):.2f} of the frame's height by the bench's description ({hint.source}), "
+            f"but at {row:.2f} in the video, so the camera or the bench has moved since: the analysis measured the rows itself",
+            "correct the description (its regions too, if it gives them)",
+        ),
     )  # fmt: skip
 
 
@@ -269,7 +282,10 @@ def _scanout(hint: Hint, checks: HintReview) -> None:
         return
     checks.note(
         hint, None, CANNOT_CHECK, "the display-sampling model's top-down scan-out",
-        f"the display scans bottom-up in the film by the bench's description ({hint.source}), but the display-sampling "
-        "model switches the sphere's rows from the top: where the display's sampling biases the latency, the correction "
-        "may be off by up to the scan-out's time across the sphere. Film the display the right way up",
+        caveat(
+            f"the display scans bottom-up in the film by the bench's description ({hint.source}), but the display-sampling "
+            "model switches the sphere's rows from the top: where the display's sampling biases the latency, the "
+            "correction may be off by up to the scan-out's time across the sphere",
+            "film the display the right way up",
+        ),
     )  # fmt: skip

@@ -23,10 +23,11 @@ import numpy as np
 from analysis.sampling.exposure import Exposure, exposure_from_blur, given_exposure
 from analysis.sampling.inference import BIAS_RANGE, RefreshHypothesis, refresh_hypotheses
 from analysis.sampling.model import commensurate
-from analysis.sampling.rates import RATE_TOLERANCE
+from analysis.sampling.rates import COMMON_REFRESH_HZ, RATE_TOLERANCE
 from analysis.sampling.residuals import TimingResiduals
 from analysis.sampling.rows import SphereRows
 from analysis.blobs import Track
+from analysis.caveat import caveat
 
 # Residuals may be correlated over this fraction of a swing period.
 CORRELATION_PERIODS = 0.1
@@ -93,16 +94,14 @@ class SamplingBias:
         return self.correction_s if abs(self.correction_s) >= least else 0.0
 
     def warning(self, ci_s: tuple[float, float] | None, widened_s: tuple[float, float] | None) -> str | None:
-        """A warning naming the cause and the remedy when the bias was corrected in, or widened
-        noticeably, the interval ``ci_s`` (``widened_s`` what ``apply`` made of it), else None."""
-        camera = f"the camera ({self.camera_fps:g} fps, exposure {self._exposure_text()})"
+        """A warning (`analysis.caveat`) naming the cause and the remedy when the bias was corrected in,
+        or widened noticeably, the interval ``ci_s`` (``widened_s`` what ``apply`` made of it), else None."""
+        camera = f"the {self.camera_fps:g} fps camera"
         if self.correction_for(ci_s) != 0.0:
-            low, high = self.range_s
-            return (
-                f"{camera} samples the {self.refresh_hz:.4g} Hz display ({self.refresh_source}) {self._phases_text()}; "
-                f"the sphere's timing in the video is off by {self.correction_s * 1e3:+.2f} ms "
-                f"({low * 1e3:+.2f} to {high * 1e3:+.2f}), which was corrected. To avoid it, film at a rate the "
-                f"display's does not divide or multiply, or expose for {_whole_refreshes(self.refresh_hz)}"
+            return caveat(
+                f"the sphere's timing in the video was {self.correction_s * 1e3:+.2f} ms off, and was corrected: {camera} "
+                f"samples the {self.refresh_hz:.4g} Hz display ({self.refresh_source}) {self._phases_text()}",
+                self._remedy(self.refresh_hz, ()),
             )
         if ci_s is None or widened_s is None:
             return None
@@ -110,22 +109,29 @@ class SamplingBias:
         if (widened_s[1] - widened_s[0]) / 2 - half_width <= max(WIDENING_NOTICE * half_width, WIDENING_NOTICE_S):
             return None
         low, high = self.range_s
+        widened = f"the interval was widened by the sphere's timing in the video, which may be off by {low * 1e3:+.2f} to {high * 1e3:+.2f} ms"
+        exposure = () if self.exposure.source == "given" else ("--exposure-ms",)
         if self.refresh_source == "not seen":
-            rates = ", ".join(dict.fromkeys(f"{rate:.4g}" for rate in sorted(self.rates_hz)))
-            cause = (
-                f"{camera} does not show the display's refresh: no rate's steps stand out in the sphere's timing, "
-                f"which allows {rates} Hz; for a {self.worst_hz:.4g} Hz display, the one of them allowing the most,"
+            rates = " or ".join(dict.fromkeys(f"{rate:.4g}" for rate in sorted(self.rates_hz)))
+            return caveat(
+                f"{widened}: the video does not show whether the display refreshes at {rates} Hz, and {camera} may sample "
+                "it at a fixed phase",
+                self._remedy(self.worst_hz, ("--display-hz", *exposure)),
             )
-            remedy = "pass --display-hz with the display's refresh rate, "
-        else:
-            cause = f"{camera} samples the {self.refresh_hz:.4g} Hz display ({self.refresh_source}) {self._phases_text()}:"
-            remedy = ""
-        exposure = "" if self.exposure.source == "given" else ", or pass --exposure-ms if the exposure is known"
-        return (
-            f"{cause} the sphere's timing in the video may be off by {low * 1e3:+.2f} to {high * 1e3:+.2f} ms, and the "
-            f"interval was widened by that. To avoid it, {remedy}film at a rate that no common display rate divides "
-            f"(e.g. {_suggested_fps(self.camera_fps)} fps), or expose for {_whole_refreshes(self.worst_hz)}{exposure}"
+        return caveat(
+            f"{widened}: {camera} samples the {self.refresh_hz:.4g} Hz display ({self.refresh_source}) {self._phases_text()}",
+            self._remedy(self.worst_hz, exposure),
         )
+
+    def _remedy(self, refresh_hz: float, options: tuple[str, ...]) -> str:
+        """What a lab can do: give the options named, film at a rate that walks through the refresh,
+        or (where a refresh fits in a frame interval) expose for whole refreshes."""
+        ways = [f"give {' and '.join(options)}"] if options else []
+        whole = [f"expose for {_whole_refreshes(refresh_hz)}"] if refresh_hz >= self.camera_fps else []
+        if not walks(self.camera_fps) or not ways + whole:
+            ways.append(f"film at {suggested_fps(self.camera_fps)} fps (no common display rate is a simple fraction of it)")
+        ways += whole
+        return ", ".join(ways[:-1]) + f" or {ways[-1]}" if len(ways) > 1 else ways[0]
 
     def _phases_text(self) -> str:
         ratio = commensurate(self.camera_fps / self.refresh_hz)
@@ -134,14 +140,6 @@ class SamplingBias:
         if ratio[0] == 1:
             return "at one phase of each refresh (phase-locked)"
         return f"at {ratio[0]} phases of each refresh"
-
-    def _exposure_text(self) -> str:
-        exposure = self.exposure
-        if exposure.source == "given":
-            return f"{exposure.high_s * 1e3:.3g} ms"
-        if exposure.source == "unknown":
-            return "unknown"
-        return f"{exposure.low_s * 1e3:.3g}-{exposure.high_s * 1e3:.3g} ms by the LED's blur"
 
     def to_dict(self) -> dict[str, object]:
         return {
@@ -159,9 +157,23 @@ def _whole_refreshes(refresh_hz: float) -> str:
     return f"a whole number of refreshes ({1e3 / refresh_hz:.3g} ms at {refresh_hz:.4g} Hz)"
 
 
-def _suggested_fps(camera_fps: float) -> str:
-    """A frame rate near the camera's that common display rates do not divide: one fewer."""
-    return f"{max(round(camera_fps) - 1, 1):g}"
+FEW_PHASES = 10
+"""A camera whose rate is p / q of a display's with q at most this samples few phases of its refresh."""
+
+
+def walks(camera_fps: float) -> bool:
+    """Whether no common display rate is a simple fraction of the camera's: it then walks through
+    every phase of any of their refreshes. A rate measured from a film counts to the hundredth of a frame."""
+    return all(commensurate(round(camera_fps, 2) / rate, FEW_PHASES) is None for rate in COMMON_REFRESH_HZ)
+
+
+def suggested_fps(camera_fps: float) -> int:
+    """The whole frame rate nearest below the camera's (above, where none is) that `walks`."""
+    start = max(round(camera_fps), 1)
+    for candidate in [*range(start - 1, 0, -1), *range(start + 1, 2 * start + 2)]:
+        if walks(candidate):
+            return candidate
+    raise AssertionError(f"no frame rate near {camera_fps:g} fps walks through the common display rates")
 
 
 def _components(means: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -11,9 +11,20 @@ readout 0 with a bound, and a film that cannot decide is refused with an Analysi
 to change.
 """
 
-from analysis.shutter.estimate import estimate_shutter, measure_shutter, suggest_flash_hz
-from analysis.shutter.film import RowFilm, film_of_frames, read_film
-from analysis.shutter.options import ShutterOptions
-from analysis.shutter.result import ShutterResult
+from declared.lazy import lazy_exports
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "estimate_shutter": "analysis.shutter.estimate",
+        "measure_shutter": "analysis.shutter.estimate",
+        "suggest_flash_hz": "analysis.shutter.estimate",
+        "RowFilm": "analysis.shutter.film",
+        "film_of_frames": "analysis.shutter.film",
+        "read_film": "analysis.shutter.film",
+        "ShutterOptions": "analysis.shutter.options",
+        "ShutterResult": "analysis.shutter.result",
+    },
+)
 
 __all__ = ["RowFilm", "ShutterOptions", "ShutterResult", "estimate_shutter", "film_of_frames", "measure_shutter", "read_film", "suggest_flash_hz"]

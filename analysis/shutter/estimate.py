@@ -27,6 +27,7 @@ from typing import Callable
 
 import numpy as np
 
+from analysis.caveat import caveat
 from analysis.errors import AnalysisError
 from analysis.shutter.film import RowFilm, read_film
 from analysis.shutter.fit import T95, BandFit, fit_bands, largest_gap
@@ -293,14 +294,14 @@ def _check_coverage(fit: BandFit) -> None:
 def _warnings(film: RowFilm, fit: BandFit, timing_off: bool) -> list[str]:
     warnings = []
     if timing_off:
-        warnings.append(
+        warnings.append(caveat(
             f"the bands shift from frame to frame by {fit.timing_rms_s * 1e3:.3f} ms (RMS) more or less than the frames' "
-            f"times ({film.timing_source}) say: the exposure may read long, and its interval allows for that; "
-            "check that the film keeps the camera's frame times"
-        )
+            f"times ({film.timing_source}) say: the exposure may read long, and its interval allows for that",
+            "check that the film keeps the camera's frame times (a recorder that stamps each frame)",
+        ))  # fmt: skip
     if film.saturated > film.lit / 2:
-        warnings.append(
-            f"{film.saturated} of the {film.lit} pixels the light reaches saturate and were left out: dim the light "
-            "or lower the camera's gain"
-        )
+        warnings.append(caveat(
+            f"{film.saturated} of the {film.lit} pixels the light reaches saturate, and were left out",
+            "dim the light or lower the camera's gain",
+        ))  # fmt: skip
     return warnings

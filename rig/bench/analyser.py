@@ -323,11 +323,8 @@ def run(sweep: Sweep, context: Context) -> dict[str, Any]:
     per group of cases (GROUPS), the targets and the time taken. On Dask, speed ratios are taken
     with the workers sharing the cores."""
     started = time.perf_counter()
-
-    def progress(done: float, total: float) -> None:
-        context.log(f"[{done}/{total} cases]")
-
     job = partial(measure_point, log=context.log)
+    progress = context.progress("analysing the cases")
     rows, _ = run_sweep(sweep, context.folder, context.workers, context.scheduler, progress, overwrite=True, job=job)
     cases = [row.pop("bench") for row in rows]
     summaries = {

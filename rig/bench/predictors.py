@@ -50,7 +50,8 @@ from rig.bench.predictor_scores import BASELINE, HeldOut, Ratios, cost_ratios, e
 from rig.commands import choices, options
 from rig.commands.declared_options import add_declared_options
 from rig.errors import ConfigError
-from rig.service.tune import HORIZONS, check_scorable, in_time_order
+from rig.service.tune import check_scorable, in_time_order
+from rig.tune_settings import HORIZONS
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import TrackerConfig, simulate_tracker
 

@@ -299,7 +299,10 @@ def run(args: argparse.Namespace, context: Context) -> list[dict[str, Any]]:
     the host of a virtual machine took during it (a stolen stretch delays records by milliseconds,
     which shows in the latency's 95th percentile first)."""
     rows = []
-    for index, case in enumerate(cases(fault_at_s=args.duration / 2.0)):
+    every = cases(fault_at_s=args.duration / 2.0)
+    progress = context.progress("recording the cases")
+    for index, case in enumerate(every):
+        progress(index, len(every))
         load = os.getloadavg()[0]
         floor = wake_floor(args.rate, WAKE_FLOOR_S, context.folder / f"floor{index}")
         before = cpu_ticks()
@@ -309,6 +312,7 @@ def run(args: argparse.Namespace, context: Context) -> list[dict[str, Any]]:
             context.log(f"{case.source}/{case.transport}/{case.profile or 'pose'} faults {case.faults}: FAILED: {error}")
             row = failed_case(case, args.rate, args.duration, error)
         rows.append({**row, "load_average_1min": load, "wake_floor_us": floor, "stolen_cpu_pct": stolen_pct(before, cpu_ticks())})
+    progress(len(every), len(every))
     return rows
 
 

@@ -3,20 +3,26 @@
 package, see protocol.py), clock sync as offset intervals, its events, and `BoardRecorder`, which
 writes them as a board recording (the format is analysis.board.recording's)."""
 
-from rig.board.clock_sync import ClockModel, OffsetInterval
-from rig.board.events import (
-    BoardIdentity,
-    BoardStatus,
-    ClockSynced,
-    EncoderEdge,
-    LedChange,
-    LinkChange,
-    PhotodiodeCrossing,
-    PhotodiodePassage,
-    PhotodiodeSample,
+from declared.lazy import lazy_exports
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "ClockModel": "rig.board.clock_sync",
+        "OffsetInterval": "rig.board.clock_sync",
+        "BoardIdentity": "rig.board.events",
+        "BoardStatus": "rig.board.events",
+        "ClockSynced": "rig.board.events",
+        "EncoderEdge": "rig.board.events",
+        "LedChange": "rig.board.events",
+        "LinkChange": "rig.board.events",
+        "PhotodiodeCrossing": "rig.board.events",
+        "PhotodiodePassage": "rig.board.events",
+        "PhotodiodeSample": "rig.board.events",
+        "Microcontroller": "rig.board.microcontroller",
+        "BoardRecorder": "rig.board.recorder",
+    },
 )
-from rig.board.microcontroller import Microcontroller
-from rig.board.recorder import BoardRecorder
 
 __all__ = [
     "BoardIdentity",

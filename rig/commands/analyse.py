@@ -10,20 +10,22 @@ import argparse
 import json
 from pathlib import Path
 
-from analysis import AnalysisError, AnalysisOptions
+from analysis.errors import AnalysisError
+from analysis.options import AnalysisOptions
 from rig.cli import EXIT_WARNINGS
 from rig.commands import options, outputs
-from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
 from rig.commands.choices import methods_listing
 from rig.commands.declared_options import add_declared_options, config_from_args
-from rig.commands.formatting import board_line, hints_line, summary_line
 from rig.progress import ProgressBar
-from rig.service import AnalysisRequest, analyse
-from rig.service.batch import find_videos
-from rig.service.bench_profile import read_profile, with_profile
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.commands.analyse_batch import check_batch_options, is_batch, run_batch_command
+    from rig.commands.formatting import board_line, hints_line, summary_line, warning_text
+    from rig.service import AnalysisRequest, analyse
+    from rig.service.batch import find_videos
+    from rig.service.bench_profile import read_profile, with_profile
+
     videos = find_videos(args.videos)
     how = config_from_args(AnalysisOptions, args, AnalysisError)
     if args.bench is not None:
@@ -48,7 +50,7 @@ def _run(args: argparse.Namespace) -> int:
                 ci = f" (95% {estimate.ci95_ms[0]:.2f} to {estimate.ci95_ms[1]:.2f})" if estimate.ci95_ms else ""
                 print(f"  {name}: {estimate.latency_ms:.2f} ms{ci}")
         for warning in result.warnings:
-            print(f"warning: {warning}")
+            print(warning_text(warning))
     if args.plot is not None:
         from analysis.plots import plot_tracks
 
@@ -61,14 +63,13 @@ def _run(args: argparse.Namespace) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "analyse",
-        help="measure latency from a video of the LED and the sphere",
         description="Track the LED and the rendered sphere and measure by how much the sphere lags. "
         "Without ROIs the two moving blobs are found and told apart by physical evidence (the display's refresh "
         "steps, the LED's saturation, size, side); when that does not decide, the command stops and asks for the "
         "ROIs. The interval allows for the camera's sampling of the display and for model misfit. Exit status: 0 "
         "clean, 3 measured with warnings (read them), 2 user error. Compiled fits are kept between runs "
         "(JAX_COMPILATION_CACHE_DIR chooses the folder).",
-        epilog=methods_listing(),
+        listings=methods_listing,
     )
     parser.add_argument(
         "videos",

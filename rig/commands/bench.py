@@ -98,7 +98,6 @@ def add_subject(benchmarks: argparse._SubParsersAction, subject: Bench, modes: t
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "bench",
-        help="benchmarks: speed against error, as JSON and a plot",
         description="Benchmarks are commands, not tests: each prints a table and writes JSON and a PNG.",
     )
     benchmarks = parser.add_subparsers(dest="bench", required=True, metavar="SUBJECT")

@@ -21,22 +21,21 @@ import threading
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from analysis.board.blink_code import BlinkSchedule
-from analysis.board.photodiode_latency import estimate_from_recording, plot_board_latency
-from rig.board.clock_sync import OffsetInterval
 from declared import Range, setting
-from rig.board.instrument import BoardInstrument, BoardSettings
-from rig.board.microcontroller import Microcontroller
-from rig.board.recorder import BoardRecorder
-from rig.clock import MonotonicClock
+from rig.board.settings import BoardSettings
 from rig.commands import outputs
 from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.commands.options import positive_float, run_seconds
 from rig.errors import ConfigError, RigError
 from rig.sim.config import MAX_HOURS
 from rig.progress import ProgressBar
+
+if TYPE_CHECKING:
+    from analysis.board.blink_code import BlinkSchedule
+    from rig.board.clock_sync import OffsetInterval
+    from rig.board.microcontroller import Microcontroller
 
 PORT_VARIABLE = "RIG_BOARD_PORT"
 # How often the waiting commands look at the link and redraw their progress.
@@ -50,7 +49,7 @@ BOARD_CLOCK_LIMIT_S = 10.0
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Registers `board info|sync|record|blink|latency`; each sets func(args) -> exit code."""
-    board = subparsers.add_parser("board", help="the rig's microcontroller: identity, clock sync, recording, blink, latency")
+    board = subparsers.add_parser("board")
     commands = board.add_subparsers(dest="board_command", required=True, metavar="BOARD_COMMAND")
 
     info = commands.add_parser("info", help="identify the board; show its counters and the clock offset")
@@ -127,6 +126,8 @@ def _port(args: argparse.Namespace) -> str:
 
 
 def _board(args: argparse.Namespace, **options: Any) -> Microcontroller:
+    from rig.board.microcontroller import Microcontroller  # here, not above: the link loads pyserial and numpy
+
     return Microcontroller(_port(args), **options)
 
 
@@ -189,6 +190,9 @@ def run_sync(args: argparse.Namespace) -> int:
 def run_record(args: argparse.Namespace) -> int:
     if args.blink and _blink_seconds(args) > args.duration:
         raise RigError(f"--duration {args.duration:g} s is shorter than the blink ({_blink_seconds(args):.2f} s): record for longer")
+    from rig.board.instrument import BoardInstrument
+    from rig.clock import MonotonicClock
+
     settings = config_from_args(BoardSettings, args, ConfigError)
     instrument = BoardInstrument(_port(args), args.out, settings, options={"requested_s": args.duration, "blink": args.blink})
     clock = MonotonicClock()
@@ -208,6 +212,8 @@ def run_record(args: argparse.Namespace) -> int:
 
 
 def run_blink(args: argparse.Namespace) -> int:
+    from rig.board.recorder import BoardRecorder
+
     board = _board(args)
     recorder = BoardRecorder(args.out) if args.out else None
     if recorder is not None:
@@ -245,6 +251,8 @@ def _blink_seconds(args: argparse.Namespace) -> float:
 
 
 def run_latency(args: argparse.Namespace) -> int:
+    from analysis.board.photodiode_latency import estimate_from_recording, plot_board_latency
+
     max_latency = args.max_latency_ms / 1e3 if args.max_latency_ms else None
     latency = estimate_from_recording(args.recording, max_latency_s=max_latency)
     if args.plot:

@@ -11,21 +11,25 @@ import json
 import sys
 from datetime import date
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from analysis import AnalysisError
-from analysis.shutter import ShutterOptions, ShutterResult
-from analysis.shutter.options import DISPLAY_GROUP
+from analysis.errors import AnalysisError
+from analysis.shutter.options import DISPLAY_GROUP, ShutterOptions
 from rig.cli import EXIT_WARNINGS
 from rig.commands import outputs
 from rig.commands.declared_options import add_declared_options, config_from_args, declared_type
 from rig.progress import ProgressBar
-from rig.service import CalibrationRequest, calibrate_camera
-from rig.service.bench_profile import read_profile, shutter_display, write_profile
-from rig.service.calibrate import bench_changes
-from rig.sim.flash import FlashTarget
+from rig.sim.flash_target import FlashTarget
+
+if TYPE_CHECKING:
+    from analysis.shutter import ShutterResult
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service import CalibrationRequest, calibrate_camera
+    from rig.service.bench_profile import read_profile, shutter_display, write_profile
+    from rig.service.calibrate import bench_changes
+
     if args.bench is not None and args.bench.exists():
         profile = read_profile(args.bench)
         if args.source == "display" and args.display_hz is None:
@@ -47,6 +51,8 @@ def _run(args: argparse.Namespace) -> int:
 
 def result_lines(result: ShutterResult) -> list[str]:
     """The readout, the exposure and what the film showed, a line each, then the warnings."""
+    from rig.commands.formatting import warning_text
+
     low, high = (v * 1e3 for v in result.readout_ci95_s)
     if result.global_shutter:
         readout = f"readout 0 ms: a global shutter (95% at most {high:.3f} ms)"
@@ -69,14 +75,13 @@ def result_lines(result: ShutterResult) -> list[str]:
         f"{result.flash_hz_seen:.4g} Hz (given {result.flash_hz:g}), on {result.duty:.1%} of each period, over rows "
         f"{result.rows[0]}-{result.rows[1]} ({result.row_count} used, {result.saturated_pixels} saturated pixels left out); "
         f"{bands}; frames agree with the bands to {result.timing_rms_s * 1e3:.3f} ms; misfit {result.misfit:.1%} of the swing",
-        *(f"warning: {warning}" for warning in result.warnings),
+        *(warning_text(warning) for warning in result.warnings),
     ]
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "calibrate-camera",
-        help="measure a camera's readout and exposure from a film of a flashing light",
         description="Film a light flashing at a known frequency (an LED lighting a white card, or out of focus so "
         "that it fills the view), or a display flashing full-field, for a few seconds; this measures the "
         "camera's rolling-shutter readout (0 for a global shutter) and its exposure from the bands the flash "

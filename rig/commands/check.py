@@ -18,13 +18,15 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rig.cli import EXIT_UNTRUSTED, EXIT_WARNINGS
 from rig.commands import choices, options, outputs
 from rig.commands.device_options import add_device_options
 from rig.commands.record import add_accept_camera_settings
-from rig.preflight import CheckPlan, CheckReport, run_checks
-from rig.preflight.rows import FAIL, PASS, STATUSES, WARN
+
+if TYPE_CHECKING:
+    from rig.preflight import CheckReport
 
 PLANNED_S = 60.0
 """The planned run's duration unless given: `rig measure`'s own."""
@@ -33,6 +35,8 @@ PLANNED_S = 60.0
 def table(report: CheckReport) -> str:
     """One line a check (status, device, what, measured), a fix under each that did not pass, and the
     overall status with the time the check took."""
+    from rig.preflight.rows import STATUSES
+
     rows = report.rows
     device = max(len(row.device) for row in rows)
     what = max(len(row.what) for row in rows)
@@ -47,10 +51,14 @@ def table(report: CheckReport) -> str:
 
 
 def exit_status(status: str) -> int:
+    from rig.preflight.rows import FAIL, PASS, WARN
+
     return {PASS: 0, WARN: EXIT_WARNINGS, FAIL: EXIT_UNTRUSTED}[status]
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.preflight import CheckPlan, run_checks
+
     plan = CheckPlan(
         tracker=args.tracker, camera=args.camera, display=None if args.external else args.display,
         duration_s=args.duration, disk_folder=outputs.nearest_existing(args.out),
@@ -65,7 +73,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `check`."""
     parser = subparsers.add_parser(
         "check",
-        help="check the devices a run would use (display refresh and pacing, camera rate and exposure, tracker, disk) in about 10 s",
         description=" ".join(__doc__.split("\n\n")[i] for i in (0, 2, 3)).replace("\n", " "),
         epilog=choices.trackers_listing(),
     )

@@ -9,19 +9,23 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rig.commands import outputs
-from rig.commands.formatting import summary_line
 from rig.commands.simulation_options import add_simulation_options, simulation_config
+from rig.demo_settings import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
 from rig.progress import ProgressBar
-from rig.service import compare_renderers, comparison_config, demo
-from rig.service.demo import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
-from rig.sim.config import SimulationConfig
+
+if TYPE_CHECKING:
+    from rig.sim.config import SimulationConfig
 
 EXIT_MISMATCH = 1
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.commands.formatting import summary_line, warning_text
+    from rig.service import comparison_config, demo
+
     config = simulation_config(args)
     if args.compare:
         return _run_comparison(args, comparison_config(config))
@@ -43,7 +47,7 @@ def _run(args: argparse.Namespace) -> int:
         print(f"difference        {report.difference_ms:+8.2f} ms  {verdict}: the analyser should agree within {AGREEMENT_MS:g} ms")
         print(f"plot of both trajectories: {report.plot}")
         for warning in result.warnings:
-            print(f"warning: {warning}")
+            print(warning_text(warning))
     return 0 if report.agrees else EXIT_MISMATCH
 
 
@@ -52,6 +56,9 @@ def _cost_text(ms: float | None, what: str) -> str:
 
 
 def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
+    from rig.commands.formatting import warning_text
+    from rig.service import compare_renderers
+
     if not args.json:
         print(
             f"comparing {' and '.join(COMPARE_RENDERERS)} on one scene: {config.scene_triangles} load triangles, "
@@ -72,7 +79,7 @@ def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
                 f"{report.difference_ms:+9.2f} ms  {verdict}"
             )
             for warning in report.measurement.result.warnings:
-                print(f"warning ({name}): {warning}")
+                print(warning_text(warning, f"warning ({name})"))
         print(f"plots: {', '.join(str(report.plot) for report in reports.values())}")
     return 0 if agrees else EXIT_MISMATCH
 
@@ -80,7 +87,6 @@ def _run_comparison(args: argparse.Namespace, config: SimulationConfig) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "demo",
-        help="simulate the rig end to end and check the analyser against the known latency",
         description="Simulate the default rig (pendulum, tracker, predictor, OpenGL renderer, display, camera), "
         "analyse the video it writes, and print the measured latency beside the true one. "
         f"Exits with {EXIT_MISMATCH} if they differ by more than {AGREEMENT_MS:g} ms.",

@@ -9,7 +9,6 @@ from dataclasses import dataclass
 
 from declared import Flag, Range, setting
 from rig.commands.declared_options import add_declared_options
-from rig.devices.trackers.discovery import hid_devices, lsl_streams, serial_ports
 
 
 @dataclass(frozen=True)
@@ -23,6 +22,8 @@ class Listing:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.devices.trackers.discovery import hid_devices, lsl_streams, serial_ports
+
     found = {"serial": serial_ports(), "hid": hid_devices(), "lsl": lsl_streams(args.lsl_wait)}
     if args.json:
         print(json.dumps(found))
@@ -42,7 +43,7 @@ def _run(args: argparse.Namespace) -> int:
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `devices`."""
-    parser = subparsers.add_parser("devices", help="list the serial ports, HID devices and LSL streams this machine sees", description=__doc__)
+    parser = subparsers.add_parser("devices", description=__doc__)
     add_declared_options(parser, Listing)
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.set_defaults(func=_run)

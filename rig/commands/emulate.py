@@ -24,11 +24,11 @@ from pathlib import Path
 from declared import Flag, Range, like, setting
 from rig.commands import options, outputs
 from rig.commands.declared_options import add_declared_option, add_declared_options, config_from_args
-from rig.devices.trackers.serial_tracker import DEFAULT_PROFILE
-from rig.emulate import EmulatorConfig, make_sink, run_emulator
+from rig.devices.trackers.default_profiles import SERIAL as DEFAULT_PROFILE
+from rig.emulator_settings import ReaderWait
 from rig.errors import ConfigError
-from rig.sim.tracker import TrackerConfig
-from rig.sim.tracker_faults import FaultPlan, parse_faults
+from rig.sim.fault_plan import FaultPlan, parse_faults
+from rig.sim.tracker_config import TrackerConfig
 
 
 SERIAL = "serial"
@@ -63,6 +63,8 @@ def _faults(text: str) -> FaultPlan:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.emulate import EmulatorConfig, make_sink, run_emulator
+
     if args.transport == "lsl":
         transport, address = "lsl", args.name
     else:
@@ -113,7 +115,7 @@ def _common(parser: argparse.ArgumentParser, serial: bool) -> None:
                         help="faults such as corrupt=0.01,drop=0.001,garbage=2,burst=8,stall=3:0.5,disconnect=5:0.5 "
                         "(default: none)")  # fmt: skip
     parser.add_argument("--log", type=outputs.csv_file, metavar="FILE.csv", help="write every record's seq, device time, write time and fate")
-    add_declared_option(parser, EmulatorConfig, "idle_timeout_s")
+    add_declared_option(parser, ReaderWait, "idle_timeout_s")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     parser.set_defaults(func=_run)
 
@@ -122,7 +124,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `emulate-tracker serial|lsl`."""
     parser = subparsers.add_parser(
         "emulate-tracker",
-        help="an emulated tracker (serial over a pty or TCP, or LSL) for tests and demos, with faults on demand",
         description=__doc__.split("\n\n")[0],
     )
     transports = parser.add_subparsers(dest="transport", required=True, metavar="TRANSPORT")

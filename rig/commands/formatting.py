@@ -6,6 +6,12 @@ from analysis import LatencyResult
 from analysis.board.reference import EVENT_NAME, BoardReference
 
 
+def warning_text(warning: str, title: str = "warning") -> str:
+    """A warning as printed: its first line (the cause) after the title, the next (the remedy,
+    `analysis.caveat`) indented under it."""
+    return f"{title}: " + warning.replace("\n", "\n  ")
+
+
 def summary_line(result: LatencyResult) -> str:
     """The one line a lab reads."""
     ci = f" (95% CI {result.ci95_ms[0]:.2f} to {result.ci95_ms[1]:.2f} ms)" if result.ci95_ms else ""

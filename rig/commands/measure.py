@@ -25,22 +25,19 @@ import json
 import sys
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from analysis import AnalysisOptions
+from analysis.options import AnalysisOptions
 from rig.cli import EXIT_UNTRUSTED, EXIT_WARNINGS
 from rig.commands import choices, options, outputs
 from rig.commands.device_options import add_device_options
 from rig.commands.record import add_camera_options
-from rig.devices.window.spec import parse_window_address
 from rig.errors import ConfigError
-from rig.live.health import VALID
-from rig.live.measure import MEASURE_FILE, PLOT_FILE, MeasureReport, measure
-from rig.live.camera_recording import check_first_seconds, record_camera
-from rig.live.run import EXTERNAL, LiveConfig
-from rig.lsl import StreamNames
+from rig.lsl.streams import StreamNames
 from rig.progress import ProgressBar
-from rig.service.bench_profile import read_profile, with_profile
+
+if TYPE_CHECKING:
+    from rig.live.measure import MeasureReport
 
 CHECK_SECONDS = 3.0
 EXIT_DISAGREE = 1
@@ -69,6 +66,10 @@ def _verdict_lines(report: MeasureReport) -> list[str]:
 
 
 def _lines(report: MeasureReport, kept: bool) -> list[str]:
+    from analysis.caveat import caveat
+    from rig.commands.formatting import warning_text
+    from rig.live.measure import MEASURE_FILE, PLOT_FILE
+
     video, log = report.video, report.log
     if report.invalid:
         return [*_verdict_lines(report), INVALID_ADVICE, f"the run's records are in {report.out_dir}" if kept
@@ -81,10 +82,10 @@ def _lines(report: MeasureReport, kept: bool) -> list[str]:
     ]
     if report.board:
         lines.append(f"latency (photodiode): {report.board['latency_ms']:.1f} +- {report.board['sd_ms']:.1f} ms")
-    lines += [f"warning: {warning}" for warning in video.get("warnings", [])]
+    lines += [warning_text(warning) for warning in video.get("warnings", [])]
     against = report.run["video_vs_log"]["warning"]
     if against:
-        lines += [f"warning: {against['cause']}", f"  remedy: {against['remedy']}"]
+        lines.append(warning_text(caveat(against["cause"], against["remedy"])))
     check = report.run.get("self_test")
     if check:
         verdict = "agree" if check["agree"] else "DISAGREE"
@@ -99,6 +100,8 @@ def _lines(report: MeasureReport, kept: bool) -> list[str]:
 def _print(report: MeasureReport, as_json: bool, kept: bool = True) -> int:
     """Print the report; the exit status: invalid run, then a self-test's disagreement, then a
     degraded run or a video that misses the whole run, then 0."""
+    from rig.live.health import VALID
+
     print(json.dumps(report.to_dict(), default=str) if as_json else "\n".join(_lines(report, kept)))
     if report.invalid:
         return EXIT_UNTRUSTED
@@ -122,6 +125,8 @@ def _self_test(args: argparse.Namespace) -> int:
 
 
 def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:
+    from rig.live.camera_recording import check_first_seconds, record_camera
+
     for step in GUIDE:
         print(step, file=sys.stderr)
     while True:
@@ -140,6 +145,11 @@ def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.devices.window.spec import parse_window_address
+    from rig.live.measure import measure
+    from rig.live.run import EXTERNAL, LiveConfig
+    from rig.service.bench_profile import read_profile, with_profile
+
     if args.self_test:
         return _self_test(args)
     missing = [name for name in ("tracker", "camera", "out") if getattr(args, name) is None]
@@ -170,9 +180,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `measure`."""
     parser = subparsers.add_parser(
         "measure",
-        help="measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
         description=" ".join(__doc__.split("\n\n")[i].replace("\n", " ") for i in (0, 2, 3)),
-        epilog="\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
+        listings=lambda: "\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
     )
     add_device_options(parser)
     parser.add_argument("--renderer", default="warp", metavar="NAME",

@@ -13,14 +13,16 @@ import json
 import sys
 from datetime import date
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rig.commands import options, outputs
 from rig.commands.declared_options import add_declared_option
-from rig.service import Plan, PlanRequest, plan
-from rig.service.bench_profile import BenchProfile, read_profile, write_profile
-from rig.sim.display import DisplayConfig
-from rig.sim.pendulum import PendulumConfig
+from rig.plan_settings import PlanAccuracy
+from rig.sim.display_config import DisplayConfig
+from rig.sim.pendulum_config import PendulumConfig
+
+if TYPE_CHECKING:
+    from rig.service import Plan
 
 EXIT_UNREACHABLE = 1
 
@@ -65,6 +67,9 @@ def _print(result: Plan) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service import PlanRequest, plan
+    from rig.service.bench_profile import BenchProfile, read_profile, write_profile
+
     request = PlanRequest(
         display_hz=args.display_hz,
         camera_fps=args.camera_fps,
@@ -99,7 +104,6 @@ def profile_line(path: Path, changes: dict[str, dict[str, Any]]) -> str:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "plan",
-        help="recommend the camera setting, film length and layout that reach a latency accuracy",
         description="Simulate each camera frame rate and exposure on offer filming the display, analyse each as a "
         "lab would (the settings given), and recommend the one that reaches the wanted 95 % half-width with the "
         "shortest film, checked by a simulation; print every setting's expected half-width and the bias a "
@@ -118,7 +122,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     )
     add_declared_option(parser, PendulumConfig, "period_s")
     add_declared_option(parser, PendulumConfig, "amplitude_deg")
-    add_declared_option(parser, PlanRequest, "accuracy_ms")
+    add_declared_option(parser, PlanAccuracy, "accuracy_ms")
     parser.add_argument("--runs", type=outputs.output_folder, metavar="DIR", help="keep the simulated films here (default: a temporary folder)")
     parser.add_argument(
         "--bench",

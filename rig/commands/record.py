@@ -14,7 +14,6 @@ import argparse
 import json
 
 from rig.commands import options, outputs
-from rig.live.camera_recording import record_camera
 from rig.progress import ProgressBar
 
 CAMERA_SPECS = (
@@ -36,6 +35,8 @@ def _summary(report: dict) -> str:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.live.camera_recording import record_camera
+
     rois = (list(args.led_roi), list(args.sphere_roi)) if args.led_roi and args.sphere_roi else None
     recording = record_camera(
         args.camera.removeprefix("camera:"), args.duration, args.out, preview=args.preview, rois=rois,
@@ -66,7 +67,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `record`."""
     parser = subparsers.add_parser(
         "record",
-        help="film with a camera (device, file or stream), every frame written as it comes",
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[1].replace("\n", " "),
     )
     parser.add_argument("--camera", required=True, metavar="SPEC", help=f"the camera: {CAMERA_SPECS}")

@@ -15,7 +15,6 @@ from rig.commands import choices, options, outputs
 from rig.progress import ProgressBar
 from rig.errors import RigError
 from rig.fresh_outputs import removed_unless_recorded
-from rig.service.tracker_recording import record_tracker
 
 
 def _summary(sidecar: dict) -> str:
@@ -35,6 +34,8 @@ def _summary(sidecar: dict) -> str:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service.tracker_recording import record_tracker
+
     bar = ProgressBar("recording") if args.duration is not None else (lambda done, total: None)
     with removed_unless_recorded(args.out):
         recording = record_tracker(args.tracker, args.duration, args.out, overwrite=args.overwrite, progress=bar)
@@ -56,9 +57,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `record-tracker`."""
     parser = subparsers.add_parser(
         "record-tracker",
-        help="record a serial, HID or LSL tracker's samples on the host's clock, as they arrive",
         description=__doc__.split("\n\n")[0] + " " + __doc__.split("\n\n")[1].replace("\n", " "),
-        epilog=choices.trackers_listing(),
+        listings=choices.trackers_listing,
     )
     parser.add_argument("--tracker", required=True, metavar="SPEC", help="the tracker (listed below)")
     parser.add_argument("--duration", type=options.run_seconds, metavar="S", help="seconds to record (default: until Ctrl-C)")

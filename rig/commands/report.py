@@ -7,12 +7,14 @@ from pathlib import Path
 
 from rig.commands import outputs
 from rig.errors import ConfigError
-from rig.service.report import run_report, summary_report, write_report
+from rig.progress import ProgressBar
 
 SUMMARY_SUFFIXES = (".csv", ".json")
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service.report import run_report, summary_report, write_report
+
     source: Path = args.source
     outputs.checked(outputs.output_file(".html"), args.out, "--out")
     if not source.exists():
@@ -20,7 +22,7 @@ def _run(args: argparse.Namespace) -> int:
     if source.is_file() and source.suffix.lower() in SUMMARY_SUFFIXES:
         report = summary_report(source, args.group)
     else:
-        report, _ = run_report(source)
+        report, _ = run_report(source, ProgressBar("analysing"))
     page, markdown = write_report(report, args.out)
     print(f"{report.headline}; {report.verdict}")
     print(f"wrote {page} and {markdown}")
@@ -30,7 +32,6 @@ def _run(args: argparse.Namespace) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "report",
-        help="write a self-contained HTML report (and Markdown) of a run or of a summary of many",
         description="For a video or a run folder (video.avi, with truth.json and board/ when the run has them): "
         "the latency in large type, the tracks over the whole film with the delayed LED laid on the sphere, the "
         "latency swing by swing, the residual, every method and diagnostic with its verdict, the warnings, the "

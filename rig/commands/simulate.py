@@ -4,16 +4,21 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import TYPE_CHECKING
 
 from rig.commands import outputs
 from rig.commands.simulation_options import add_flash_options, add_simulation_options, simulation_config
 from rig.progress import ProgressBar
-from rig.service import SimulationConfig, simulate
-from rig.service.run_plot import plot_run
-from rig.sim.board import BOARD_FOLDER
+from rig.session.run_files import BOARD_FOLDER
+
+if TYPE_CHECKING:
+    from rig.sim.config import SimulationConfig
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service import simulate
+    from rig.service.run_plot import plot_run
+
     config = simulation_config(args)
     result = simulate(config, args.out, ProgressBar("simulating"), args.overwrite)
     writes = outputs.LateWrites()
@@ -41,7 +46,6 @@ def _run(args: argparse.Namespace) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "simulate",
-        help="simulate the rig and write a video with known latency",
         description="Simulate pendulum, tracker, predictor, renderer, display and camera on a virtual clock. "
         "Writes DIR/video.avi, DIR/camera_frames.csv, DIR/truth.json, DIR/tracker.csv, DIR/app_frames.csv and "
         "DIR/display_frames.csv, "

@@ -12,10 +12,11 @@ from rig.commands import options
 from rig.commands.choices import predictors_listing, renderers_listing
 from rig.commands.declared_options import add_declared_options, config_from_args, declared_type
 from rig.errors import ConfigError
-from rig.service import SimulationConfig
-from rig.sim.board import BOARD_FOLDER, SimulatedBoardConfig
-from rig.sim.flash import FlashTarget
-from rig.sim.impairments import FILM
+from rig.session.run_files import BOARD_FOLDER
+from rig.sim.board_config import SimulatedBoardConfig
+from rig.sim.config import SimulationConfig
+from rig.sim.flash_target import FlashTarget
+from rig.sim.impairments_config import FILM
 
 RIG = "simulated rig"
 LAB = "lab"
@@ -24,7 +25,7 @@ LAB = "lab"
 def add_simulation_options(parser: argparse.ArgumentParser, lab: bool = False) -> None:
     """The options that describe a simulated rig; with `lab`, what a lab does during a filmed run
     too (release a held pendulum, blink the board's LED)."""
-    parser.epilog = "\n\n".join((renderers_listing(), predictors_listing()))
+    parser.listings = lambda: "\n\n".join((renderers_listing(), predictors_listing()))
     groups = {"": RIG, FILM: "simulated camera's film"} | ({LAB: "lab procedure"} if lab else {})
     sections = add_declared_options(parser, SimulationConfig, groups)
     sections[RIG].add_argument(

@@ -10,10 +10,11 @@ from pathlib import Path
 from rig.cli import EXIT_USER_ERROR
 from rig.commands import options, outputs
 from rig.progress import ProgressBar
-from rig.service.sweep import read_sweep, run_sweep
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service.sweep import read_sweep, run_sweep
+
     sweep = read_sweep(args.spec)
     rows, summary = run_sweep(sweep, args.out, args.workers, args.scheduler, ProgressBar("sweeping", unit="points"), args.overwrite)
     if args.json:
@@ -36,7 +37,6 @@ def _run(args: argparse.Namespace) -> int:
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "sweep",
-        help="simulate and analyse a grid of simulated rigs into one summary",
         description="SPEC.toml names [base] simulation settings, a [grid] of settings and the values to sweep each "
         "over (every combination runs) and/or [[points]] given one by one (each its settings, and its row's labels "
         "as labels = {...}), and optional [analysis] options (rig analyse's, by their setting names: method, "

@@ -15,18 +15,24 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from predictors import Trace, read_trace
 from rig.commands import choices, options, outputs
 from rig.commands.declared_options import add_declared_option
 from rig.progress import ProgressBar
-from rig.service import TuneReport, split_traces, tune
-from rig.service.tune import PARTS, TuneSettings, check_scorable, in_time_order
+from rig.tune_settings import TuneSettings
+
+if TYPE_CHECKING:
+    from predictors import Trace
+    from rig.service import TuneReport
 
 EXIT_NOT_WRITTEN = 1
 
 
 def _read(paths: list[Path], repair: bool) -> tuple[list[Trace], list[str]]:
+    from predictors import read_trace
+    from rig.service.tune import in_time_order
+
     traces, repaired = [], []
     for path in paths:
         trace, note = in_time_order(read_trace(path), repair)
@@ -37,6 +43,8 @@ def _read(paths: list[Path], repair: bool) -> tuple[list[Trace], list[str]]:
 
 
 def _table(report: TuneReport) -> str:
+    from rig.service.tune import PARTS
+
     rows = [f"RMS error at {report.horizon_ms:g} ms         training (deg, mm)    validation (deg, mm)"]
     for key, label in report.labels.items():
         cells = "   ".join(
@@ -47,6 +55,9 @@ def _table(report: TuneReport) -> str:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.service import split_traces, tune
+    from rig.service.tune import check_scorable
+
     traces, repaired = _read(args.trace, args.repair)
     held_out, repaired_held_out = _read(args.held_out or [], args.repair)
     train, validation = split_traces(traces, held_out, args.split)
@@ -83,10 +94,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Register `tune`."""
     parser = subparsers.add_parser(
         "tune",
-        help="fit a predictor's parameters (Kalman noise ratios and damping, DESP's smoothing, auto's "
-        "choice) to recorded motion; keep them only if they beat the defaults on motion held out",
         description=__doc__.split("\n\n")[0],
-        epilog=choices.tunable_listing(),
+        listings=choices.tunable_listing,
     )
     parser.add_argument("predictor", type=options.predictor_spec, metavar="PREDICTOR[:key=value,...]",
                         help="predictor to tune, with starting or fixed parameters (e.g. the tracker's noise)")

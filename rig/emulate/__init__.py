@@ -16,13 +16,14 @@ from typing import Callable
 
 import numpy as np
 
-from declared import Flag, Range, check, setting
+from declared import check, like
 from predictors import quaternion, read_trace
+from rig.devices.trackers.default_profiles import SERIAL as DEFAULT_PROFILE
 from rig.devices.trackers.profile import load_profile
 from rig.emulate.encode import RecordEncoder
 from rig.emulate.sinks import LslSink, PtySink, TcpSink
-from rig.devices.trackers.serial_tracker import DEFAULT_PROFILE
-from rig.emulate.streamer import READER_TIMEOUT_S, SENT_COLUMNS, SentCounts, Sink, stream
+from rig.emulate.streamer import SENT_COLUMNS, SentCounts, Sink, stream
+from rig.emulator_settings import ReaderWait
 from rig.errors import ConfigError
 from rig.writers import CsvRecord
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -56,10 +57,7 @@ class EmulatorConfig:
     seed: int = 0
     drift_ppm: float = 0.0
     log: Path | None = None
-    idle_timeout_s: float = setting(
-        READER_TIMEOUT_S, "seconds", "end when no reader has connected this long after the emulator is ready",
-        Range(0.0, 86400.0, False, True), flag=Flag("--idle-timeout", metavar="SECONDS"),
-    )  # fmt: skip
+    idle_timeout_s: float = like(ReaderWait, "idle_timeout_s")
 
     def __post_init__(self) -> None:
         check(self, ConfigError)

@@ -19,12 +19,11 @@ from typing import Callable, Protocol, Sequence
 import numpy as np
 
 from rig.emulate.encode import Emission
+from rig.emulator_settings import ReaderWait
 from rig.writers import CsvRecord
 from rig.sim.tracker import TrackerSamples
 
 SENT_COLUMNS = ("seq", "device_time", "t_write", "fate")
-# How long a sink waits for its first reader before the emulator gives up, unless told otherwise.
-READER_TIMEOUT_S = 60.0
 # How long after its last record the emulator waits for a reader to come back from a disconnect.
 READER_RETURN_S = 2.0
 # At the end the emulator keeps the port open up to this long for the reader to take what is in
@@ -78,7 +77,7 @@ def stream(
     log: CsvRecord | None,
     on_event: Callable[[str], None] = lambda message: None,
     on_start: Callable[[float], None] = lambda t: None,
-    idle_timeout_s: float = READER_TIMEOUT_S,
+    idle_timeout_s: float = ReaderWait.idle_timeout_s,
 ) -> SentCounts:
     """Sends `samples` (with their angular `rates`) through `sink` once a reader is there (given up
     after `idle_timeout_s` without one), until they are all sent or the reader hangs up;

@@ -36,7 +36,7 @@ from rig.live.video_vs_log import video_against_log
 from rig.live.view import View
 from rig.render.protocol import RenderSetup
 from rig.service.analyse import AnalysisRequest, analyse
-from rig.session.run_record import BOARD_FOLDER, FRAMES_FILE
+from rig.session.run_files import BOARD_FOLDER, FRAMES_FILE
 
 MEASURE_FILE = "measure.json"
 PLOT_FILE = "measure.png"

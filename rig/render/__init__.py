@@ -5,15 +5,21 @@
 The plug-in protocol is in `rig.render.protocol`; shared OpenGL helpers are in `rig.render.gl`.
 """
 
-from rig.render.protocol import (
-    AppFrameRequest,
-    AppFrameResult,
-    DisplayFrameRequest,
-    DisplayFrameResult,
-    Renderer,
-    RenderSetup,
+from declared.lazy import lazy_exports
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "AppFrameRequest": "rig.render.protocol",
+        "AppFrameResult": "rig.render.protocol",
+        "DisplayFrameRequest": "rig.render.protocol",
+        "DisplayFrameResult": "rig.render.protocol",
+        "Renderer": "rig.render.protocol",
+        "RenderSetup": "rig.render.protocol",
+        "make_renderer": "rig.render.registry",
+        "renderer_names": "rig.render.registry",
+    },
 )
-from rig.render.registry import make_renderer, renderer_names
 
 __all__ = [
     "AppFrameRequest",

@@ -19,13 +19,12 @@ import inspect
 from typing import Any
 
 from rig.errors import ConfigError, RigError
-from rig.plugins import load_plugin, plugin_names
+from rig.plugins import RENDERER_GROUP, load_plugin, plugin_names
 from rig.render.direct import DirectRenderer
 from rig.render.protocol import Renderer
 from rig.render.warp import WarpRenderer
 from rig.render.warp_options import WarpOptions
 
-ENTRY_POINT_GROUP = "rig.renderers"
 
 BUILT_IN_RENDERERS: dict[str, type] = {"direct": DirectRenderer, "warp": WarpRenderer}
 BUILT_IN_OPTIONS: dict[str, type] = {"warp": WarpOptions}
@@ -34,7 +33,7 @@ BUILT_IN_OPTIONS: dict[str, type] = {"warp": WarpOptions}
 
 def renderer_names() -> list[str]:
     """Every renderer name `make_renderer` accepts, sorted: built-in and installed third-party."""
-    return plugin_names(ENTRY_POINT_GROUP, BUILT_IN_RENDERERS)
+    return plugin_names(RENDERER_GROUP, BUILT_IN_RENDERERS)
 
 
 def _value(text: str) -> Any:
@@ -80,7 +79,7 @@ def make_renderer(spec: str) -> Renderer:
     or does not satisfy the Renderer protocol.
     """
     name, options = parse_spec(spec)
-    plugin = load_plugin(ENTRY_POINT_GROUP, name, BUILT_IN_RENDERERS, "renderer")
+    plugin = load_plugin(RENDERER_GROUP, name, BUILT_IN_RENDERERS, "renderer")
     if options:
         _check_options(name, plugin.obj, options)
     try:

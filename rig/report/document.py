@@ -7,6 +7,8 @@ from __future__ import annotations
 import base64
 import html
 import io
+import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Sequence
@@ -34,12 +36,41 @@ class Report:
     sections: list[Section] = field(default_factory=list)
 
 
-def _cell(value: Any) -> str:
-    if value is None:
+def cell(value: Any) -> str:
+    """A table's value as people read it: a number to four significant figures (nothing below a
+    billionth, so a rounding error reads 0), yes or no for a
+    flag, a list's items joined, "-" for none; text a CSV summary kept of these ("False",
+    "[0.0, 9.99]", "9.991666666666667") reads the same."""
+    if isinstance(value, str):
+        value = _read_back(value)
+    if value is None or value == "":
         return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
     if isinstance(value, float):
-        return f"{value:.4g}"
+        return f"{round(value, 9) + 0.0:.4g}" if math.isfinite(value) else str(value)  # + 0.0: no "-0"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(map(cell, value)) or "-"
+    if isinstance(value, dict):
+        return ", ".join(f"{key} {cell(item)}" for key, item in value.items()) or "-"
     return str(value)
+
+
+def _read_back(text: str) -> Any:
+    """The value a CSV cell wrote as text (a flag, a number, a list), or the text itself."""
+    if text in ("True", "False"):
+        return text == "True"
+    if text.startswith("[") and text.endswith("]"):
+        try:
+            return json.loads(text)
+        except ValueError:
+            return text
+    if any(mark in text for mark in ".eE") and not text.lower().startswith(("inf", "nan")):
+        try:
+            return float(text)
+        except ValueError:
+            return text
+    return text
 
 
 def _png(figure: Figure) -> bytes:
@@ -79,7 +110,7 @@ def write_html(report: Report, path: Path) -> None:
             else:
                 header, rows = block
                 parts.append("<table><tr>" + "".join(f"<th>{html.escape(str(h))}</th>" for h in header) + "</tr>")
-                parts += ["<tr>" + "".join(f"<td>{html.escape(_cell(v))}</td>" for v in row) + "</tr>" for row in rows]
+                parts += ["<tr>" + "".join(f"<td>{html.escape(cell(v))}</td>" for v in row) + "</tr>" for row in rows]
                 parts.append("</table>")
     parts.append("</body></html>")
     _write(path, "\n".join(parts).encode("utf-8"))
@@ -103,7 +134,7 @@ def write_markdown(report: Report, path: Path) -> None:
                 header, rows = block
                 lines.append("| " + " | ".join(str(h) for h in header) + " |")
                 lines.append("|" + "---|" * len(header))
-                lines += ["| " + " | ".join(_cell(v).replace("|", "/") for v in row) + " |" for row in rows]
+                lines += ["| " + " | ".join(cell(v).replace("|", "/") for v in row) + " |" for row in rows]
                 lines.append("")
     _write(path, "\n".join(lines).encode("utf-8"))
 

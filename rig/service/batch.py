@@ -116,7 +116,7 @@ def analysed_row(item: BatchItem) -> tuple[dict[str, Any], LatencyResult | None]
             frames=result.frames,
             frames_used=result.frames_used,
             ambiguous=result.ambiguous,
-            warnings="; ".join(result.warnings),
+            warnings="; ".join(warning.replace("\n", ", ") for warning in result.warnings),  # a cell of one line
         )
     row["seconds"] = time.perf_counter() - started
     return row | item.labels, result

@@ -10,16 +10,15 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
+from analysis.options import AnalysisOptions
+from rig.demo_settings import AGREEMENT_MS, COMPARE_APP_FRAME_MS, COMPARE_RENDERERS, COMPARE_TRIANGLES
 from rig.errors import RigError
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
+from rig.service.bench_profile import with_profile
 from rig.service.simulate import TRUTH_FILE, SimulationResult, simulate
+from rig.service.sweep import simulated_bench
 from rig.session.session import Progress
 from rig.sim.config import SimulationConfig
-
-AGREEMENT_MS = 1.0
-COMPARE_RENDERERS = ("direct", "warp")
-COMPARE_TRIANGLES = 100_000
-COMPARE_APP_FRAME_MS = 100.0
 
 ProgressFactory = Callable[[str], Progress]
 """Makes the progress callback of one stage ("simulating", "analysing")."""
@@ -65,13 +64,17 @@ class DemoReport:
 def demo(config: SimulationConfig, out: Path, progress: ProgressFactory | None = None) -> DemoReport:
     """Simulate `config` into `out`, analyse its video, plot both tracks into out/demo.png.
 
+    The analysis is told the simulated bench as a lab that knows its bench tells it (its camera's
+    rate and exposure, the display's refresh, the LED's side: `simulated_bench`), each checked
+    against the video, so that the demo measures as the filming advice says a lab should.
     A demo folder holds synthetic data only: rerunning the demo replaces a previous simulation
     (recognised by its truth.json) but never anything else.
     """
     out = Path(out)
     stage = progress or (lambda label: None)
     simulation = simulate(config, out, stage("simulating"), overwrite=(out / TRUTH_FILE).exists())
-    measurement = analyse(AnalysisRequest(simulation.video_path), stage("analysing"))
+    told = with_profile(AnalysisOptions(), simulated_bench(config), out / TRUTH_FILE)
+    measurement = analyse(AnalysisRequest(simulation.video_path, told), stage("analysing"))
     result = measurement.result
     plot = out / "demo.png"
     try:

@@ -28,10 +28,11 @@ from pathlib import Path
 from typing import Any, Callable
 
 import analysis
-from declared import Range, check, setting
+from declared import check, like
 from analysis.sampling.model import bias_range_s, commensurate
 from analysis.timing import RATE_AGREEMENT
 from rig.errors import ConfigError
+from rig.plan_settings import PlanAccuracy
 from rig.service.bench_profile import CameraProfile
 from rig.service.simulate import SimulationResult, simulate
 from rig.sim.camera import CameraConfig
@@ -67,10 +68,7 @@ class PlanRequest:
     exposures: tuple[float, ...] = (1.0,)
     period_s: float = 1.0
     amplitude_deg: float = PendulumConfig().amplitude_deg
-    accuracy_ms: float = setting(
-        1.0, "ms", "the 95% half-width of the latency wanted, from 10 us to 100 ms",
-        Range(0.01, 100.0, True, True), flag="--accuracy-ms",
-    )  # fmt: skip
+    accuracy_ms: float = like(PlanAccuracy, "accuracy_ms")
 
     def __post_init__(self) -> None:
         check(self, ConfigError)

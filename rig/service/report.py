@@ -17,7 +17,7 @@ import platform
 import subprocess
 from importlib import metadata
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 from analysis import LatencyResult
 from analysis.board.recording import METADATA
@@ -27,7 +27,7 @@ from rig.report.figures import latency_over_time_figure, residuals_figure, summa
 from rig.service.analyse import AnalysisRequest, Measurement, analyse
 from rig.service.batch import RESULT_COLUMNS
 from rig.service.compare import Z95, differences, group_latencies
-from rig.session.run_record import BOARD_FOLDER
+from rig.session.run_files import BOARD_FOLDER
 
 PACKAGES = ("latency-rig", "numpy", "scipy", "opencv-contrib-python-headless", "jax", "jaxopt", "emcee", "matplotlib", "moderngl")
 RUN_VIDEO = "video.avi"
@@ -113,8 +113,9 @@ def read_truth(path: Path) -> dict[str, Any]:
     return truth
 
 
-def run_report(path: Path) -> tuple[Report, Measurement]:
-    """The report of a video, or of a run folder holding video.avi (and maybe truth.json, board/)."""
+def run_report(path: Path, progress: Callable[[int, int], object] | None = None) -> tuple[Report, Measurement]:
+    """The report of a video, or of a run folder holding video.avi (and maybe truth.json, board/);
+    `progress(done, total)` as its frames are tracked."""
     path = Path(path)
     folder = path if path.is_dir() and (path / RUN_VIDEO).exists() else None
     video = folder / RUN_VIDEO if folder is not None else path
@@ -122,7 +123,7 @@ def run_report(path: Path) -> tuple[Report, Measurement]:
     truth = read_truth(truth_path) if truth_path.exists() else None
     board = (folder or video.parent) / BOARD_FOLDER
     request = AnalysisRequest(video, board=board if (board / METADATA).exists() else None)
-    measurement = analyse(request)
+    measurement = analyse(request, progress)
     result = measurement.result
     report = Report(f"Latency of {video}", _headline(result), _run_verdict(result, truth))
     report.sections.append(Section("Warnings", list(result.warnings) or ["none"]))
@@ -159,7 +160,7 @@ def read_summary(path: Path) -> list[dict[str, Any]]:
                 rows = list(csv.DictReader(stream))
         if not all(isinstance(row, dict) and "video" in row for row in rows):
             raise ValueError("every row needs a video column, as `rig analyse --summary` and `rig sweep` write")
-        numeric = ("latency_ms", "ci95_low_ms", "ci95_high_ms", "period_s", "frequency_hz", "seconds")
+        numeric = ("latency_ms", "ci95_low_ms", "ci95_high_ms", "period_s", "frequency_hz", "seconds", "truth_ms", "error_ms")
         for row in rows:
             for key in numeric:
                 if key in row:
@@ -183,18 +184,29 @@ def summary_report(path: Path, group: str | None = None) -> Report:
     report = Report(f"Summary of {path}", f"{len(measured)} of {len(rows)} videos measured",
                     f"{len(failed)} failed, {sum(row.get('status') == 'warning' for row in rows)} with warnings")  # fmt: skip
     report.sections.append(Section("Latency per video", [("summary", summary_figure(rows, group))]))
+    known = any(row.get("truth_ms") is not None for row in rows)
+    truth_header = ("true (ms)", "error (ms)") if known else ()
     if group is not None:
-        pooled = group_latencies(measured, group)
-        table = [(g.name, g.videos, g.latency_ms, g.latency_ms - Z95 * g.se_ms, g.latency_ms + Z95 * g.se_ms) for g in pooled]
-        pairs = [(f"{d.b} - {d.a}", d.difference_ms, *d.ci95_ms, "differ" if d.differs else "not shown to differ") for d in differences(pooled)]
+        others = [label for label in labels if label != group]
+        pooled = group_latencies(measured, group, others)
+        table = [
+            (g.name, *(value for _, value in g.conditions), g.videos, g.latency_ms, g.latency_ms - Z95 * g.se_ms, g.latency_ms + Z95 * g.se_ms,
+             *((g.truth_ms, g.error_ms) if known else ()))
+            for g in pooled
+        ]  # fmt: skip
+        pairs = [(f"{d.b} - {d.a}", *(value for _, value in d.conditions), d.difference_ms, *d.ci95_ms,
+                  "differ" if d.differs else "not shown to differ") for d in differences(pooled)]  # fmt: skip
         report.sections.append(Section(f"By {group}", [
-            "Each group pooled over its videos, weighted by their intervals (rig.service.compare).",
-            (("group", "videos", "latency (ms)", "95 % low", "95 % high"), table),
-            (("difference", "ms", "95 % low", "95 % high", "verdict"), pairs),
+            f"Each group pooled over its videos, weighted by their intervals (rig.service.compare); only videos whose "
+            f"other labels ({', '.join(others) or 'none'}) match are pooled, and only such groups compared.",
+            ((group, *others, "videos", "latency (ms)", "95 % low", "95 % high", *truth_header), table),
+            (("difference", *others, "ms", "95 % low", "95 % high", "verdict"), pairs),
         ]))  # fmt: skip
-    table = [(row["video"], row.get("status"), row.get("latency_ms"), row.get("ci95_low_ms"), row.get("ci95_high_ms"), row.get(group) if group else "-",
+    table = [(row["video"], row.get("status"), *(row.get(label) for label in labels), row.get("latency_ms"), row.get("ci95_low_ms"),
+              row.get("ci95_high_ms"), *((row.get("truth_ms"), row.get("error_ms")) if known else ()),
               row.get("warnings") or row.get("error") or "") for row in rows]  # fmt: skip
-    report.sections.append(Section("Every video", [(("video", "status", "latency (ms)", "95 % low", "95 % high", group or "group", "warnings / error"), table)]))
+    header = ("video", "status", *labels, "latency (ms)", "95 % low", "95 % high", *truth_header, "warnings / error")
+    report.sections.append(Section("Every video", [(header, table)]))
     report.sections.append(Section("Software", [(("software", "version"), software())]))
     return report
 

@@ -22,7 +22,8 @@ from analysis.windows import MIN_SAMPLES
 from rig.clock import VirtualClock
 from rig.devices.registry import DeviceContext, make_camera, make_display, make_tracker
 from rig.errors import RigError
-from rig.film_file import FRAME_TIMES_FILE, STAMPED_CONTAINERS, check_film_rate, video_file_name
+from rig.film_file import FRAME_TIMES_FILE, check_film_rate, video_file_name
+from rig.film_formats import STAMPED_CONTAINERS
 from rig.fresh_outputs import removed_unless_recorded
 from rig.render import RenderSetup, make_renderer
 from rig.session import RUN_FILES, PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for

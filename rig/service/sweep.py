@@ -54,7 +54,7 @@ from rig.service.batch import SUMMARY_COLUMNS, USER_ERRORS, BatchItem, BatchRun,
 from rig.service.bench_profile import BenchProfile, CameraProfile, DisplayProfile, LayoutProfile, read_profile, with_profile
 from rig.service.simulate import SimulationResult, simulate
 from rig.sim.config import SimulationConfig
-from rig.sim.layout import placement
+from rig.sim.placement import placement
 from rig.sim.truth import Truth
 from rig.toml_file import read_toml
 

@@ -25,7 +25,6 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 
 from predictors import DEFAULT, Trace, evaluate, resolve, write_params
-from declared import Range, setting
 from rig.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -35,21 +34,6 @@ COMPARED_WITH = "slerp"
 """The baseline: constant velocity from the last two samples."""
 
 PARTS = ("training", "validation")
-HORIZONS = Range(0.0, 1000.0, True, True)
-"""A prediction horizon: a display's photons come tens of ms after a sample, a cloud-rendered one's
-a few hundred; past a second no motion is predictable."""
-
-
-@dataclass(frozen=True)
-class TuneSettings:
-    """`rig tune`'s numbers, each declared on its field (its options are made from them and checked
-    against their ranges as the command line is read)."""
-
-    split: float = setting(0.6, "", "fraction of each trace's duration to train on when no --held-out is given",
-                           Range(0.0, 1.0), flag="--split")  # fmt: skip
-    horizon_ms: float | None = setting(None, "ms", "prediction horizon after each sample's arrival to tune for", HORIZONS,
-                                       unset="always given", flag="--horizon-ms")  # fmt: skip
-    max_iterations: int = setting(40, "", "optimiser iterations at most", Range(0.0, 10000.0, True, True), flag="--max-iterations")
 
 
 MIN_SAMPLES = 10

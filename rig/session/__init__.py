@@ -6,20 +6,29 @@
 cost models, `rig.session.run_record` the files a run writes as it goes.
 """
 
-from rig.session.run_record import RUN_FILES, RunRecord
-from rig.session.session import Session, SessionLog, SessionParts, ShownImage
-from rig.session.timing import (
-    DEFAULT_SERVER_MS,
-    PHOTON_TARGETS,
-    CompositeEveryRefresh,
-    CostModel,
-    MeasuredCost,
-    ModelledCost,
-    OneImagePerAppFrame,
-    PhotonTarget,
-    TimingPolicy,
-    cost_model,
-    timing_for,
+from declared.lazy import lazy_exports
+
+__getattr__, __dir__ = lazy_exports(
+    __name__,
+    {
+        "RUN_FILES": "rig.session.run_files",
+        "RunRecord": "rig.session.run_record",
+        "Session": "rig.session.session",
+        "SessionLog": "rig.session.session",
+        "SessionParts": "rig.session.session",
+        "ShownImage": "rig.session.session",
+        "DEFAULT_SERVER_MS": "rig.session.photon_target",
+        "PHOTON_TARGETS": "rig.session.photon_target",
+        "CompositeEveryRefresh": "rig.session.timing",
+        "CostModel": "rig.session.timing",
+        "MeasuredCost": "rig.session.timing",
+        "ModelledCost": "rig.session.timing",
+        "OneImagePerAppFrame": "rig.session.timing",
+        "PhotonTarget": "rig.session.photon_target",
+        "TimingPolicy": "rig.session.timing",
+        "cost_model": "rig.session.timing",
+        "timing_for": "rig.session.timing",
+    },
 )
 
 __all__ = [

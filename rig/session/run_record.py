@@ -44,14 +44,8 @@ from rig.devices.protocols import CameraFrame
 from rig.errors import RigError
 from rig.film_file import StampedVideoRecord, check_film_rate, video_file_name
 from rig.writers import CsvRecord, VideoRecord
+from rig.session.run_files import APP_FRAMES_FILE, DISPLAY_FRAMES_FILE, FRAMES_FILE, TRACKER_FILE
 
-TRACKER_FILE = "tracker.csv"
-APP_FRAMES_FILE = "app_frames.csv"
-DISPLAY_FRAMES_FILE = "display_frames.csv"
-VIDEO_FILE = "video.avi"
-FRAMES_FILE = "camera_frames.csv"
-BOARD_FOLDER = "board"
-RUN_FILES = (VIDEO_FILE, FRAMES_FILE, TRACKER_FILE, APP_FRAMES_FILE, DISPLAY_FRAMES_FILE)
 APP_FRAME_COLUMNS = (
     "index", "t_start", "cost_s", "cost_source", "t_finish", "t_photon_target", "t_sensor_newest", "x", "y", "z",
 )  # fmt: skip

@@ -30,7 +30,8 @@ from rig.errors import RigError
 from rig.writers import CsvRecord
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, DisplayFrameResult, Renderer, RenderSetup
 from rig.session.run_record import RunRecord
-from rig.session.timing import CostModel, PhotonTarget, TimingPolicy
+from rig.session.photon_target import PhotonTarget
+from rig.session.timing import CostModel, TimingPolicy
 
 Progress = Callable[[float, float], None]
 

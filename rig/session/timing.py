@@ -28,7 +28,7 @@ A **timing policy** says when the renderer works and when its images reach the d
   last image at the refreshes the server missed. The next composition aims past the refresh the
   last image actually took.
 
-A **photon target** (`PhotonTarget`) says which instant a display frame's pose is predicted for:
+A **photon target** (`PhotonTarget`, in `rig.session.photon_target`) says which instant a display frame's pose is predicted for:
 the moment the frame's scan-out reaches the tracked object's row, or the middle of the interval
 during which that row then emits it (scan-out plus half the persistence).
 
@@ -43,10 +43,10 @@ from typing import Any, ClassVar, Protocol, Sequence
 
 import numpy as np
 
-from declared import Range, check, setting
 from rig.devices.protocols import Display
 from rig.errors import ConfigError
 from rig.render.protocol import AppFrameResult, DisplayFrameResult, Renderer
+from rig.session.photon_target import PhotonTarget
 
 PLANNED_COST_WINDOW = 60
 """How many of the latest measured server costs the plan for the next one weighs."""
@@ -57,7 +57,6 @@ measured costs the plan misses 4 to 6 % of refreshes (`rig bench renderers --see
 planning for the 90th percentile of the last 20 costs missed about one in ten by construction."""
 SWAP_MARGIN_S = 2e-4
 """A composition aims to be ready this long before its blank: a swap at the blank misses it."""
-PHOTON_TARGETS = ("photons", "scanout")
 
 
 def latency_minimising_cost(costs_s: Sequence[float], miss_s: float) -> float:
@@ -127,37 +126,6 @@ CostModel = ModelledCost | MeasuredCost
 def cost_model(ms: float | None) -> CostModel:
     """A modelled cost of `ms`, or the measured one for None."""
     return MeasuredCost() if ms is None else ModelledCost(ms)
-
-
-@dataclass(frozen=True)
-class PhotonTarget:
-    """The instant a display frame's pose is predicted for, at the tracked object's display row.
-
-    mode "scanout": when the frame's scan-out reaches the row; "photons": the middle of the interval
-    the row then emits the frame, scan-out plus half the persistence. `persistence` is the share of
-    a refresh period a row emits each frame: 1 for a sample-and-hold display (the simulated one),
-    less for a low-persistence (strobed) panel.
-    """
-
-    mode: str = setting(
-        "photons", "", "the instant each frame's pose is predicted for, at the sphere's row: 'photons' the middle of the "
-        "interval the row emits it (scan-out plus half the persistence), 'scanout' when scan-out reaches the row",
-        choices=PHOTON_TARGETS,
-    )  # fmt: skip
-    persistence: float = setting(
-        1.0, "", "share of a refresh each display row emits a frame: 1 for sample-and-hold (the simulated display), "
-        "less for a low-persistence panel", Range(0.0, 1.0, includes_high=True),
-    )  # fmt: skip
-
-    def __post_init__(self) -> None:
-        check(self, ConfigError)
-
-    def time(self, display: Display, k: int, row_fraction: float) -> float:
-        """The instant refresh k's pose is predicted for, for an object at `row_fraction`."""
-        t = display.photon_time(k, row_fraction)
-        if self.mode == "photons":
-            t += 0.5 * self.persistence / display.refresh_hz
-        return t
 
 
 class Stage(Protocol):
@@ -279,12 +247,6 @@ class CompositeEveryRefresh:
 
     def display_frame_cost(self) -> dict[str, Any] | None:
         return self.server_cost.describe(self._charged)
-
-
-DEFAULT_SERVER_MS = 2.0
-"""Modelled server cost per composed image of a renderer that composes at every refresh: a GPU's
-point warp of a display-sized image, well inside a refresh. Software OpenGL takes longer, which a
-run with measured costs shows as missed refreshes."""
 
 
 def timing_for(renderer: Renderer, server_cost: CostModel) -> TimingPolicy:

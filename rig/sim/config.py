@@ -8,14 +8,14 @@ from typing import Any
 
 from declared import Flag, Range, check, like, setting
 from rig.errors import ConfigError
-from rig.session.timing import DEFAULT_SERVER_MS, PhotonTarget
-from rig.sim.layout import DEFAULT_LAYOUT, LAYOUT_HELP, placement
-from rig.sim.board import SimulatedBoardConfig
-from rig.sim.camera import CameraConfig
-from rig.sim.display import DisplayConfig
-from rig.sim.flash import FlashTarget
-from rig.sim.pendulum import PendulumConfig
-from rig.sim.tracker import TrackerConfig
+from rig.session.photon_target import DEFAULT_SERVER_MS, PhotonTarget
+from rig.sim.board_config import SimulatedBoardConfig
+from rig.sim.camera_config import CameraConfig
+from rig.sim.display_config import DisplayConfig
+from rig.sim.flash_target import FlashTarget
+from rig.sim.pendulum_config import PendulumConfig
+from rig.sim.placement import DEFAULT_LAYOUT, LAYOUT_HELP, placement
+from rig.sim.tracker_config import TrackerConfig
 
 MEASURED = "measured"
 """A cost given as this (on the command line, in a spec) is what this machine's GL takes."""

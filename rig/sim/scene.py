@@ -7,7 +7,6 @@ display's scan-out and sample-and-hold, `rig.sim.display`), in camera digital nu
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 
 from rig.devices.protocols import NO_IMAGE
@@ -89,6 +88,8 @@ class FilmedScene:
         if image_id not in self._panels:
             for old in [i for i in self._panels if i not in self.display.images]:
                 del self._panels[old]
+            import cv2  # here, not above: a scene's settings are read without OpenCV
+
             _, _, pw, ph = self.panel
             grey = cv2.cvtColor(np.ascontiguousarray(self.display.images[image_id]), cv2.COLOR_RGB2GRAY)
             panel = cv2.resize(grey, (pw, ph), interpolation=cv2.INTER_AREA).astype(np.float32)

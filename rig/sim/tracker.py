@@ -32,12 +32,13 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from declared import FRACTION, Flag, Range, check, setting
+from declared import check
 from predictors import PoseSample
 from rig.clock import Clock
 from rig.devices.protocols import Fault
 from rig.errors import ConfigError, RigError
 from rig.sim.tracker_faults import FaultPlan, delivered
+from rig.sim.tracker_config import TrackerConfig
 
 NO_FAULTS = FaultPlan()
 
@@ -50,35 +51,6 @@ class Motion(Protocol):
 
     def sensor_pose(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Positions (N, 3) and unit (w, x, y, z) orientations (N, 4) at the times `t` (N,)."""
-
-
-@dataclass(frozen=True)
-class TrackerConfig:
-    """Rate, noise and transport of a simulated tracker, each declared on its field (`declared.setting`)."""
-
-    rate_hz: float = setting(
-        120.0, "Hz", "tracker sample rate: optical trackers sample at tens to hundreds of Hz, inertial ones up to a few kHz",
-        Range(1.0, 5000.0, True, True), flag="--tracker-hz",
-    )  # fmt: skip
-    position_noise_m: float = setting(0.0002, "metres", "position noise, standard deviation per axis", Range(0.0, 0.1, True, True))
-    orientation_noise_deg: float = setting(
-        0.05, "degrees", "orientation noise, standard deviation of each rotation-vector component",
-        Range(0.0, 10.0, True, True),
-    )
-    transport_delay_s: float = setting(
-        0.004, "seconds", "fixed tracker-to-host delay, at most a second", Range(0.0, 1.0, True, True), flag=Flag("--transport-delay-ms", unit="ms", factor=1e3)
-    )
-    jitter_s: float = setting(0.0005, "seconds", "mean transport jitter, exponentially distributed", Range(0.0, 0.1, True, True))
-    dropout: float = setting(0.0, "", "probability that a sample is lost", FRACTION)
-    phase_s: float = setting(0.0, "seconds", "first sensor time after the start, less than one sample interval", Range(0.0, 1.0, True))
-
-    def __post_init__(self) -> None:
-        check(self, ConfigError, "tracker.")
-        if not self.phase_s < 1.0 / self.rate_hz:
-            raise ConfigError(
-                f"tracker.phase_s must be in [0, 1 / rate_hz) = [0, {1.0 / self.rate_hz!r}) s, "
-                f"got {self.phase_s!r}"
-            )
 
 
 @dataclass(frozen=True)

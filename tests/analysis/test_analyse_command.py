@@ -36,7 +36,8 @@ def test_a_result_with_warnings_exits_3_and_prints_them(clip_file, capsys):
     assert main(["analyse", str(clip_file)]) == 3
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("latency 45.")
-    assert any(line.startswith("warning: the camera (120 fps") and "--exposure-ms" in line for line in out)
+    (at,) = [i for i, line in enumerate(out) if line.startswith("warning: ") and "the 120 fps camera" in line]
+    assert out[at + 1].startswith("  to avoid it: ") and "--exposure-ms" in out[at + 1]
     assert main(["analyse", str(clip_file), "--json"]) == 3
     assert json.loads(capsys.readouterr().out)["warnings"]
 

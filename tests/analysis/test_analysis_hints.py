@@ -68,4 +68,6 @@ def test_a_side_the_film_contradicts_follows_the_evidence(scene, render_video) -
     hinted = analysis.analyse(render_video(clip), AnalysisOptions(fps=clip.fps, hints=(Hint("led_side", "right", "bench.toml"),)))
     assert hinted.latency_ms == pytest.approx(clip.latency_s * 1e3, abs=0.5)
     assert hinted.hints[0].verdict == "contradicts" and hinted.led_roi.x < hinted.sphere_roi.x
-    assert any("the LED is on the right" in warning and "the evidence was followed" in warning for warning in hinted.warnings)
+    (warning,) = [w for w in hinted.warnings if "the LED is on the right" in w]
+    cause, remedy = warning.split("\n")
+    assert "the evidence was followed" in cause and remedy.startswith("to avoid it: ") and "--led-side" in remedy

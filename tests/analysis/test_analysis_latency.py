@@ -157,7 +157,7 @@ def test_missing_detections_are_left_out_and_reported(scene, render_video):
     assert not result.sphere_track.valid[hidden].any()
     assert result.warnings == [
         f"the sphere was missing in {hidden.size} frames (5.0%), of them {hidden.size} dark (off or hidden); "
-        "those frames were left out"
+        "those frames were left out\nto avoid it: keep the sphere lit and in view while filming"
     ]
     assert result.diagnostics["detection_rate"]["sphere"] == pytest.approx(0.95, abs=0.005)
 
@@ -368,7 +368,8 @@ def test_missing_frames_are_told_apart_as_dark_or_cut_off():
     check_track(track, "LED", warnings)
     assert warnings == [
         "the LED was missing in 6 frames (3.0%), of them 3 dark (off or hidden) and 2 cut off by the ROI's edge; "
-        "those frames were left out"
+        "those frames were left out\nto avoid it: keep the LED lit and in view while filming, and give a larger LED ROI "
+        "that holds its whole swing"
     ]
 
 

@@ -62,7 +62,7 @@ def test_a_latency_that_alternates_from_swing_to_swing_fails_consistency_not_dri
     alternation = lambda t: 0.0015 * np.sign(np.sin(np.pi * t / clip.period_s + 0.3))  # noqa: E731
     result, failed = checked(clip, render_video, lag_s=alternation)
     assert "per-swing consistency" in failed and "drift" not in failed
-    assert any(warning.startswith("the model does not fit the swing: per-swing consistency") for warning in result.warnings)
+    assert any(warning.startswith("the model does not fit the swing (per-swing consistency") for warning in result.warnings)
     statistical = result.methods["sinefit"].details["statistical_ci95_ms"]
     assert result.ci95_ms[1] - result.ci95_ms[0] > 1.3 * (statistical[1] - statistical[0])
     t = result.sphere_track.t

@@ -13,7 +13,10 @@ def test_analyse_is_track_then_estimate(scene, render_video):
     tracks = track(frames, AnalysisOptions(fps=clip.fps))
     assert isinstance(tracks, Tracks)
     assert tracks.roi_source == "auto" and tracks.led_rule.startswith("auto: by physical evidence")
-    assert tracks.warnings == ("the sphere was missing in 1 frames (0.3%), of them 1 dark (off or hidden); those frames were left out",)
+    assert tracks.warnings == (
+        "the sphere was missing in 1 frames (0.3%), of them 1 dark (off or hidden); those frames were left out\n"
+        "to avoid it: keep the sphere lit and in view while filming",
+    )
     assert np.array_equal(tracks.stamps, np.arange(clip.frame_count) / clip.fps)
     assert tracks.led.t is tracks.times.t and tracks.diagnostics["time_source"] == tracks.times.source
     known = {"display_hz": clip.display_hz, "exposure_ms": 1e3 / clip.fps, "readout_ms": 0.0}

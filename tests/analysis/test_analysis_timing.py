@@ -110,3 +110,18 @@ def test_duplicated_frames_in_a_video_are_left_out(scene, render_video):
     assert not result.led_track.valid[[201, 351, 421]].any()
     assert result.latency_ms == pytest.approx(40.0, abs=0.3)
     assert any("repeat the one before" in w for w in result.warnings)
+
+
+@pytest.mark.parametrize(
+    "stamps, stated_fps, says",
+    [
+        (np.zeros(50), 120.0, "timestamps do not increase"),
+        (np.arange(100) / 240.0, 120.0, "240 fps apart"),
+        (np.delete(np.arange(200), [50, 51]) / 120.0, 120.0, "2 frame(s) were dropped"),
+        (np.concatenate([[0.0], np.cumsum(np.where(np.arange(299) % 2 == 0, 1 / 100.0, 1 / 140.0))]), 120.0, "frame rate varies"),
+    ],
+)
+def test_each_timing_warning_is_a_cause_and_a_remedy(stamps, stated_fps, says):
+    (warning,) = [w for w in frame_times(stamps, None, stated_fps, "container").warnings if says in w]
+    cause, remedy = warning.split("\n")
+    assert says in cause and remedy.startswith("to avoid it: ")

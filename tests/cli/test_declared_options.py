@@ -19,7 +19,7 @@ from rig.commands.simulation_options import add_simulation_options, simulation_c
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
-from rig.sim.impairments import FilmImpairments
+from rig.sim.impairments_config import FilmImpairments
 from rig.sim.pendulum import PendulumConfig
 
 DECLARED = {"analyse": AnalysisOptions, "simulate": SimulationConfig, "calibrate-camera": ShutterOptions}

@@ -52,3 +52,27 @@ def test_bench_predictors_lists_every_predictor(capsys: pytest.CaptureFixture[st
 def test_analyse_lists_every_estimator(capsys: pytest.CaptureFixture[str]) -> None:
     for text in (methods_listing(), _help(capsys, "analyse")):
         assert all(_listed(text, name) for name in (*analysis.methods(), "all"))
+
+
+def test_each_listed_line_is_the_first_sentence_of_what_it_lists() -> None:
+    from analysis.estimators.registry import estimators_for
+    from predictors.tuning import TUNABLE as FITTED
+    from rig.commands.choices import DEFAULT_PREDICTOR, METHOD_LINES, PREDICTOR_LINES, RENDERER_LINES, TUNABLE
+    from rig.commands.options import first_sentence
+    from rig.render.registry import BUILT_IN_RENDERERS
+
+    assert list(PREDICTOR_LINES) == list(predictors.names())
+    assert DEFAULT_PREDICTOR == (predictors.DEFAULT, predictors.resolve(predictors.DEFAULT))
+    assert TUNABLE == FITTED
+    lines = {
+        **{name: first_sentence(type(predictors.make(name))) for name in predictors.names()},
+        **{name: first_sentence(kind) for name, kind in BUILT_IN_RENDERERS.items()},
+        **{name: first_sentence(type(estimators_for(name)[0])) for name in analysis.methods()},
+    }
+    assert lines == {**PREDICTOR_LINES, **RENDERER_LINES, **METHOD_LINES}
+
+
+def test_a_built_in_estimator_made_on_first_use_has_its_registered_name() -> None:
+    from analysis.estimators.registry import estimators_for
+
+    assert [estimator.name for estimator in estimators_for("all")] == list(analysis.methods())

@@ -49,7 +49,7 @@ def test_late_csv_has_a_column_per_field_in_first_seen_order_and_notes_a_failure
 def test_simulate_keeps_its_run_and_prints_it_when_the_plot_fails(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr("rig.commands.simulate.plot_run", _no_space)
+    monkeypatch.setattr("rig.service.run_plot.plot_run", _no_space)
     code = main(["simulate", "--out", str(tmp_path / "run"), "--duration", "1", "--plot", str(tmp_path / "truth.png")])
     out, err = capsys.readouterr()
     assert code == EXIT_USER_ERROR
@@ -79,8 +79,8 @@ def test_tune_prints_its_report_when_the_parameters_cannot_be_written(
 
 def test_a_fault_of_our_own_keeps_its_traceback_and_says_to_report_it() -> None:
     program = (
-        "import sys, rig.commands.devices as devices\n"
-        "devices.serial_ports = lambda: 1 / 0\n"
+        "import sys, rig.devices.trackers.discovery as discovery\n"
+        "discovery.serial_ports = lambda: 1 / 0\n"
         "sys.argv = ['rig', 'devices', '--lsl-wait', '0']\n"
         "from rig.cli import run\n"
         "run()\n"

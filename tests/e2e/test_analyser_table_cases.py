@@ -68,7 +68,7 @@ def test_a_240_fps_run_with_every_fourth_frame_kept_at_each_of_four_phases(tmp_p
     for phase in range(4):
         result = analysis.analyse(frames[phase::4], analysis.AnalysisOptions(fps=60.0))
         _holds_truth(result, truth)
-        assert any("does not show the display's refresh" in w or "phase-locked" in w for w in result.warnings), phase
+        assert any("does not show whether the display refreshes" in w or "phase-locked" in w for w in result.warnings), phase
         assert result.ci95_ms[1] - result.ci95_ms[0] > 8.0
 
 
@@ -97,7 +97,7 @@ def test_a_240_fps_camera_exposing_half_of_each_frame_the_settings_unknown(tmp_p
     frames, truth = _run(tmp_path, 240.0, display_hz, exposure=HALF_FRAME, phase=OFF_STEP_PHASE)
     result = analysis.analyse(frames, analysis.AnalysisOptions(fps=240.0))
     _holds_truth(result, truth)
-    assert any(warning.startswith("the camera (240 fps") for warning in result.warnings)
+    assert any("the 240 fps camera" in warning for warning in result.warnings)
 
 
 def _told(fps: float, display_hz: float, exposure: float) -> analysis.AnalysisOptions:
@@ -113,7 +113,7 @@ def test_a_240_fps_camera_exposing_half_of_each_frame_the_settings_given(tmp_pat
     frames, truth = _run(tmp_path, 240.0, display_hz, exposure=HALF_FRAME, phase=OFF_STEP_PHASE)
     result = analysis.analyse(frames, _told(240.0, display_hz, HALF_FRAME))
     _holds_truth(result, truth)
-    assert any(warning.startswith("the camera (240 fps") for warning in result.warnings)
+    assert any("the 240 fps camera" in warning for warning in result.warnings)
     if display_hz == 60.0:
         # Narrower than the +-1.04 ms any phase allows: four phases of each refresh place the refreshes
         # (two phases of a 120 Hz one do not, the sphere's rows unknown, and the interval holds them all).

@@ -95,7 +95,7 @@ def test_a_profile_written_by_rig_plan_gives_the_answer_of_the_options_it_prints
     request = PlanRequest(display_hz=DISPLAY_HZ, camera_fps=(FPS,))
     best = Setting(FPS, 1.0, 4, 0.0, 4.0, 0.2, 0.0, 0.05, 4.0, 0.5)
     canned = Plan(request, (best,), best, {"half_width_ms": 0.5, "error_ms": 0.05}, {"advice": "", "led_roi": [], "sphere_roi": []})
-    monkeypatch.setattr("rig.commands.plan.plan", lambda *arguments: canned)
+    monkeypatch.setattr("rig.service.plan", lambda *arguments: canned)
     profile = tmp_path / "bench.toml"
     assert main(["plan", "--display-hz", "60", "--camera-fps", "240", "--bench", str(profile)]) == 0
     analyse_line = next(line for line in capsys.readouterr().out.splitlines() if line.strip().startswith("rig analyse"))

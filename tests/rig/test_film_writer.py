@@ -13,7 +13,6 @@ import cv2
 import numpy as np
 import pytest
 
-import rig.writers
 from analysis import AnalysisOptions, analyse
 from rig.devices.protocols import CameraFrame
 from rig.errors import RigError
@@ -132,7 +131,7 @@ class DroppingWriter(FailingWriter):
 
 
 def test_a_write_that_fails_raises_and_leaves_a_readable_film_of_the_frames_before_it(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(rig.writers.cv2, "VideoWriter", FailingWriter)
+    monkeypatch.setattr(cv2, "VideoWriter", FailingWriter)
     video = VideoRecord(tmp_path / "film.avi", 240.0, WIDTH, HEIGHT)
     with video:
         for index in range(FailingWriter.room):
@@ -145,7 +144,7 @@ def test_a_write_that_fails_raises_and_leaves_a_readable_film_of_the_frames_befo
 
 
 def test_a_film_missing_frames_when_closed_raises(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(rig.writers.cv2, "VideoWriter", DroppingWriter)
+    monkeypatch.setattr(cv2, "VideoWriter", DroppingWriter)
     video = VideoRecord(tmp_path / "film.avi", 240.0, WIDTH, HEIGHT)
     for index in range(FailingWriter.room + 3):
         video.write(numbered(index))
@@ -154,7 +153,7 @@ def test_a_film_missing_frames_when_closed_raises(tmp_path: Path, monkeypatch: p
 
 
 def test_a_runs_film_that_fails_stops_with_its_table_listing_the_frames_it_holds(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(rig.writers.cv2, "VideoWriter", FailingWriter)
+    monkeypatch.setattr(cv2, "VideoWriter", FailingWriter)
     film = FilmRecord(tmp_path, 240.0, WIDTH, HEIGHT)
     for index in range(FailingWriter.room + 2):
         frame = CameraFrame(index=index, t_start=index / 240.0, exposure_s=1 / 240.0, image=numbered(index))

@@ -19,6 +19,7 @@ import serial
 
 from rig.devices.trackers.clock_mapping import mapping_for
 from rig.devices.trackers.decoders import decoder_for
+from rig.devices.trackers.default_profiles import SERIAL as DEFAULT_PROFILE
 from rig.devices.trackers.profile import load_profile
 from rig.devices.trackers.stream import TrackerStream
 from rig.devices.trackers.transport import Reader, ThreadReader
@@ -31,7 +32,6 @@ except ImportError:
 
 log = logging.getLogger("rig.trackers")
 
-DEFAULT_PROFILE = "csv"
 DEFAULT_BAUD = 115200
 READ_TIMEOUT_S = 0.05
 FD_READER_MISSING = (

@@ -14,7 +14,7 @@ from rig.bench.contract import Context
 from rig.cli import main
 from rig.commands import bench
 from rig.service.sweep import SweepPoint, read_sweep
-from rig.sim.layout import placement
+from rig.sim.placement import placement
 
 
 @pytest.fixture

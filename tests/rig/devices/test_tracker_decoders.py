@@ -14,7 +14,8 @@ from rig.devices.trackers.decoders import decoder_for
 from rig.devices.trackers.profile import load_profile, parse_profile
 from rig.devices.trackers.readings import Readings, keep_possible
 from rig.emulate.encode import Emission, RecordEncoder
-from rig.sim.tracker_faults import ByteFaults, parse_faults
+from rig.sim.fault_plan import parse_faults
+from rig.sim.tracker_faults import ByteFaults
 
 
 def emissions(count: int) -> list[Emission]:

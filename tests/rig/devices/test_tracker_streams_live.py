@@ -13,7 +13,7 @@ from predictors import read_samples, read_trace
 from rig.devices.trackers.clock_mapping import WINDOW_S
 from rig.emulate import EmulatorConfig, quiet_tracker
 from rig.service.tracker_recording import DEVICE_FILE, TRACKER_FILE, record_tracker
-from rig.sim.tracker_faults import parse_faults
+from rig.sim.fault_plan import parse_faults
 
 RATE_HZ = 400.0
 DURATION_S = 1.5

@@ -33,3 +33,25 @@ def test_a_difference_is_called_only_when_its_interval_excludes_zero() -> None:
 def test_rows_without_an_interval_are_left_out() -> None:
     data = rows("a", [10.0], 1.0) + [{"system": "a", "latency_ms": None, "ci95_low_ms": None, "ci95_high_ms": None}]
     assert group_latencies(data, "system")[0].videos == 1
+
+
+def test_only_rows_under_the_same_conditions_are_pooled_and_compared() -> None:
+    def at(period_s: float, system: str, value: float) -> dict:
+        return {"system": system, "period_s": period_s, "latency_ms": value, "ci95_low_ms": value - 0.3, "ci95_high_ms": value + 0.3}
+
+    data = [at(1.0, "a", 1.0), at(1.0, "a", 1.1), at(2.0, "a", 3.0), at(1.0, "b", 5.0), at(2.0, "b", 7.0)]
+    groups = group_latencies(data, "system", ["period_s"])
+    assert [(g.name, g.conditions, g.videos) for g in groups] == [
+        ("a", (("period_s", "1.0"),), 2), ("a", (("period_s", "2.0"),), 1), ("b", (("period_s", "1.0"),), 1), ("b", (("period_s", "2.0"),), 1),
+    ]
+    assert groups[0].latency_ms == pytest.approx(1.05)
+    compared = [(d.a, d.b, d.difference_ms) for d in differences(groups)]
+    assert compared == [("a", "b", pytest.approx(3.95)), ("a", "b", pytest.approx(4.0))]
+
+
+def test_a_group_carries_its_truth_and_error_where_every_row_knows_it() -> None:
+    known = [dict(row, truth_ms=39.0) for row in rows("a", [40.0, 40.0], 1.0)]
+    (group,) = group_latencies(known, "system")
+    assert (group.truth_ms, group.error_ms) == (39.0, pytest.approx(1.0))
+    (unknown,) = group_latencies(known[:1] + rows("a", [40.0], 1.0), "system")
+    assert unknown.truth_ms is None and unknown.error_ms is None

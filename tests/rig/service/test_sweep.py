@@ -14,7 +14,7 @@ from rig.service.sweep import SIMULATED_BENCH, SIMULATED_ROIS, Sweep, build, rea
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
-from rig.sim.impairments import FilmImpairments
+from rig.sim.impairments_config import FilmImpairments
 from rig.sim.pendulum import PendulumConfig
 
 SPEC = """

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from rig.errors import ConfigError
-from rig.sim.display import COMMON_REFRESH_HZ, DisplayConfig, SimDisplay
+from rig.sim.display import DisplayConfig, SimDisplay
+from rig.sim.display_config import COMMON_REFRESH_HZ
 
 
 @pytest.fixture(params=COMMON_REFRESH_HZ, ids=lambda hz: f"{hz:g}Hz")

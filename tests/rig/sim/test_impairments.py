@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from rig.errors import ConfigError
-from rig.sim.impairments import OCCLUDER_FRACTION, FilmImpairments, FrameImpairer
+from rig.sim.impairments import OCCLUDER_FRACTION, FrameImpairer
+from rig.sim.impairments_config import FilmImpairments
 
 HEIGHT, WIDTH = 48, 64
 LED_ROI, SPHERE_ROI = (4, 10, 24, 20), (36, 12, 24, 18)

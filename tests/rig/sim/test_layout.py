@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from rig.errors import ConfigError
-from rig.sim.layout import LAYOUTS, make_layout, placement
+from rig.sim.layout import make_layout
+from rig.sim.placement import LAYOUTS, placement
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import Pendulum, PendulumConfig

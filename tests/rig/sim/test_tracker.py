@@ -10,7 +10,7 @@ from rig.clock import VirtualClock
 from rig.errors import ConfigError, RigError
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import SimTracker, TrackerConfig, measure, simulate_tracker
-from rig.sim.tracker_faults import parse_faults
+from rig.sim.fault_plan import parse_faults
 
 QUIET = dict(position_noise_m=0.0, orientation_noise_deg=0.0, jitter_s=0.0)
 

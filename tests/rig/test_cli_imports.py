@@ -1,0 +1,71 @@
+"""What the command line loads before it runs anything: `rig --help` lists the commands without
+importing any of them, and `rig COMMAND --help` builds that command's parser from light
+declarations alone (the heavy libraries and the analysis load only when the command runs).
+Checked in a fresh interpreter, by what lands in sys.modules."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from rig.cli import COMMANDS, SUMMARIES, build_parser, main
+
+HEAVY = ("numpy", "cv2", "jax", "scipy", "matplotlib", "moderngl", "OpenGL", "pylsl", "serial", "dask")
+"""Libraries whose import alone costs a tenth of a second or more."""
+ANALYSIS_INTERNALS = ("analysis.pipeline", "analysis.estimation", "analysis.tracks", "analysis.blobs")
+
+
+def _loaded(argv: list[str]) -> set[str]:
+    """The modules a fresh interpreter holds after importing rig.cli and building the parser for argv."""
+    code = (
+        "import json, sys\n"
+        "import rig.cli\n"
+        f"rig.cli.build_parser({argv!r})\n"
+        "print(json.dumps(sorted(sys.modules)))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True)
+    return set(json.loads(done.stdout))
+
+
+def _heavy(modules: set[str]) -> list[str]:
+    return sorted(name for name in modules if name.split(".")[0] in HEAVY or name in ANALYSIS_INTERNALS)
+
+
+def test_listing_the_commands_imports_none_of_them() -> None:
+    modules = _loaded([])
+    assert not [name for name in modules if name.startswith("rig.commands")]
+    assert _heavy(modules) == []
+    assert "importlib.metadata" not in modules
+
+
+HEAVY_PARSERS = ("bench",)
+"""Commands whose parser still imports what it runs (each benchmark's module declares its options
+beside its code)."""
+
+
+@pytest.mark.parametrize("command", [name for name in COMMANDS if name not in HEAVY_PARSERS])
+def test_a_commands_parser_loads_no_heavy_library(command: str) -> None:
+    assert _heavy(_loaded([command])) == []
+
+
+def test_every_command_has_a_summary() -> None:
+    assert set(SUMMARIES) == set(COMMANDS)
+    assert all(len(summary) < 120 and "\n" not in summary for summary in SUMMARIES.values())
+
+
+def test_the_listing_shows_each_summary() -> None:
+    listing = " ".join(build_parser([]).format_help().split())
+    for name, summary in SUMMARIES.items():
+        assert f"{name} {summary.split()[0]}" in listing
+
+
+def test_version_is_the_installed_packages(capsys: pytest.CaptureFixture[str]) -> None:
+    from importlib import metadata
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["--version"])
+    assert exit_.value.code == 0
+    assert capsys.readouterr().out == f"rig {metadata.version('latency-rig')}\n"
