@@ -12,7 +12,21 @@ its ``hints`` carry what a lab says of its bench (``Hint``), each checked agains
 (sinefit, bayes) is asked for, and no import changes a JAX setting.
 """
 
+from typing import TYPE_CHECKING
+
 from declared.lazy import lazy_exports
+
+if TYPE_CHECKING:  # the names as documentation tools and type checkers read them
+    from analysis.errors import AnalysisError
+    from analysis.estimation import estimate
+    from analysis.estimators.contract import EstimationContext, Estimator
+    from analysis.estimators.registry import methods, register_estimator, unregister_estimator
+    from analysis.hints import Hint
+    from analysis.options import AnalysisOptions
+    from analysis.pipeline import analyse
+    from analysis.result import LatencyResult, MethodResult
+    from analysis.tracks import Tracks, track
+
 
 __getattr__, __dir__ = lazy_exports(
     __name__,

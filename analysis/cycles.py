@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from analysis.caveat import caveat
-from analysis.options import DEFAULT_LATENCY_RANGE_S
+from analysis.latency_range import DEFAULT_LATENCY_RANGE_S
 from analysis.windows import WindowPhases
 
 DECISIVE_CHI2 = 25.0

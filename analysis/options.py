@@ -11,6 +11,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from analysis.errors import AnalysisError
+from analysis.latency_range import DEFAULT_LATENCY_RANGE_S
 from analysis.estimators.registry import ALL, DEFAULT_METHOD, methods
 from analysis.hints.hint import APPLIED, CHECKED, IDENTITY, Hint, HintedFacts, in_words
 from declared import Flag, Range, check, setting, setting_of
@@ -20,9 +21,6 @@ from declared.settings import whole_numbers
 ROI = tuple[int, int, int, int]
 SIDES = ("left", "right")
 """Where the LED's blob may be: the left or the right one of the two."""
-DEFAULT_LATENCY_RANGE_S = (-0.2, 0.6)
-"""The latencies considered unless asked otherwise (s): from a prediction 200 ms ahead of the motion to
-600 ms behind it."""
 CAMERA_RATES = Range(1.0, 10000.0, True, True)
 """Frames per second a camera films at: a webcam's tens to a high-speed camera's several thousand."""
 DISPLAY_RATES = Range(1.0, 1000.0, True, True)

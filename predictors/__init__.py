@@ -19,7 +19,18 @@ filters (`predictors.jax_filters`) import JAX, so they are imported only by name
 the real-time path stays free of it.
 """
 
+from typing import TYPE_CHECKING
+
 from declared.lazy import lazy_exports
+
+if TYPE_CHECKING:  # the names as documentation tools and type checkers read them
+    from predictors.errors import PredictorError
+    from predictors.evaluation import Evaluation, HorizonScore, evaluate
+    from predictors.params_file import read_params, write_params
+    from predictors.pose import Pose, PoseSample
+    from predictors.registry import DEFAULT, Predictor, make, names, resolve
+    from predictors.trace import SAMPLE_COLUMNS, Trace, read_samples, read_trace, sample_row, write_trace
+
 
 __getattr__, __dir__ = lazy_exports(
     __name__,
