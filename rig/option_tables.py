@@ -7,10 +7,10 @@ from __future__ import annotations
 from analysis import AnalysisOptions
 from analysis.shutter import ShutterOptions
 from declared.docs import markdown_table
-from rig.bench.batch import BatchBenchOptions
-from rig.bench.predictors import PredictorBenchOptions
-from rig.bench.renderers import BenchGrid
-from rig.bench.trackers import TrackerBenchOptions
+from rig.bench.batch_settings import BatchBenchOptions
+from rig.bench.predictors_settings import PredictorBenchOptions
+from rig.bench.renderer_specs import BenchGrid
+from rig.bench.trackers_settings import TrackerBenchOptions
 from rig.board.settings import BoardSettings
 from rig.commands.board import BlinkOptions, SyncOptions
 from rig.commands.devices import Listing

@@ -1,13 +1,14 @@
 """Benchmarks behind `rig bench`: speed against error, one module per bench (`rig.bench.contract`).
 
-SUBJECTS registers them: per subject, the module of its bench, then those of its modes."""
+SUBJECTS registers them: per subject, the light module that declares its command (`SUBJECT`, and
+`MODES` where it has modes); each bench's own module is imported only when it runs."""
 
 SUBJECTS = (
-    ("analyser",),
-    ("predictors",),
-    ("renderers", "seed_table", "warp_variants", "photon_residual"),
-    ("trackers",),
-    ("batch",),
-    ("live",),
-    ("camera_calibration",),
+    "analyser_settings",
+    "predictors_settings",
+    "renderers_settings",
+    "trackers_settings",
+    "batch_settings",
+    "live_settings",
+    "camera_calibration_settings",
 )

@@ -1,12 +1,4 @@
-"""`rig bench analyser`: simulate videos of known latency over two grids, analyse each with every
-method, and report per method the median and worst error, the coverage of the 95 % intervals, the
-confidently wrong answers (truth outside the interval by more than max(0.5 ms, its half-width)),
-the refusals and the speed against decoding alone. The mixed grid spans periods, frame rates,
-refresh rates, swings, damping and impairments; the hard grid, what goes wrong in a lab: camera
-rates that lock to the display's, short exposures, a dim LED or sphere, swapped sides, a second
-bright object, a partly hidden blob, decimated films. Both take about forty minutes on two cores;
---quick runs three tiny cases. The cases are a sweep: `rig sweep` on its spec gives the same
-summary rows.
+"""`rig bench analyser` (its command line declared in `rig.bench.analyser_settings`): what it measures.
 
 The bench is a sweep (`rig.service.sweep`) with a fixed spec, `specs/analyser.toml` (three tiny
 cases in `specs/analyser-quick.toml`), its points written out one by one; the impairments are the
@@ -32,7 +24,6 @@ machine touches the ratio less.
 
 from __future__ import annotations
 
-import argparse
 import time
 from dataclasses import replace
 from functools import partial
@@ -45,14 +36,11 @@ import analysis
 from analysis import AnalysisOptions
 from analysis.sampling.model import commensurate
 from analysis.video.sources import open_frames
-from rig.bench.contract import Bench, Context, Log, SpecFile, cell
+from rig.bench.analyser_settings import GROUPS
+from rig.bench.contract import Bench, Context, Log, cell
 from rig.service.batch import USER_ERRORS
 from rig.service.sweep import Sweep, SweepPoint, read_sweep, run_sweep, simulate_and_analyse, unsimulated_row
 from rig.sim.config import SimulationConfig
-
-SPECS = Path(__file__).parent / "specs"
-SPEC = SPECS / "analyser.toml"
-QUICK_SPEC = SPECS / "analyser-quick.toml"
 
 TARGETS = {
     "median_frames": 0.1,
@@ -63,7 +51,6 @@ TARGETS = {
     "unlocked_median_ms": 0.05,
 }
 WRONG_MS = 0.5
-GROUPS = {"all": ("mixed", "named", "hard"), "mixed": ("mixed", "named"), "hard": ("hard",)}
 
 
 def decode_seconds(video: Path) -> tuple[float, int]:
@@ -348,24 +335,11 @@ def tables(report: dict[str, Any]) -> str:
     return "\n".join(f"{group} ({summary['sinefit']['cases']} cases):\n{table(summary)}" for group, summary in report["summaries"].items())
 
 
-def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--grid", choices=tuple(GROUPS), default="all", help="which grid to run, by the points' group (default: %(default)s)")
-
-
 BENCH = Bench(
-    name="analyser",
-    help="error, interval coverage, confidently wrong answers and speed of each latency estimator on simulated videos",
-    spec=lambda args: of_groups(args.spec, args.grid),
+    spec=lambda args: of_groups(args.spec, args.grid), read_spec=read_sweep,
     run=run, table=tables,
     targets=lambda report: report["targets_met"],
     all_failed=lambda report: every_case_refused(report["cases"]),
     notes=lambda report: f"{len(report['cases'])} cases in {report['seconds'] / 60:.1f} minutes",
     plot=lambda report, path: plot(report["summary"], report["cases"], path),
-    options=_options,
-    outputs={"json": "write the summaries, every case and the sweep's rows as JSON", "plot": "plot speed against error per method"},
-    spec_file=SpecFile(read_sweep, SPEC, QUICK_SPEC,
-                       help="the cases, as a sweep whose points are labelled case, group (mixed, named or hard) and impairment "
-                       "(default: the bench's own)", quick_help=f"three short cases (a smoke test; {QUICK_SPEC.name})"),
-    runs="keep the simulated videos and the sweep's summary.csv here (default: a temporary folder)",
-    executor="the grid",
 )  # fmt: skip

@@ -1,4 +1,4 @@
-"""The batch bench (`rig bench batch`): what many measurements cost, serially and on Dask.
+"""`rig bench batch` (its command line declared in `rig.bench.batch_settings`): what it measures.
 
 * **Scale-out**: `rig analyse` of a batch of simulated videos in a fresh process, serially, then
   on a local Dask cluster of two worker processes (the cluster's start included), alternately a
@@ -18,20 +18,19 @@ one run.
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from declared import Flag, Range, check, like, setting
+from rig.bench.batch_settings import BatchBenchOptions
 from rig.bench.contract import Bench, Context, Log
-from rig.commands.declared_options import add_declared_options, config_from_args
+from rig.commands.declared_options import config_from_args
 from rig.errors import ConfigError
 from rig.executor import worker_environment
 from rig.service.simulate import simulate
@@ -51,45 +50,6 @@ def _process_seconds(arguments: list[str], environment: dict[str, str], allowed:
     return time.perf_counter() - started
 
 
-SIMULATING_S_PER_FILM_S = 0.25
-"""Seconds simulating a second of film takes: a generous rate (this machine takes about 0.75)."""
-ANALYSING_S_PER_FILM_S = 0.05
-"""Seconds analysing a second of film takes: a generous rate."""
-MAX_HOURS = 24.0
-"""The longest batch bench it starts: longer is a mistake in the options."""
-
-
-@dataclass(frozen=True)
-class BatchBenchOptions:
-    """The batch bench's options, each declared on its field; a bench that could not finish in
-    MAX_HOURS at generous rates is refused with its estimate."""
-
-    videos: int = setting(24, "videos", "videos in the batch (a lab's day of films is tens to hundreds)", Range(1.0, 1000.0, True, True),
-                          flag="--videos")  # fmt: skip
-    duration_s: float = like(SimulationConfig, "duration_s", default=6.0, help="seconds per batch video", flag=Flag("--duration"))
-    clip_duration_s: float = like(SimulationConfig, "duration_s", default=20.0, help="seconds of the fixed-cost clip",
-                                  flag=Flag("--clip-duration"))  # fmt: skip
-    workers: int = setting(2, "processes", "Dask worker processes", Range(1.0, 256.0, True, True), flag="--workers")
-    rounds: int = setting(3, "", "times the batch runs serially and on Dask, alternately", Range(1.0, 100.0, True, True),
-                          flag="--rounds")  # fmt: skip
-
-    def __post_init__(self) -> None:
-        check(self, ConfigError)
-        hours = self.estimated_hours()
-        if hours > MAX_HOURS:
-            raise ConfigError(
-                f"this bench would take about {hours:.3g} hours ({self.videos} videos of {self.duration_s:g} s, each "
-                f"analysed {3 * self.rounds} times), more than the {MAX_HOURS:g} hours the rig starts: fewer videos, "
-                "shorter ones or fewer rounds"
-            )
-
-    def estimated_hours(self) -> float:
-        """Hours at the generous rates above: every film simulated once, each batch video analysed
-        three times a round (serially, serially as a worker, on Dask), the clip three times."""
-        batch_s = self.videos * self.duration_s
-        simulating = (batch_s + self.clip_duration_s) * SIMULATING_S_PER_FILM_S
-        analysing = (3 * self.rounds * batch_s + 3 * self.clip_duration_s) * ANALYSING_S_PER_FILM_S
-        return (simulating + analysing) / 3600.0
 
 
 def videos(folder: Path, count: int, duration_s: float, log: Log) -> list[Path]:
@@ -208,14 +168,4 @@ def plot(report: dict[str, Any], path: Path) -> None:
     figure.savefig(path, dpi=100)
 
 
-def _options(parser: argparse.ArgumentParser) -> None:
-    add_declared_options(parser, BatchBenchOptions)
-
-
-BENCH = Bench(
-    name="batch",
-    help="what many measurements cost: a batch serially and on Dask, and the fixed cost per video",
-    run=run, table=table, plot=plot, options=_options,
-    spec=lambda args: config_from_args(BatchBenchOptions, args, ConfigError),
-    outputs={"json": "write the figures as JSON", "plot": "draw the wall times"},
-)
+BENCH = Bench(run=run, table=table, plot=plot, spec=lambda args: config_from_args(BatchBenchOptions, args, ConfigError))

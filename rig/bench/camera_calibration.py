@@ -1,10 +1,4 @@
-"""How well `rig calibrate-camera` measures a camera's readout and exposure: a grid of simulated
-films whose camera the simulation knows (30, 60, 120 and 240 fps; readouts of 0, a global shutter,
-to 95 % of the frame interval; exposures of an eighth to a whole frame interval; a light flashing
-at 50 % and at 25 %, and a display flashing full-field), each measured as the command does, with
-the readout's and the exposure's error, the refusals, how many are within 5 % and 10 % and how
-many 95 % intervals hold the truth, and the seconds per film (5 to 8 minutes on two shared cores;
---quick films four small cases).
+"""`rig bench camera-calibration` (its command line declared in `rig.bench.camera_calibration_settings`): what it measures.
 
 Each case films a calibration target (`rig.sim.flash`) with the simulated camera: a light flashing
 at 50 % (or 25 %) at the frequency `analysis.shutter.suggest_flash_hz` gives for the camera, or the
@@ -241,17 +235,9 @@ def every_film_refused(found: list[dict[str, Any]]) -> str | None:
     return f"the estimate refused every one of the {len(found)} films (the first: {found[0]['refused']})"
 
 
-def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--quick", action="store_true", help="four small films (a smoke test)")
-
-
 BENCH = Bench(
-    name="camera-calibration",
-    help="rig calibrate-camera's readout and exposure error on simulated films, 30 to 240 fps",
-    run=run, table=table, plot=plot, options=_options,
+    run=run, table=table, plot=plot,
     targets=lambda report: targets_met(report["rows"]), all_failed=lambda report: every_film_refused(report["rows"]),
     notes=lambda report: f"{len(report['rows'])} films in {report['seconds'] / 60:.1f} minutes",
     record=lambda report: {"summary": summary(report["rows"]), "targets_met": targets_met(report["rows"]), **report},
-    outputs={"json": "write the summaries and every film's row as JSON", "plot": "plot seconds per film against each error"},
-    runs="keep the simulated films here (default: a temporary folder)",
 )

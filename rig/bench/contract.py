@@ -1,13 +1,15 @@
 """The bench contract: what a benchmark declares, and what `rig bench` does with every one alike.
 
-A bench is one module holding a `Bench`, registered in `rig.bench.SUBJECTS`: the subject `rig
-bench` names it by, its help (the module docstring's first paragraph is its description) and
-options, its spec (a grid written as TOML, read by its `SpecFile`, with the options over it; or its
-options alone), what it measures (`run(spec, context) -> rows`), and how its rows become the
-printed table, the targets met, notes on what the figures carry, the JSON record, a plot and CSV.
-The runner (`rig.commands.bench`) does the rest: the command line, the folder the runs go in
-(`--runs`, or a temporary one), the run, the outputs asked for (`rig.commands.outputs.LateWrites`:
-a failed write loses neither the others nor the table), the printing and the exit status.
+A bench is declared twice over, so that `rig bench --help` loads nothing a bench runs on. Its
+`Command`, in a light module registered in `rig.bench.SUBJECTS`, is what the command line shows:
+the subject `rig bench` names it by, its help and description, options, outputs and spec file (a
+grid written as TOML, or its options alone). Its `Bench`, in the module the command loads only
+when the bench runs, is what it does: read its spec file, make its spec (the options over it),
+measure (`run(spec, context) -> rows`), and turn its rows into the printed table, the targets met,
+notes on what the figures carry, the JSON record, a plot and CSV. The runner (`rig.commands.bench`)
+does the rest: the command line, the folder the runs go in (`--runs`, or a temporary one), the
+run, the outputs asked for (`rig.commands.outputs.LateWrites`: a failed write loses neither the
+others nor the table), the printing and the exit status.
 
 A subject may have modes (`rig bench renderers --seed-table`): benches in modules of their own,
 each chosen by a flag of its name, whose options join the subject's command line and which use
@@ -17,6 +19,7 @@ the subject's spec file, folder and outputs.
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,11 +49,9 @@ class Context:
 
 @dataclass(frozen=True)
 class SpecFile:
-    """A spec written as TOML: the bench's own file, the small one --quick runs, the help of --spec
-    and --quick, and the one function that reads any of them (a user's copy too), checking every key."""
+    """A spec written as TOML: the bench's own file, the small one --quick runs, and the help of
+    --spec and --quick (its `Bench.read_spec` reads any of them, a user's copy too)."""
 
-    read: Callable[[Path | None], Any]
-    """reads a spec file, or (given None) makes the spec of the defaults"""
     default: Path | None
     """the bench's own file; None: its spec's declared defaults"""
     quick: Path
@@ -60,18 +61,17 @@ class SpecFile:
 
 @dataclass(frozen=True)
 class Bench:
-    """One benchmark (see the module docstring). The fields from `outputs` on are its command
-    line's (its description is its module docstring's first paragraph); a mode leaves them out and
-    has its subject's."""
+    """What one benchmark does (see the module docstring); its `Command` is what the command line
+    shows of it."""
 
-    name: str
-    """the subject (`rig bench NAME`), or a mode's flag (`--NAME`)"""
-    help: str
     run: Callable[[Any, Context], Any]
     table: Callable[[Any], str]
     """the rows as the text printed"""
     spec: Callable[[argparse.Namespace], Any] = lambda options: options
     """the parsed options (`spec` among them the spec read, where there is a SpecFile) -> the spec"""
+    read_spec: Callable[[Path | None], Any] | None = None
+    """reads a spec file checking every key, or (given None) makes the spec of the defaults; None:
+    the bench has no SpecFile"""
     record: Callable[[Any], Any] = lambda rows: rows
     """the rows as JSON-ready values (a list of flat dicts where the bench writes CSV)"""
     plot: Callable[[Any, Path], None] | None = None
@@ -82,8 +82,26 @@ class Bench:
     all_failed: Callable[[Any], str | None] | None = None
     """a sentence where every item the bench measured failed (its figures are of nothing), else
     None: `rig bench` then exits with status 2 once it has written and printed what it has"""
+
+
+def bench_in(module: str) -> Callable[[], Bench]:
+    """The loader of the `BENCH` of `rig.bench.MODULE`: the module is imported when the bench runs."""
+    return lambda: importlib.import_module(f"rig.bench.{module}").BENCH
+
+
+@dataclass(frozen=True)
+class Command:
+    """What the command line shows of one benchmark, declared without importing what it runs. The
+    fields from `description` on are a subject's; a mode leaves them out and has its subject's."""
+
+    name: str
+    """the subject (`rig bench NAME`), or a mode's flag (`--NAME`)"""
+    help: str
+    bench: Callable[[], Bench]
+    """loads the bench (`bench_in`)"""
     options: Callable[[argparse.ArgumentParser], object] = lambda parser: None
     """adds the bench's own options (a mode's join its subject's)"""
+    description: str = ""
     outputs: dict[str, str] = field(default_factory=dict)
     """the help of each output it writes, by kind: json, plot, csv"""
     spec_file: SpecFile | None = None

@@ -24,7 +24,8 @@ from predictors.registry import params_of
 from predictors.corpus import GROUPINGS, Recording, read_corpus
 from predictors.cross_validation import REPORTED, CorpusScores, Fold, cross_validate, groups_of, held_out_mean
 from rig.bench.contract import Context
-from rig.bench.predictor_scores import BASELINE, evaluate_all, finite_or_none, label
+from rig.bench.predictor_scores import evaluate_all, finite_or_none, label
+from rig.bench.predictors_settings import BASELINE
 from rig.service.tune import check_scorable, in_time_order
 
 COST_REFERENCE = "kalman-cv"

@@ -1,7 +1,4 @@
-"""`rig bench live`: what the live loop itself adds, measured in one run: the rig runs live on an
-emulated LSL tracker with a window paced at 60 Hz (under xvfb-run or a desktop), and the bench
-reports the time from a sample's arrival to the pose the renderer gets, and from each buffer swap
-to its logged row.
+"""`rig bench live` (its command line declared in `rig.bench.live_settings`): what it measures.
 
 1. **Sample arrival to pose**: the rig runs live (`rig.live.run`) for a while on an emulated LSL
    tracker at 1 kHz (`rig.live.selftest.emulator`) with the direct renderer in a window paced by a
@@ -30,7 +27,6 @@ import numpy as np
 
 from rig.bench.contract import Bench, Context
 from rig.clock import MonotonicClock
-from rig.commands import options
 from rig.devices.window import SWAP_COLUMNS, SwapRecord, WindowDisplay, WindowSettings
 from rig.live.run import LiveConfig, run_live
 from rig.live.selftest.emulator import EmulatedPendulum
@@ -143,16 +139,8 @@ def plot(report: dict[str, Any], path: Path) -> None:
     figure.savefig(path, dpi=120)
 
 
-def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--duration", type=options.run_seconds, default=10.0, help="seconds of live run (default: %(default)s)")
-
-
 BENCH = Bench(
-    name="live",
-    help="the live loop's overhead: sample arrival to the pose the renderer gets, swap to log (needs an X display)",
     run=run, table=table,
     notes=lambda report: f"machine noise: {report['cpus']} CPUs, 1-minute load average {report['load_average_1min']:.2f}",
-    plot=plot, options=_options,
-    outputs={"json": "write the figures as JSON", "plot": "plot the figures"},
-    runs="keep the run's files here (default: a temporary folder)",
+    plot=plot,
 )

@@ -11,7 +11,6 @@ whose photon-target latency lies nearest zero.
 
 from __future__ import annotations
 
-import argparse
 import time
 from dataclasses import dataclass, replace
 from typing import Any
@@ -19,7 +18,8 @@ from typing import Any
 from rig.bench.contract import Bench, Context, cell
 from rig.bench.renderer_latency import film_latency
 from rig.bench.renderer_setup import machine_name
-from rig.bench.renderers import BenchGrid, plain, with_options
+from rig.bench.renderer_specs import BenchGrid
+from rig.bench.renderers import plain, with_options
 from rig.session import DEFAULT_SERVER_MS, PHOTON_TARGETS
 
 RESIDUAL_PREDICTORS = ("adaptive", "kalman-ca", "kalman-cv", "desp", "slerp", "hold")
@@ -75,14 +75,7 @@ def residual_text(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--residual-predictor", action="append", metavar="NAME",
-                        help="a predictor for --photon-residual; repeat for several (default: adaptive, kalman-ca, kalman-cv, desp, slerp, hold)")  # fmt: skip
-
-
 BENCH = Bench(
-    name="photon-residual",
-    help="latency left by each predictor aimed at the photons and at scan-out",
     spec=lambda args: ResidualSpec(with_options(args.spec, args), tuple(args.residual_predictor or RESIDUAL_PREDICTORS)),
-    run=run, table=residual_text, record=plain, options=_options,
+    run=run, table=residual_text, record=plain,
 )

@@ -9,8 +9,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
 from predictors import Evaluation, Trace, evaluate
-
-BASELINE = "slerp"
+from rig.bench.predictors_settings import BASELINE
 
 
 def label(name: str, params: dict[str, Any]) -> str:

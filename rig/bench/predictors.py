@@ -1,6 +1,4 @@
-"""The predictor bench (`rig bench predictors`): every predictor on every trace, its error against
-constant velocity and against its cost. With no --trace or --stress, it runs the simulated
-pendulum, the synthetic head and the two recordings in data/traces.
+"""`rig bench predictors` (its command line declared in `rig.bench.predictors_settings`): what it measures.
 
 Default traces:
 
@@ -34,7 +32,7 @@ import argparse
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -42,22 +40,18 @@ import predictors
 from predictors import Evaluation, Trace, read_trace
 from predictors.stress import stress_streams
 from predictors.synthetic import head_motion
-from declared import Flag, Range, setting
 from rig.bench import corpus_bench
 from rig.bench.contract import Bench, Context
 from rig.bench.corpus_bench import CorpusRun
-from rig.bench.predictor_scores import BASELINE, HeldOut, Ratios, cost_ratios, evaluate_all, label, leave_one_out, ratios
-from rig.commands import choices, options
-from rig.commands.declared_options import add_declared_options
+from rig.bench.predictors_settings import BASELINE
+from rig.bench.predictor_scores import HeldOut, Ratios, cost_ratios, evaluate_all, label, leave_one_out, ratios
 from rig.errors import ConfigError
 from rig.service.tune import check_scorable, in_time_order
-from rig.tune_settings import HORIZONS
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import TrackerConfig, simulate_tracker
 
 TRACES = Path(__file__).resolve().parents[2] / "data" / "traces"
 RECORDINGS = (TRACES / "hmd_orientation_user1.csv", TRACES / "quest_pro_robot_traj2.csv")
-DEFAULT_HORIZONS_MS = (0.0, 10.0, 20.0, 50.0, 100.0)
 _TRUTH_RATE_HZ = 1000.0
 
 
@@ -224,67 +218,8 @@ def record(scores: Scores | CorpusRun) -> dict[str, Any]:
     }
 
 
-@dataclass(frozen=True)
-class PredictorBenchOptions:
-    """The predictor bench's numeric options, each declared on its field (the command line's are
-    made from them and checked against their ranges as they are read)."""
-
-    horizons_ms: tuple[float, ...] = setting(
-        DEFAULT_HORIZONS_MS, "ms", "prediction horizons after each sample's arrival", HORIZONS,
-        flag=Flag("--horizons-ms", metavar="H,H,..."),
-    )  # fmt: skip
-    plot_horizon_ms: float = setting(50.0, "ms", "the horizon the plot shows and --leave-one-out tunes for", HORIZONS,
-                                     flag="--plot-horizon-ms")  # fmt: skip
-    tune_iterations: int = setting(40, "", "optimiser iterations per --leave-one-out fit", Range(0.0, 10000.0, True, True),
-                                   flag="--tune-iterations")  # fmt: skip
-    duration_s: float = setting(
-        30.0, "seconds", "simulated pendulum, synthetic head and stress streams, each (a minute of motion scores a "
-        "predictor; ten minutes is the most the bench simulates)", Range(1.0, 600.0, True, True), flag="--duration",
-    )  # fmt: skip
-    seed: int = setting(0, "", "seed of the simulated traces", Range(0.0, 1e9, True, True), flag="--seed")
-    timing_repeats: int = setting(3, "", "timed replays per predictor and trace; the best counts", Range(0.0, 100.0, True, True),
-                                  flag="--timing-repeats")  # fmt: skip
-
-
-def _tunable(name: str) -> str:
-    from predictors.tuning import TUNABLE  # imports JAX: only when the option is given
-
-    if name not in TUNABLE:
-        raise argparse.ArgumentTypeError(f"cannot tune {name!r}; tunable predictors: {', '.join(TUNABLE)}")
-    return name
-
-
-def _options(parser: argparse.ArgumentParser) -> None:
-    parser.epilog = choices.predictors_listing()
-    parser.add_argument("--trace", type=Path, action="append", metavar="FILE",
-                        help="trace CSV (t_sensor,t_arrival,px,py,pz,qw,qx,qy,qz, or t instead of t_sensor); repeat "
-                        "for several (default: the built-in four)")  # fmt: skip
-    parser.add_argument("--repair", action="store_true",
-                        help="sort a --trace that is out of time order and drop repeated times, instead of refusing it")  # fmt: skip
-    parser.add_argument("--stress", action="store_true",
-                        help="run the synthetic stress streams (30-1000 Hz, noise, jitter, repeats, sudden stops) too")  # fmt: skip
-    parser.add_argument("--predictor", type=options.predictor_spec, action="append", metavar="NAME[:key=value,...]",
-                        help="predictor (listed below) and parameters, or NAME:FILE.json; repeat for several (default: every "
-                        f"predictor); {BASELINE}, the baseline, is always run")  # fmt: skip
-    parser.add_argument("--corpus", type=Path, metavar="DIR",
-                        help="score on a corpus of recordings instead, by recording and by device, person and scene "
-                        "(labels from the file names or DIR/manifest.csv; see docs/predictor-validation.md)")  # fmt: skip
-    parser.add_argument("--manifest", type=Path, metavar="FILE",
-                        help="with --corpus: the recordings' labels (CSV file,device,person,scene,apart) instead of DIR/manifest.csv")  # fmt: skip
-    parser.add_argument("--cross-validate", action="store_true",
-                        help="with --corpus: choose among the predictors on all groups but one and score the choice on "
-                        "that one, for every person, scene and device")  # fmt: skip
-    parser.add_argument("--leave-one-out", type=_tunable, action="append", metavar="NAME",
-                        help="tune NAME on all traces but one and score it on that one, for each trace; repeat for several")  # fmt: skip
-    add_declared_options(parser, PredictorBenchOptions)
-
-
 BENCH = Bench(
-    name="predictors",
-    help="score every predictor on traces: error against constant velocity at several horizons, and cost per update",
     run=run, table=text, record=record,
     plot=lambda scores, path: (corpus_bench.plot(scores, path) if isinstance(scores, CorpusRun)
                                else plot(scores.results, scores.plot_horizon_ms, path)),
-    options=_options,
-    outputs={"json": "write every score, ratio and held-out result as JSON", "plot": "draw speed against error"},
 )

@@ -1,12 +1,4 @@
-"""`rig bench renderers`: time the direct renderer and the warp renderer's client and server for
-load sizes and display resolutions, measure the image error of warped frames against direct
-renders, and the latency `rig analyse` finds in simulated videos whose clock every frame's measured
-cost drives (--server-ms models the warp server instead, labelled). --seed-table sets this
-machine's latencies beside Smit et al.'s (2010, Table 2); --variants plots image error against latency saved
-for each warp variant; --photon-residual films each predictor aimed at the photons and at
-scan-out. The grid is a spec file, the grid's options override it; its latency films are written
-beside the runs as films.toml, which `rig sweep` films again. The default grid takes several
-minutes, --seed-table up to an hour; --quick runs a tiny one of each.
+"""`rig bench renderers` (its command line declared in `rig.bench.renderers_settings`): what it measures.
 
 For each display resolution and load of N triangles:
 
@@ -43,32 +35,22 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from dataclasses import dataclass, replace
-from pathlib import Path
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from declared import Range, check, like, setting
 from predictors import Pose
 from rig.bench import renderer_plots
-from rig.bench.contract import Bench, Context, SpecFile, cell, given
-from rig.bench.renderer_estimate import estimated_hours
-from rig.bench.renderer_latency import LatencyRun, film_latencies
+from rig.bench.contract import Bench, Context, cell, given
+from rig.bench.renderer_latency import film_latencies
 from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup
-from rig.bench.spec_reader import read_spec
+from rig.bench.renderer_specs import BenchGrid, read_grid
 from rig.commands import options
-from rig.commands.declared_options import declared_type
-from rig.errors import ConfigError
 from rig.render.direct import DirectRenderer
-from rig.render.gl import LOAD_SHAPES
 from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, RenderSetup
-from rig.sim.camera import CameraConfig
-from rig.sim.config import MAX_HOURS
-from rig.sim.display import DisplayConfig
 
-QUICK_SPEC = Path(__file__).parent / "specs" / "renderers-quick.toml"
 
 ROW_FIELDS = (
     "renderer", "spec", "reconstruction", "views", "triangles", "width", "height", "rate_ratio",
@@ -82,83 +64,6 @@ LATENCY_FIELDS = (
     "frame_delay_sd_ms", "missed_pct", "latency_period_s", "latency_note",
 )  # fmt: skip
 """The fields a latency run fills in a row."""
-
-
-TRIANGLES = Range(0.0, 1e8, True, True)
-"""A load's triangles: a heavy VR scene draws a few million a frame, 100 million is past any GPU's budget."""
-
-
-@dataclass(frozen=True)
-class BenchGrid:
-    """What `rig bench renderers` measures, and how much of it: each setting declared on its field
-    (the defaults are the bench's grid); a spec file (`--spec FILE.toml`, `specs/renderers-quick.toml`)
-    sets any of them, every key and value checked (`read_grid`)."""
-
-    triangles: tuple[int, ...] = setting(
-        (10_000, 100_000, 1_000_000, 5_000_000), "triangles",
-        "load sizes (a soup of small random triangles), each timed at every resolution", TRIANGLES,
-    )  # fmt: skip
-    resolutions: tuple[tuple[int, int], ...] = setting(
-        ((320, 240), (640, 480), (1280, 720)), "pixels", "display sizes, [width, height]; the first is the latency films' display too"
-    )
-    ratios: tuple[int, ...] = setting(
-        (1, 5, 10), "", "client:display rate ratios 1:r whose image error is measured (display frames per client frame)",
-        Range(1.0, 100.0, True, True),
-    )  # fmt: skip
-    warp: str = setting("warp", "", "the warp renderer and its options, a renderer spec such as warp:recon=grid,views=2")
-    phases: int = setting(4, "", "client poses per load and resolution for the image error, spread over a swing",
-                          Range(1.0, 1000.0, True, True))  # fmt: skip
-    warp_rounds: int = setting(
-        16, "", "rounds of warp timing; each round times one display frame of every load in turn", Range(1.0, 10000.0, True, True)
-    )
-    direct_frames: int = setting(4, "", "direct frames timed at most (the first is always timed)", Range(1.0, 10000.0, True, True))
-    direct_budget_s: float = setting(6.0, "seconds", "no more direct frames are timed after this long", Range(0.0, 3600.0, includes_high=True))
-    latency_triangles: tuple[int, ...] | None = setting(
-        None, "triangles", "the load sizes whose latency is filmed", TRIANGLES, unset="all of them"
-    )
-    latency_camera: CameraConfig = CameraConfig()
-    """the latency films' camera; its frame rate follows the pendulum's period"""
-    latency_duration_s: float = setting(6.0, "seconds", "the latency films' shortest length", Range(0.5, 3600.0, True, True))
-    max_period_s: float = setting(
-        8.0, "seconds", "the longest pendulum period filmed: a latency that would need a longer one is beyond range",
-        Range(0.2, 20.0, True, True),
-    )
-    refresh_hz: float = like(DisplayConfig, "refresh_hz", flag=None)
-    server_ms: float | None = setting(
-        None, "ms", "the warp server's modelled cost in the latency films", Range(0.0, 1000.0, includes_high=True), unset="measured here, as every other cost"
-    )
-    predictor: str = setting("hold", "", "the latency films' predictor, both renderers alike (as in Smit et al. 2010, Table 2)")
-    direct_predictor: str | None = setting(
-        None, "", "the direct renderer's predictor in the latency films, where it differs", unset="the same"
-    )
-
-    def __post_init__(self) -> None:
-        check(self, ConfigError)
-        if not (self.triangles and self.resolutions and self.ratios):
-            raise ConfigError("a renderer bench grid needs at least one load size, resolution and rate ratio")
-        if min(min(size) for size in self.resolutions) < 16:
-            raise ConfigError(f"a display is at least 16x16 pixels, got {self.resolutions}")
-        if (hours := estimated_hours(self)) > MAX_HOURS:
-            raise ConfigError(f"this grid would take about {hours:.3g} hours at the least, more than the {MAX_HOURS:g} hours the rig "
-                              "starts: fewer or smaller loads, resolutions, phases or warp rounds, or split it into grids of its own")  # fmt: skip
-
-    def latency_run(
-        self, renderer: str, triangles: int, predictor: str, photon_target: str = "photons", load: str = "soup"
-    ) -> LatencyRun:
-        """The filmed run of `renderer` on `triangles` (shaped as `load` says) at the first
-        resolution, costs measured (the server's modelled if `server_ms` says)."""
-        return LatencyRun(
-            renderer, triangles, self.resolutions[0], predictor, server_ms=self.server_ms, photon_target=photon_target,
-            refresh_hz=self.refresh_hz, camera=self.latency_camera, min_duration_s=self.latency_duration_s,
-            max_period_s=self.max_period_s, load=load,
-        )  # fmt: skip
-
-
-def read_grid(path: Path | None) -> BenchGrid:
-    """The grid a TOML spec sets (`rig.bench.spec_reader`: every key and value checked), the
-    defaults where it is silent; with no spec, the defaults."""
-    return read_spec(BenchGrid, path) if path is not None else BenchGrid()
-
 
 
 def _percentile_ms(values: list[float], q: float) -> float | None:
@@ -339,50 +244,7 @@ def with_options(grid: BenchGrid, args: argparse.Namespace) -> BenchGrid:
     return replace(grid, **given(args, *GRID_OPTIONS))
 
 
-def _int_list(text: str) -> tuple[int, ...]:
-    return tuple(options.non_negative_int(part) for part in text.split(","))
-
-
-def _ratio_list(text: str) -> tuple[int, ...]:
-    values = _int_list(text)
-    if min(values) < 1:
-        raise argparse.ArgumentTypeError(f"rate ratios are display frames per client frame, at least 1, got {text!r}")
-    return values
-
-
-def _resolution(text: str) -> tuple[int, int]:
-    w, sep, h = text.lower().partition("x")
-    try:
-        size = (int(w), int(h))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, got {text!r}") from None
-    if not sep or min(size) < 16:
-        raise argparse.ArgumentTypeError(f"a resolution is WIDTHxHEIGHT, each at least 16, got {text!r}")
-    return size
-
-
-def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--triangles", type=_int_list, metavar="N,N,...", help="load sizes (default 10000,100000,1000000,5000000; --variants 10000,200000)")
-    parser.add_argument("--resolutions", type=lambda text: tuple(map(_resolution, text.split(","))), metavar="WxH,...",
-                        help="display sizes; the first is the latency runs' (default 320x240,640x480,1280x720)")  # fmt: skip
-    parser.add_argument("--ratios", type=_ratio_list, metavar="R,R,...", help="display frames per client frame (default 1,5,10)")
-    parser.add_argument("--warp", metavar="SPEC", help="the warp renderer and its options, e.g. warp:recon=grid,views=2 (default: warp)")
-    parser.add_argument("--load", choices=LOAD_SHAPES, help="--variants, --seed-table: what the load's triangles make, a soup of small random ones (the stress case) or a few tessellated solid objects (default: soup)")
-    parser.add_argument("--predictor", help="the predictor of every latency run, both renderers alike (default: the spec's, hold, as in Smit et al. 2010, Table 2)")
-    parser.add_argument("--direct-predictor", metavar="NAME", help="a different predictor for the direct renderer in the grid's latency runs")
-    parser.add_argument("--server-ms", type=declared_type(BenchGrid, "server_ms"), metavar="MS", help="model the warp server's cost at MS per composed image, a GPU-like figure, labelled modelled (default: measured here; --photon-residual: 2)")
-
-
 BENCH = Bench(
-    name="renderers",
-    help="frame cost, latency and image error of the direct and warp renderers against scene size",
-    spec=lambda args: with_options(args.spec, args),
-    run=run, table=table, record=plain, plot=renderer_plots.plot_rows, options=_options,
-    outputs={"json": "write the rows as a JSON list", "csv": "write the rows as CSV",
-             "plot": "plot the run (latency against N, error against latency saved, ...)"},
-    spec_file=SpecFile(read_grid, None, QUICK_SPEC,
-                       help="the grid, as a TOML file of rig.bench.renderers.BenchGrid's settings (default: BenchGrid's defaults)",
-                       quick_help=f"a tiny run (a smoke test, seconds not minutes; {QUICK_SPEC.name})"),
-    runs="keep the latency runs' videos here, and the grid's films.toml and summary (default: a temporary folder)",
-    executor="the latency films",
-)  # fmt: skip
+    spec=lambda args: with_options(args.spec, args), read_spec=read_grid,
+    run=run, table=table, record=plain, plot=renderer_plots.plot_rows,
+)

@@ -25,19 +25,18 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from declared import Range, setting
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
 from rig.bench.renderer_latency import film_latency
 from rig.bench.renderer_setup import machine_name, open_warp, pose_of, scene_setup
-from rig.bench.renderers import BenchGrid, plain, time_direct, with_options
-from rig.commands.declared_options import declared_type
+from rig.bench.renderer_specs import BenchGrid, SeedTableSpec
+from rig.bench.renderers import plain, time_direct, with_options
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest
 from rig.sim.camera import CameraConfig
 
@@ -54,32 +53,6 @@ SEED_TABLE_2 = (
 )
 """The seed's multi-GPU rows (faces; reference latency, sd, draw time; warp latency, sd, warp
 time; ms). 64M faces: the reference's latency exceeded half the pendulum's period."""
-
-
-@dataclass(frozen=True)
-class SeedTableSpec:
-    """What `--seed-table` measures: load sizes from `first` up to the limits, what the load makes,
-    and the grid whose first resolution, direct-frame timing, films (camera, length, longest period,
-    refresh), predictor, warp spec and server cost the table takes."""
-
-    first: int = 4_000
-    max_triangles: int = setting(
-        20_000_000, "triangles", "the largest load (720 MB and the GL driver's copy)", Range(1.0, 1e8, True, True),
-    )  # fmt: skip
-    max_frame_s: float = setting(
-        60.0, "seconds", "the largest direct frame a scene may take, at most ten minutes", Range(0.0, 600.0, includes_high=True),
-    )  # fmt: skip
-    load: str = "soup"
-    """what the load's triangles make (`rig.render.gl.LOAD_SHAPES`): the soup is the stress case,
-    meshes a few tessellated solid objects, as the seed's scenes were"""
-    grid: BenchGrid = BenchGrid(resolutions=((320, 240),), direct_frames=3, direct_budget_s=2.0)
-
-    def sizes(self) -> list[int]:
-        """The fourfold series of load sizes up to `max_triangles` (the frame limit stops it earlier)."""
-        sizes = [self.first]
-        while sizes[-1] * 4 <= self.max_triangles:
-            sizes.append(sizes[-1] * 4)
-        return sizes
 
 
 QUICK_SPEC = SeedTableSpec(first=1_000, max_triangles=4_000, grid=BenchGrid(
@@ -227,17 +200,8 @@ def _plot(rows: list[dict[str, Any]], path: Path) -> None:
     renderer_plots.plot_seed_table(rows, seed_rows(), path, run_label(rows))
 
 
-def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--max-frame-s", type=declared_type(SeedTableSpec, "max_frame_s"), metavar="S",
-                        help="--seed-table: the largest direct frame, in seconds, a scene may take (default: 60)")  # fmt: skip
-    parser.add_argument("--max-triangles", type=declared_type(SeedTableSpec, "max_triangles"), metavar="N",
-                        help="--seed-table: the largest load (default: 20000000, 720 MB and the GL driver's copy)")  # fmt: skip
-
-
 BENCH = Bench(
-    name="seed-table",
-    help="Smit et al.'s latencies (2010, Table 2) beside this machine's (see rig.bench.seed_table)",
     spec=spec, run=run, table=seed_table_text,
     record=lambda rows: plain(rows + seed_rows()),
-    plot=_plot, options=_options,
+    plot=_plot,
 )

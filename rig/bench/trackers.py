@@ -1,8 +1,4 @@
-"""`rig bench trackers`: stream the simulated pendulum from `rig emulate-tracker` (a pseudo-terminal,
-TCP, LSL), clean and with faults (1% of bytes corrupted and a 0.5 s disconnect; a disconnect for
-LSL), record each with the rig's tracker source as `rig record-tracker` does, and report per case
-what was sent, recorded, missing, fabricated and counted corrupt, the CPU per sample, and the
-latency from the emulator's write to the sample's queueing for a predictor.
+"""`rig bench trackers` (its command line declared in `rig.bench.trackers_settings`): what it measures.
 
 Each case starts `rig emulate-tracker` in a process of its own (a pseudo-terminal, a TCP socket or
 an LSL outlet, with the emulator's log of every record's fate) and records it in this process with
@@ -51,16 +47,13 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from declared import Flag, Range, like, setting
 from rig.bench.contract import Bench, Context, Log
 from rig.clock import MonotonicClock
-from rig.commands.declared_options import add_declared_options
 from rig.devices.trackers.decoders import BinaryDecoder
 from rig.devices.trackers.profile import load_profile
 from rig.devices.trackers.stream import TrackerRecord
 from rig.errors import RigError
 from rig.service.tracker_recording import record_tracker
-from rig.sim.tracker import TrackerConfig
 
 TARGET_US_PER_SAMPLE = 50.0
 TARGET_LATENCY_MEDIAN_MS = 1.0
@@ -370,25 +363,4 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
     figure.savefig(path, dpi=100)
 
 
-@dataclass(frozen=True)
-class TrackerBenchOptions:
-    """The tracker bench's options, each declared on its field; each case runs in real time, so its
-    duration is the bench's time."""
-
-    rate_hz: float = like(TrackerConfig, "rate_hz", default=1000.0, flag=Flag("--rate", help="records a second the emulators send"))
-    duration_s: float = setting(10.0, "seconds", "seconds per case, run in real time (at most ten minutes)",
-                                Range(0.5, 600.0, True, True), flag="--duration")  # fmt: skip
-
-
-def _options(parser: argparse.ArgumentParser) -> None:
-    add_declared_options(parser, TrackerBenchOptions)
-    parser.add_argument("--quick", dest="duration", action="store_const", const=2.0, help="2 s per case (a smoke test)")
-
-
-BENCH = Bench(
-    name="trackers",
-    help="the serial and LSL tracker sources fed by the emulators: loss, fabrication, CPU per sample, added latency",
-    run=run, table=table, targets=targets, notes=machine_noise, plot=plot, options=_options, all_failed=every_case_failed,
-    outputs={"json": "write the rows as a JSON list", "plot": "plot CPU per sample and latency per case"},
-    runs="keep the recordings and emulator logs here (default: a temporary folder)",
-)
+BENCH = Bench(run=run, table=table, targets=targets, notes=machine_noise, plot=plot, all_failed=every_case_failed)

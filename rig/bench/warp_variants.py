@@ -23,7 +23,8 @@ from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
 from rig.bench.renderer_latency import film_latency
 from rig.bench.renderer_setup import QUALITY_FIGURES, machine_name, open_warp, scene_setup
-from rig.bench.renderers import BenchGrid, measure_warp_quality, plain, time_direct, time_warp_rounds, with_options
+from rig.bench.renderer_specs import BenchGrid
+from rig.bench.renderers import measure_warp_quality, plain, time_direct, time_warp_rounds, with_options
 
 DEFAULT_VARIANTS = (
     "warp", "warp:recon=quad", "warp:recon=mesh", "warp:recon=grid", "warp:views=2", "warp:holes=1", "warp:holes=2",
@@ -110,13 +111,4 @@ def variants_text(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def _options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--variant", action="append", metavar="SPEC",
-                        help="a warp variant for --variants; repeat for several (default: each published warp feature in turn: reconstructions, two views, hole levels, low-pass fill, spin)")  # fmt: skip
-
-
-BENCH = Bench(
-    name="variants",
-    help="image error against latency saved for each warp variant and scene",
-    spec=spec, run=run, table=variants_text, record=plain, plot=renderer_plots.plot_variants, options=_options,
-)
+BENCH = Bench(spec=spec, run=run, table=variants_text, record=plain, plot=renderer_plots.plot_variants)

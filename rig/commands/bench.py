@@ -1,6 +1,7 @@
-"""`rig bench SUBJECT`: the benchmarks of `rig.bench`, one command each, made from its `Bench`
-(`rig.bench.contract`), and the one runner that runs any of them: read its spec, run it in its
-folder, write the outputs asked for, print its table, targets and notes."""
+"""`rig bench SUBJECT`: the benchmarks of `rig.bench`, one command each, made from its `Command`
+(`rig.bench.contract`), and the one runner that runs any of them: load its `Bench`, read its spec,
+run it in its folder, write the outputs asked for, print its table, targets and notes. The help
+imports no bench: each is loaded when it runs."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from pathlib import Path
 from typing import Any, Iterator
 
 from rig.bench import SUBJECTS
-from rig.bench.contract import Bench, Context
+from rig.bench.contract import Bench, Command, Context
 from rig.cli import EXIT_USER_ERROR
 from rig.commands import options, outputs
 
@@ -32,19 +33,21 @@ def _folder(runs: Path | None, name: str) -> Iterator[Path]:
         yield Path(scratch)
 
 
-def spec(subject: Bench, args: argparse.Namespace) -> Any:
-    """The spec of the bench the options chose (`subject`, or the mode named): its spec file read
-    where it has one (the quick one with --quick; the bench's `spec` sees it as `args.spec`), then
-    the options over it."""
+def spec(subject: Command, args: argparse.Namespace) -> Any:
+    """The spec of the bench the options chose (`subject`, or the mode named): the subject's spec
+    file read where it has one (the quick one with --quick; the bench's `spec` sees it as
+    `args.spec`), then the options over it."""
     if subject.spec_file is not None:
         path = subject.spec_file.quick if args.quick else args.spec
-        args = argparse.Namespace(**{**vars(args), "spec": subject.spec_file.read(path)})
-    return args.mode.spec(args)
+        read = subject.bench().read_spec
+        assert read is not None, f"the bench {subject.name} declares a spec file but no reader"
+        args = argparse.Namespace(**{**vars(args), "spec": read(path)})
+    return args.mode.bench().spec(args)
 
 
-def run(subject: Bench, args: argparse.Namespace) -> int:
+def run(subject: Command, args: argparse.Namespace) -> int:
     """Run the bench the options chose, then write its outputs, print its table, targets and notes."""
-    bench: Bench = args.mode
+    bench: Bench = args.mode.bench()
     chosen = spec(subject, args)
     executor = {"workers": args.workers, "scheduler": args.scheduler} if subject.executor else {}
     with _folder(args.runs if subject.runs else None, subject.name) as folder:
@@ -69,12 +72,12 @@ def run(subject: Bench, args: argparse.Namespace) -> int:
     return 0
 
 
-def add_subject(benchmarks: argparse._SubParsersAction, subject: Bench, modes: tuple[Bench, ...] = (), description: str = "") -> None:
+def add_subject(benchmarks: argparse._SubParsersAction, subject: Command, modes: tuple[Command, ...] = ()) -> None:
     """`rig bench SUBJECT`: its modes' flags, outputs, spec file, options (its modes' too), runs folder and executor."""
     files = subject.spec_file
     own = files.default if files is not None and files.default is not None else "its settings' defaults"
     where = f" Its spec: {own} (--quick: {files.quick.name}); --spec runs an edited copy." if files else ""
-    parser = benchmarks.add_parser(subject.name, help=subject.help, description=description + where)
+    parser = benchmarks.add_parser(subject.name, help=subject.help, description=subject.description + where)
     if modes:
         chosen = parser.add_mutually_exclusive_group()
         for mode in modes:
@@ -101,6 +104,6 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description="Benchmarks are commands, not tests: each prints a table and writes JSON and a PNG.",
     )
     benchmarks = parser.add_subparsers(dest="bench", required=True, metavar="SUBJECT")
-    for modules in SUBJECTS:
-        first, *others = (importlib.import_module(f"rig.bench.{module}") for module in modules)
-        add_subject(benchmarks, first.BENCH, tuple(mode.BENCH for mode in others), (first.__doc__ or "").split("\n\n")[0])
+    for module in SUBJECTS:
+        declared = importlib.import_module(f"rig.bench.{module}")
+        add_subject(benchmarks, declared.SUBJECT, declared.MODES)

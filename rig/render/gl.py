@@ -16,6 +16,7 @@ import numpy as np
 
 from rig.errors import ConfigError, RigError
 from rig.render.protocol import RenderSetup
+from rig.sim.config import LOAD_SHAPES
 
 GL_VERSION = 330
 
@@ -24,11 +25,6 @@ LOAD_TRIANGLE_HALF_SIZE = 0.04
 
 LOAD_DEPTH_RANGE = (0.2, 0.95)
 """NDC depth of the load triangles: inside the back half of the range, which the sphere never uses."""
-
-LOAD_SHAPES = ("soup", "meshes")
-"""What the load's triangles make (`load_triangles`): a soup of small random triangles (the stress
-case: every visible fragment a few pixels wide) or a few solid objects tessellated into them (what a
-real scene's triangles are)."""
 
 LOAD_MESH_OBJECTS = 6
 LOAD_MESH_RADIUS = (0.2, 0.45)

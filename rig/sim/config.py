@@ -26,6 +26,10 @@ TRIANGLES_PER_S = 1e9
 """Load triangles the renderer draws per second: a generous rate for a GPU."""
 MAX_HOURS = 24.0
 """The longest simulation the rig starts: longer is a mistake in the settings, not a lab's run."""
+LOAD_SHAPES = ("soup", "meshes")
+"""What the load's triangles make (`rig.render.gl.load_triangles`): a soup of small random
+triangles (the stress case: every visible fragment a few pixels wide) or a few solid objects
+tessellated into them (what a real scene's triangles are)."""
 # (section, field) of settings a run's record leaves out at their defaults (`SimulationConfig.to_dict`).
 FILM_DEFAULTS = (
     ("camera", "readout_s"), ("camera", "frame_jitter_s"), ("camera", "container"), ("camera", "codec"), ("", "layout"), ("", "flash"),

@@ -5,12 +5,14 @@ Checked in a fresh interpreter, by what lands in sys.modules."""
 
 from __future__ import annotations
 
+import importlib
 import json
 import subprocess
 import sys
 
 import pytest
 
+from rig.bench import SUBJECTS
 from rig.cli import COMMANDS, SUMMARIES, build_parser, main
 
 HEAVY = ("numpy", "cv2", "jax", "scipy", "matplotlib", "moderngl", "OpenGL", "pylsl", "serial", "dask")
@@ -18,13 +20,15 @@ HEAVY = ("numpy", "cv2", "jax", "scipy", "matplotlib", "moderngl", "OpenGL", "py
 ANALYSIS_INTERNALS = ("analysis.pipeline", "analysis.estimation", "analysis.tracks", "analysis.blobs")
 
 
-def _loaded(argv: list[str]) -> set[str]:
-    """The modules a fresh interpreter holds after importing rig.cli and building the parser for argv."""
+def _loaded(argv: list[str], shown: bool = False) -> set[str]:
+    """The modules a fresh interpreter holds after importing rig.cli and building the parser for
+    argv; `shown`: after printing argv's --help too."""
     code = (
-        "import json, sys\n"
+        "import contextlib, io, json, sys\n"
         "import rig.cli\n"
-        f"rig.cli.build_parser({argv!r})\n"
-        "print(json.dumps(sorted(sys.modules)))\n"
+        f"parser = rig.cli.build_parser({argv!r})\n"
+        + (f"with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n    parser.parse_args({[*argv, '--help']!r})\n" if shown else "")
+        + "print(json.dumps(sorted(sys.modules)))\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True)
     return set(json.loads(done.stdout))
@@ -41,14 +45,16 @@ def test_listing_the_commands_imports_none_of_them() -> None:
     assert "importlib.metadata" not in modules
 
 
-HEAVY_PARSERS = ("bench",)
-"""Commands whose parser still imports what it runs (each benchmark's module declares its options
-beside its code)."""
-
-
-@pytest.mark.parametrize("command", [name for name in COMMANDS if name not in HEAVY_PARSERS])
+@pytest.mark.parametrize("command", COMMANDS)
 def test_a_commands_parser_loads_no_heavy_library(command: str) -> None:
     assert _heavy(_loaded([command])) == []
+
+
+@pytest.mark.parametrize("subject", [importlib.import_module(f"rig.bench.{module}").SUBJECT.name for module in SUBJECTS])
+def test_a_benchs_help_loads_no_heavy_library(subject: str) -> None:
+    modules = _loaded(["bench", subject], shown=True)
+    assert _heavy(modules) == []
+    assert not [name for name in modules if name.startswith("predictors")]
 
 
 def test_every_command_has_a_summary() -> None:

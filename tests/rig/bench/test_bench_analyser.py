@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rig.bench import analyser
+from rig.bench import analyser, analyser_settings
 from rig.bench.contract import Context
 from rig.cli import main
 from rig.commands import bench
@@ -62,7 +62,7 @@ def _cases(spec: Path) -> list[SweepPoint]:
 
 
 def test_the_shipped_spec_parses_into_the_mixed_grid_its_named_cases_and_the_hard_grid() -> None:
-    points = _cases(analyser.SPEC)
+    points = _cases(analyser_settings.SPEC)
     groups = [point.labels["group"] for point in points]
     assert groups == ["mixed"] * 48 + ["named"] * 5 + ["hard"] * 58
     assert len({point.labels["case"] for point in points}) == len(points)
@@ -83,7 +83,7 @@ def test_the_shipped_spec_parses_into_the_mixed_grid_its_named_cases_and_the_har
 
 
 def test_the_hard_grid_has_every_rate_pair_exposure_impairment_and_decimation() -> None:
-    hard = [point for point in _cases(analyser.SPEC) if point.labels["group"] == "hard"]
+    hard = [point for point in _cases(analyser_settings.SPEC) if point.labels["group"] == "hard"]
     rates = {(p.config.camera.fps, p.config.display.refresh_hz) for p in hard}
     assert rates >= {(60.0, 60.0), (120.0, 60.0), (60.0, 120.0), (144.0, 144.0), (240.0, 144.0), (59.94, 60.0), (90.0, 60.0), (30.0, 60.0)}
     assert {round(p.config.camera.exposure * p.config.camera.fps, 6) for p in hard} >= {0.05, 0.25, 0.5, 1.0}
@@ -101,7 +101,7 @@ def test_the_hard_grid_has_every_rate_pair_exposure_impairment_and_decimation() 
 ROLLING_SPECS = ("analyser-rolling.toml", "analyser-rolling-told.toml", "analyser-rolling-known.toml")
 
 
-@pytest.mark.parametrize("spec", [analyser.SPEC, *(analyser.SPECS / name for name in ROLLING_SPECS)])
+@pytest.mark.parametrize("spec", [analyser_settings.SPEC, *(analyser_settings.SPECS / name for name in ROLLING_SPECS)])
 def test_the_rolling_shutter_films_read_out_within_a_frame_with_the_blobs_a_third_of_the_frame_apart(spec: Path) -> None:
     rolling = [p.config for p in _cases(spec) if p.labels["impairment"] == "rolling-shutter"]
     assert {c.camera.fps for c in rolling} == {30.0, 60.0, 120.0, 240.0}
@@ -109,11 +109,11 @@ def test_the_rolling_shutter_films_read_out_within_a_frame_with_the_blobs_a_thir
     for config in rolling:
         led, display = placement(config.layout).led, placement(config.layout).display
         assert 0.30 <= abs(display[1] - led[1]) <= 0.40
-    assert len(rolling) == (8 if spec == analyser.SPEC else 40)
+    assert len(rolling) == (8 if spec == analyser_settings.SPEC else 40)
 
 
 def test_the_display_sampling_films_pair_eleven_rates_and_exposures_with_ten_seeds_told_their_bench() -> None:
-    spec = analyser.SPECS / "analyser-sampling-told.toml"
+    spec = analyser_settings.SPECS / "analyser-sampling-told.toml"
     points = _cases(spec)
     assert read_sweep(spec).analysis == {"method": "sinefit", "simulated_bench": True}
     films = Counter((p.config.camera.fps, p.config.display.refresh_hz, round(p.config.camera.exposure * p.config.camera.fps, 3))
@@ -128,7 +128,7 @@ def test_the_specs_are_package_data() -> None:
     pyproject = tomllib.loads((Path(__file__).parents[3] / "pyproject.toml").read_text())
     patterns = pyproject["tool"]["setuptools"]["package-data"]["rig.bench"]
     shipped = {path.name for pattern in patterns for path in Path(analyser.__file__).parent.glob(pattern)}
-    assert {analyser.SPEC.name, analyser.QUICK_SPEC.name} <= shipped
+    assert {analyser_settings.SPEC.name, analyser_settings.QUICK_SPEC.name} <= shipped
 
 
 @pytest.mark.parametrize(
@@ -152,7 +152,7 @@ def test_confidently_wrong_is_outside_by_more_than_half_a_millisecond_and_the_ha
 def test_rig_sweep_on_the_spec_gives_the_rows_of_the_bench(monkeypatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     # The first of the quick cases; the bench's own analysis of each film (every method) is left
     # out here: the rows compared are the sweep's, which the bench records beside its own.
-    text = analyser.QUICK_SPEC.read_text()
+    text = analyser_settings.QUICK_SPEC.read_text()
     spec = tmp_path / "one.toml"
     spec.write_text(text[: text.index("[[points]]", text.index("[[points]]") + 1)])
     monkeypatch.setattr(analyser, "_case_record", lambda point, options, row, log, started: {"case": point.labels["case"], "group": "mixed"})
@@ -200,6 +200,6 @@ def test_grid_runs_the_points_of_its_group(monkeypatch, tmp_path: Path) -> None:
     monkeypatch.setattr(analyser, "measure_point", measured)
     monkeypatch.setattr(analyser, "summarise", lambda cases: {"cases": len(cases)})
     monkeypatch.setattr(analyser, "targets_met", lambda summaries: {})
-    report = analyser.run(analyser.of_groups(read_sweep(analyser.QUICK_SPEC), "hard"), Context(tmp_path, log=lambda message: None))
+    report = analyser.run(analyser.of_groups(read_sweep(analyser_settings.QUICK_SPEC), "hard"), Context(tmp_path, log=lambda message: None))
     assert ran == [case["case"] for case in report["cases"]] and len(ran) == 1 and ran[0].startswith("quick-dim-led")
     assert report["summaries"] == {"all": {"cases": 1}, "hard": {"cases": 1}}

@@ -11,10 +11,11 @@ from pathlib import Path
 
 import pytest
 
-from rig.bench import renderers, seed_table
+from rig.bench import renderers_settings, seed_table
 from rig.bench.renderer_latency import FILMS_SPEC, film_latency
 from rig.bench.renderer_setup import scene_setup
-from rig.bench.renderers import LATENCY_FIELDS, QUICK_SPEC, ROW_FIELDS, BenchGrid, read_grid
+from rig.bench.renderer_specs import QUICK_SPEC, BenchGrid, read_grid
+from rig.bench.renderers import LATENCY_FIELDS, ROW_FIELDS
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
 from rig.bench.spec_reader import read_spec
 from rig.cli import EXIT_USER_ERROR, main
@@ -26,7 +27,7 @@ QUICK_GRID = read_spec(BenchGrid, QUICK_SPEC)
 
 
 def _grid(args: argparse.Namespace) -> BenchGrid:
-    return bench.spec(renderers.BENCH, args)
+    return bench.spec(renderers_settings.SUBJECT, args)
 
 
 def bench_parser() -> argparse.ArgumentParser:

@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 
 from rig.bench import SUBJECTS
-from rig.bench.contract import Bench, Context, SpecFile
+from rig.bench.contract import Bench, Command, Context, SpecFile
 from rig.commands import bench as runner
 from rig.errors import RigError
 
@@ -32,31 +32,42 @@ def _size(text: str) -> int:
     return int(text.split("=")[1])
 
 
-TOY = Bench(
-    name="toy",
-    help="counts",
+COUNT = Bench(
     spec=lambda args: args.spec + args.extra,
+    read_spec=lambda path: _size(path.read_text()),
     run=_count,
     table=lambda report: f"{len(report['rows'])} rows",
     record=lambda report: report["rows"],
     plot=_plot,
     targets=lambda report: {"enough rows": len(report["rows"]) >= 3, "few rows": len(report["rows"]) < 3, "speed": None},
     notes=lambda report: "noted last",
+)
+TOY = Command(
+    name="toy",
+    help="counts",
+    bench=lambda: COUNT,
     options=lambda parser: parser.add_argument("--extra", type=int, default=0),
     outputs={"json": "the rows", "csv": "the rows", "plot": "a picture"},
     runs="keep the runs here",
 )
-DEEP = Bench(
+
+
+def _toy(**changes: Any) -> Command:
+    """TOY running COUNT with `changes`."""
+    bench = replace(COUNT, **changes)
+    return replace(TOY, bench=lambda: bench)
+
+
+DEPTH = Bench(spec=lambda args: args.depth, run=lambda depth, context: [{"depth": depth}], table=lambda rows: f"deep {rows[0]['depth']}")
+DEEP = Command(
     name="deep",
     help="counts deeper",
-    spec=lambda args: args.depth,
-    run=lambda depth, context: [{"depth": depth}],
-    table=lambda rows: f"deep {rows[0]['depth']}",
+    bench=lambda: DEPTH,
     options=lambda parser: parser.add_argument("--depth", type=int, default=7),
 )
 
 
-def _parse(subject: Bench, *argv: str, modes: tuple[Bench, ...] = ()) -> argparse.Namespace:
+def _parse(subject: Command, *argv: str, modes: tuple[Command, ...] = ()) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="rig bench")
     runner.add_subject(parser.add_subparsers(dest="bench"), subject, modes)
     return parser.parse_args([subject.name, *argv])
@@ -65,11 +76,11 @@ def _parse(subject: Bench, *argv: str, modes: tuple[Bench, ...] = ()) -> argpars
 def _spec_file(tmp_path: Path) -> SpecFile:
     (tmp_path / "own.txt").write_text("size=4")
     (tmp_path / "quick.txt").write_text("size=2")
-    return SpecFile(lambda path: _size(path.read_text()), tmp_path / "own.txt", tmp_path / "quick.txt", "the size", "a small size")
+    return SpecFile(tmp_path / "own.txt", tmp_path / "quick.txt", "the size", "a small size")
 
 
 def test_the_runner_writes_every_output_asked_for_and_prints_table_targets_and_notes_in_order(tmp_path, capsys):
-    toy = replace(TOY, spec=lambda args: 4)
+    toy = _toy(spec=lambda args: 4)
     args = _parse(toy, "--json", str(tmp_path / "rows.json"), "--csv", str(tmp_path / "rows.csv"), "--plot", str(tmp_path / "rows.png"))
     assert args.func(args) == 0
     rows = [{"n": k, "square": k * k} for k in range(4)]
@@ -91,11 +102,11 @@ def test_the_spec_file_is_read_once_the_quick_one_with_quick_and_the_options_go_
 
 
 def test_runs_go_in_the_runs_folder_or_a_temporary_one_removed_afterwards(tmp_path, capsys):
-    toy = replace(TOY, spec=lambda args: 1)
+    toy = _toy(spec=lambda args: 1)
     args = _parse(toy, "--runs", str(tmp_path / "kept" / "here"), "--json", str(tmp_path / "kept.json"))
     assert args.func(args) == 0
     assert (tmp_path / "kept" / "here" / "made.txt").read_text() == "a run's file"
-    toy = replace(toy, record=lambda report: {"folder": report["folder"]})
+    toy = _toy(spec=lambda args: 1, record=lambda report: {"folder": report["folder"]})
     args = _parse(toy, "--json", str(tmp_path / "report.json"))
     assert args.func(args) == 0
     folder = Path(json.loads((tmp_path / "report.json").read_text())["folder"])
@@ -115,7 +126,7 @@ def test_a_failed_write_keeps_the_others_and_the_table_then_is_one_error(tmp_pat
     def unwritable(report: dict[str, Any], path: Path) -> None:
         raise OSError(28, "No space left on device")
 
-    toy = replace(TOY, spec=lambda args: 2, plot=unwritable)
+    toy = _toy(spec=lambda args: 2, plot=unwritable)
     args = _parse(toy, "--json", str(tmp_path / "rows.json"), "--plot", str(tmp_path / "rows.png"))
     with pytest.raises(RigError, match=r"cannot write .*rows.png \(No space left on device\); the result above stands"):
         args.func(args)
@@ -127,12 +138,20 @@ def test_every_registered_subject_and_mode_is_a_command():
     parser = argparse.ArgumentParser(prog="rig")
     runner.add_parser(parser.add_subparsers(dest="command"))
     subjects = []
-    for modules in SUBJECTS:
-        subject, *modes = (importlib.import_module(f"rig.bench.{module}").BENCH for module in modules)
-        subjects.append(subject.name)
-        assert parser.parse_args(["bench", subject.name]).mode is subject
-        for mode in modes:
-            assert parser.parse_args(["bench", subject.name, f"--{mode.name}"]).mode is mode
+    for module in SUBJECTS:
+        declared = importlib.import_module(f"rig.bench.{module}")
+        subjects.append(declared.SUBJECT.name)
+        assert parser.parse_args(["bench", declared.SUBJECT.name]).mode is declared.SUBJECT
+        for mode in declared.MODES:
+            assert parser.parse_args(["bench", declared.SUBJECT.name, f"--{mode.name}"]).mode is mode
     assert subjects == ["analyser", "predictors", "renderers", "trackers", "batch", "live", "camera-calibration"]
     with pytest.raises(SystemExit):
         parser.parse_args(["bench", "renderers", "--seed-table", "--variants"])
+
+
+@pytest.mark.parametrize("module", SUBJECTS)
+def test_every_subject_and_mode_loads_a_bench_that_keeps_the_contract(module: str):
+    declared = importlib.import_module(f"rig.bench.{module}")
+    for command in (declared.SUBJECT, *declared.MODES):
+        assert isinstance(command.bench(), Bench)
+    assert (declared.SUBJECT.bench().read_spec is not None) == (declared.SUBJECT.spec_file is not None)
