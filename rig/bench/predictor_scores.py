@@ -8,9 +8,26 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
-from predictors import Evaluation, Trace, evaluate
+from predictors import Evaluation, PredictorError, Trace, evaluate
 
 BASELINE = "slerp"
+
+
+@dataclass(frozen=True)
+class FailedEvaluation:
+    """A predictor that could not be scored on a trace, and why: a row of the bench beside the scores."""
+
+    predictor: str
+    trace: str
+    failed: str
+
+    def to_dict(self) -> dict[str, str]:
+        return {"trace": self.trace, "predictor": self.predictor, "failed": self.failed}
+
+
+def failure_reason(error: Exception) -> str:
+    """Why an evaluation failed, in one line: a predictor's refusal as it says it, anything else with its kind."""
+    return str(error) if isinstance(error, PredictorError) else f"{type(error).__name__}: {error}"
 
 
 def label(name: str, params: dict[str, Any]) -> str:
@@ -24,13 +41,21 @@ def evaluate_all(
     horizons: Sequence[float],
     timing_repeats: int,
     progress: Callable[[float, float], object] | None = None,
+    failures: list[FailedEvaluation] | None = None,
 ) -> list[Evaluation]:
-    """Every predictor spec on every trace."""
+    """Every predictor spec on every trace. Given `failures`, an evaluation that raises is added
+    there with its reason and the others still run (a predictor that cannot score a trace is a
+    result of the bench); without it, the error propagates."""
     results = []
     total = len(traces) * len(specs)
     for i, trace in enumerate(traces):
         for j, (name, params) in enumerate(specs):
-            results.append(evaluate(name, trace, [h / 1e3 for h in horizons], params, timing_repeats))
+            try:
+                results.append(evaluate(name, trace, [h / 1e3 for h in horizons], params, timing_repeats))
+            except Exception as error:
+                if failures is None:
+                    raise
+                failures.append(FailedEvaluation(label(name, params), trace.name, failure_reason(error)))
             if progress is not None:
                 progress(i * len(specs) + j + 1, total)
     return results

@@ -8,9 +8,12 @@ import json
 from pathlib import Path
 from typing import Any, Callable
 
+import numpy as np
 import pytest
 
-from rig.bench import camera_calibration, trackers
+from predictors import PredictorError, Trace, write_trace
+from predictors import quaternion as quat
+from rig.bench import camera_calibration, predictor_scores, trackers
 from rig.cli import EXIT_USER_ERROR
 from rig.errors import RigError
 
@@ -72,3 +75,41 @@ def test_an_analyser_bench_case_that_cannot_be_filmed_is_refused_and_the_bench_e
     _assert_exits_2_saying(code, err, "refused every one of the 1 cases (the first: not simulated: the film would hold 15 frames")
     (case,) = json.loads(out.read_text())["cases"]
     assert (case["case"], case["truth_ms"], case["frames"]) == ("half the frames", None, 0)
+
+
+def _tiny_trace(folder: Path) -> Path:
+    t = np.arange(120) / 60.0
+    path = folder / "tiny.csv"
+    write_trace(path, Trace.from_samples("tiny", t, np.outer(t, [0.2, 0.0, 0.0]), quat.from_rotation_vector(np.outer(t, [0, 1.0, 0]))))
+    return path
+
+
+def test_a_predictor_bench_whose_every_evaluation_raised_writes_the_failures_and_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def refuses(name: str, trace: Trace, *_: Any) -> None:
+        raise PredictorError(f"{name} cannot score {trace.name}")
+
+    monkeypatch.setattr(predictor_scores, "evaluate", refuses)
+    out = tmp_path / "predictors.json"
+    trace = _tiny_trace(tmp_path)
+    code, printed, err = run_rig(["bench", "predictors", "--trace", str(trace), "--predictor", "hold", "--horizons-ms", "0,50",
+                                  "--json", str(out), "--plot", str(tmp_path / "predictors.png")], capsys)  # fmt: skip
+    _assert_exits_2_saying(code, err, "every one of the 2 evaluations failed (the first: hold on tiny: hold cannot score tiny)")
+    assert json.loads(out.read_text())["failed"] == [
+        {"trace": "tiny", "predictor": name, "failed": f"{name} cannot score tiny"} for name in ("hold", "slerp")
+    ]
+    assert "| tiny | slerp | failed: slerp cannot score tiny |" in printed
+    assert (tmp_path / "predictors.png").stat().st_size > 0
+
+
+def test_a_predictor_that_fails_on_a_trace_is_a_row_beside_the_scores_of_the_others(tmp_path: Path) -> None:
+    t = np.arange(120) / 60.0
+    trace = Trace.from_samples("tiny", t, np.outer(t, [0.2, 0.0, 0.0]), quat.from_rotation_vector(np.outer(t, [0, 1.0, 0])))
+    failures: list[predictor_scores.FailedEvaluation] = []
+    results = predictor_scores.evaluate_all([trace], [("slerp", {}), ("desp", {"position_alpha": 7.0})], [50.0], 0, failures=failures)
+    assert [r.predictor for r in results] == ["slerp"]
+    ((failure),) = failures
+    assert (failure.predictor, failure.trace) == ("desp:position_alpha=7", "tiny") and "position_alpha" in failure.failed
+    with pytest.raises(PredictorError):
+        predictor_scores.evaluate_all([trace], [("desp", {"position_alpha": 7.0})], [50.0], 0)
