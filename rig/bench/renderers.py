@@ -8,7 +8,8 @@ scan-out. The grid is a spec file, the grid's options override it; its latency f
 beside the runs as films.toml, which `rig sweep` films again. The default grid takes several
 minutes, --seed-table up to an hour; --quick runs a tiny one of each.
 
-For each display resolution and load of N triangles:
+For each display resolution and load of N triangles (a load that cannot be drawn is rows failed with
+the reason, and the others still run; a latency film that fails is its rows' reason too):
 
 * direct: the real frame time on this machine (render and readback, wall clock);
 * warp (the grid's warp spec, `warp` by default): the client's frame time, the server's time per
@@ -52,14 +53,15 @@ import numpy as np
 from declared import Range, check, like, setting
 from predictors import Pose
 from rig.bench import renderer_plots
-from rig.bench.contract import Bench, Context, SpecFile, cell, given
+from rig.bench.contract import Bench, Context, Log, SpecFile, given
 from rig.bench.renderer_estimate import estimated_hours
 from rig.bench.renderer_latency import LatencyRun, film_latencies
+from rig.bench.renderer_rows import every_row_failed, table
 from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup
 from rig.bench.spec_reader import read_spec
 from rig.commands import options
 from rig.commands.declared_options import declared_type
-from rig.errors import ConfigError
+from rig.errors import ConfigError, RigError
 from rig.render.direct import DirectRenderer
 from rig.render.gl import LOAD_SHAPES
 from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
@@ -75,11 +77,12 @@ ROW_FIELDS = (
     "frame_ms_median", "frame_ms_p95", "frame_gpu_ms_median", "frame_cpu_ms_median", "frames_timed", "client_ms_median",
     "primitives", "cost_source", "predictor", "photon_target",
     "latency_measured_ms", "latency_true_ms", "latency_sd_ms", "frame_delay_sd_ms", "missed_pct", "latency_period_s", "latency_note",
-    "lab_error_pct", "ssim", "dssim", "psnr_db", "hole_pct", "timing", "machine",
+    "lab_error_pct", "ssim", "dssim", "psnr_db", "hole_pct", "timing", "machine", "failed",
 )  # fmt: skip
+"""A row's fields; `failed` says why its load could not be timed or its latency film failed (None: neither)."""
 LATENCY_FIELDS = (
     "cost_source", "predictor", "photon_target", "latency_measured_ms", "latency_true_ms", "latency_sd_ms",
-    "frame_delay_sd_ms", "missed_pct", "latency_period_s", "latency_note",
+    "frame_delay_sd_ms", "missed_pct", "latency_period_s", "latency_note", "failed",
 )  # fmt: skip
 """The fields a latency run fills in a row."""
 
@@ -240,9 +243,41 @@ def warp_row(base: dict[str, Any], m: WarpMeasurement, triangles: int, size: tup
     }  # fmt: skip
 
 
+def timed_load(grid: BenchGrid, size: tuple[int, int], triangles: int, base: dict[str, Any], log: Log) -> tuple[dict[str, Any], WarpMeasurement, float]:
+    """One load at one display size: its direct row, the warp renderer opened on it with its image
+    error measured (the caller closes it, and times its rounds), and the direct frame's median (s)."""
+    width, height = size
+    setup, pendulum = scene_setup(width, height, triangles, grid.refresh_hz)
+    started = time.perf_counter()
+    direct, direct_cpu = time_direct(setup, grid)
+    log(f"{width}x{height} {triangles:>9} triangles: direct {np.median(direct) * 1e3:9.1f} ms "
+        f"({len(direct)} frames, {time.perf_counter() - started:.0f} s)")  # fmt: skip
+    row = {
+        **base, "renderer": "direct", "spec": "direct", "triangles": triangles, "width": width, "height": height,
+        "frame_ms_median": _percentile_ms(direct, 50), "frame_ms_p95": _percentile_ms(direct, 95),
+        "frame_cpu_ms_median": _percentile_ms(direct_cpu, 50), "frames_timed": len(direct),
+        "timing": "wall clock, render and readback; frame_cpu_ms_median: this process's CPU time, all threads",
+    }  # fmt: skip
+    m = open_warp(grid.warp, setup, pendulum, grid.ratios)
+    try:
+        measure_warp_quality(m, grid)
+    except BaseException:
+        m.renderer.close()
+        raise
+    log(f"{width}x{height} {triangles:>9} triangles: warp client {np.median(m.client_s) * 1e3:9.1f} ms")
+    return row, m, float(np.median(direct))
+
+
+def untimed_rows(base: dict[str, Any], grid: BenchGrid, size: tuple[int, int], triangles: int, reason: str) -> list[dict[str, Any]]:
+    """The rows of a load that could not be timed at one display size, direct and warp, each failed with `reason`."""
+    where = {**base, "triangles": triangles, "width": size[0], "height": size[1], "failed": reason}
+    return [{**where, "renderer": "direct", "spec": "direct"}, *({**where, "renderer": "warp", "spec": grid.warp, "rate_ratio": ratio} for ratio in grid.ratios)]
+
+
 def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
-    """Every row of the benchmark (see the module docstring). The timings run here, one at a time;
-    the latency films (simulate, then analyse: a sweep into the context's folder) on its executor."""
+    """Every row of the benchmark (see the module docstring). The timings run here, one at a time
+    (a load that cannot be drawn is failed rows with the reason, and the others still run); the
+    latency films (simulate, then analyse: a sweep into the context's folder) on its executor."""
     log = context.log
     machine = machine_name()
     log(f"machine: {machine}")
@@ -252,31 +287,26 @@ def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
     base["machine"] = machine
     for resolution_index, (width, height) in enumerate(grid.resolutions):
         measurements: list[WarpMeasurement] = []
+        timed: list[int] = []
         try:
             for triangles in grid.triangles:
-                setup, pendulum = scene_setup(width, height, triangles, grid.refresh_hz)
-                started = time.perf_counter()
-                direct, direct_cpu = time_direct(setup, grid)
-                log(f"{width}x{height} {triangles:>9} triangles: direct {np.median(direct) * 1e3:9.1f} ms "
-                    f"({len(direct)} frames, {time.perf_counter() - started:.0f} s)")  # fmt: skip
-                rows.append({
-                    **base, "renderer": "direct", "spec": "direct", "triangles": triangles, "width": width, "height": height,
-                    "frame_ms_median": _percentile_ms(direct, 50), "frame_ms_p95": _percentile_ms(direct, 95),
-                    "frame_cpu_ms_median": _percentile_ms(direct_cpu, 50), "frames_timed": len(direct),
-                    "timing": "wall clock, render and readback; frame_cpu_ms_median: this process's CPU time, all threads",
-                })  # fmt: skip
-                m = open_warp(grid.warp, setup, pendulum, grid.ratios)
+                try:
+                    row, m, direct_s = timed_load(grid, (width, height), triangles, base, log)
+                except RigError as error:
+                    log(f"{width}x{height} {triangles:>9} triangles: failed: {error}")
+                    rows += untimed_rows(base, grid, (width, height), triangles, str(error))
+                    continue
+                rows.append(row)
                 measurements.append(m)
-                measure_warp_quality(m, grid)
-                log(f"{width}x{height} {triangles:>9} triangles: warp client {np.median(m.client_s) * 1e3:9.1f} ms")
+                timed.append(triangles)
                 if resolution_index == 0 and triangles in (grid.latency_triangles or grid.triangles):
-                    expected["direct", triangles] = (float(np.median(direct)), 0.0)
+                    expected["direct", triangles] = (direct_s, 0.0)
                     expected["warp", triangles] = (float(np.median(m.client_s)), 0.0)
             time_warp_rounds(measurements, grid)
         finally:
             for m in measurements:
                 m.renderer.close()
-        for triangles, m in zip(grid.triangles, measurements):
+        for triangles, m in zip(timed, measurements):
             log(f"{width}x{height} {triangles:>9} triangles: warp {np.median(m.wall_s) * 1e3:7.1f} ms per display frame")
             if ("warp", triangles) in expected and resolution_index == 0:
                 expected["warp", triangles] = (expected["warp", triangles][0], float(np.median(m.wall_s)))
@@ -296,34 +326,13 @@ def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
     for (labels, *_), figures in zip(films, film_latencies(films, context.folder, comment, context.workers, context.scheduler, progress)):
         measured = figures["latency_measured_ms"]
         shown = f"{measured:.1f} ms measured, {figures['latency_true_ms']:.1f} ms true" if measured is not None else figures["latency_note"]
+        if figures["failed"] is not None:
+            shown = f"failed: {figures['failed']}"
         log(f"latency {labels['renderer']:6} {labels['triangles']:>9} triangles: {shown}")
         for row in rows:
             if (row["renderer"], row["triangles"], (row["width"], row["height"])) == (labels["renderer"], labels["triangles"], grid.resolutions[0]):
                 row.update({name: figures[name] for name in LATENCY_FIELDS})
     return rows
-
-
-def table(rows: list[dict[str, Any]]) -> str:
-    """The grid's rows as a fixed-width table, with the latency notes and the machine below."""
-    lines = [
-        f"{'renderer':8} {'N':>9} {'size':>9} {'ratio':>5} {'frame ms':>9} {'p95':>8} {'gpu ms':>7} {'cpu ms':>8} {'client ms':>9} "
-        f"{'lat meas':>8} {'lat true':>8} {'sd':>5} {'missed':>6} {'Lab>10 %':>8} {'SSIM':>6} {'PSNR':>5} {'holes %':>7}"
-    ]  # fmt: skip
-    for r in rows:
-        ratio = f"1:{r['rate_ratio']}" if r["rate_ratio"] else "-"
-        missed = f"{r['missed_pct']:.0f}%" if r["missed_pct"] is not None else "-"
-        lines.append(
-            f"{r['renderer']:8} {r['triangles']:>9} {r['width']}x{r['height']:<4} {ratio:>5} {cell(r['frame_ms_median']):>9} "
-            f"{cell(r['frame_ms_p95']):>8} {cell(r['frame_gpu_ms_median']):>7} {cell(r['frame_cpu_ms_median']):>8} "
-            f"{cell(r['client_ms_median']):>9} "
-            f"{cell(r['latency_measured_ms']):>8} {cell(r['latency_true_ms']):>8} {cell(r['latency_sd_ms']):>5} {missed:>6} "
-            f"{cell(r['lab_error_pct'], '.2f'):>8} {cell(r['ssim'], '.3f'):>6} {cell(r['psnr_db']):>5} {cell(r['hole_pct'], '.2f'):>7}"
-        )
-    specs = sorted({r["spec"] for r in rows if r["renderer"] == "warp"})
-    lines.append(f"warp: {', '.join(specs)}; sd: the latency's spread swing by swing, from the video" if specs else "")
-    lines += [f"latency: {note}" for note in sorted({r["latency_note"] for r in rows if r["latency_note"]})]
-    lines.append(f"machine: {rows[0]['machine']}" if rows else "no rows")
-    return "\n".join(lines)
 
 
 def plain(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -377,7 +386,7 @@ BENCH = Bench(
     name="renderers",
     help="frame cost, latency and image error of the direct and warp renderers against scene size",
     spec=lambda args: with_options(args.spec, args),
-    run=run, table=table, record=plain, plot=renderer_plots.plot_rows, options=_options,
+    run=run, table=table, record=plain, plot=renderer_plots.plot_rows, options=_options, all_failed=every_row_failed,
     outputs={"json": "write the rows as a JSON list", "csv": "write the rows as CSV",
              "plot": "plot the run (latency against N, error against latency saved, ...)"},
     spec_file=SpecFile(read_grid, None, QUICK_SPEC,

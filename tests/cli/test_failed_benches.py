@@ -13,7 +13,7 @@ import pytest
 
 from predictors import PredictorError, Trace, write_trace
 from predictors import quaternion as quat
-from rig.bench import camera_calibration, predictor_scores, trackers
+from rig.bench import camera_calibration, predictor_scores, renderer_latency, renderer_rows, renderers, trackers
 from rig.cli import EXIT_USER_ERROR
 from rig.errors import RigError
 
@@ -113,3 +113,45 @@ def test_a_predictor_that_fails_on_a_trace_is_a_row_beside_the_scores_of_the_oth
     assert (failure.predictor, failure.trace) == ("desp:position_alpha=7", "tiny") and "position_alpha" in failure.failed
     with pytest.raises(PredictorError):
         predictor_scores.evaluate_all([trace], [("desp", {"position_alpha": 7.0})], [50.0], 0)
+
+
+def test_a_renderer_bench_whose_every_load_cannot_be_drawn_writes_failed_rows_and_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def undrawable(width: int, height: int, triangles: int, *_: Any) -> None:
+        raise RigError(f"{triangles} triangles are more than this GPU draws")
+
+    monkeypatch.setattr(renderers, "scene_setup", undrawable)
+    out, plot = tmp_path / "renderers.json", tmp_path / "renderers.png"
+    code, printed, err = run_rig(["bench", "renderers", "--quick", "--json", str(out), "--plot", str(plot)], capsys)
+    _assert_exits_2_saying(code, err, "every one of the 6 rows failed (the first: direct on 1000 triangles: 1000 triangles are more than")
+    rows = json.loads(out.read_text())
+    assert [(r["renderer"], r["rate_ratio"], r["failed"]) for r in rows] == [
+        (renderer, ratio, f"{n} triangles are more than this GPU draws") for n in (1000, 8000)
+        for renderer, ratio in (("direct", None), ("warp", 1), ("warp", 3))
+    ]  # fmt: skip
+    assert all(r["frames_timed"] is None and r["latency_measured_ms"] is None for r in rows)
+    assert "warp          8000 160x120    1:3 failed: 8000 triangles are more than this GPU draws" in printed
+    assert plot.stat().st_size > 0
+
+
+def test_a_renderer_bench_whose_every_latency_film_failed_keeps_its_timings_and_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def unfilmable(point: Any) -> None:
+        raise RigError(f"no film at {point.config.scene_triangles} triangles")
+
+    monkeypatch.setattr(renderer_latency, "simulate_and_analyse", unfilmable)
+    out = tmp_path / "renderers.json"
+    code, printed, err = run_rig(["bench", "renderers", "--quick", "--triangles", "1000", "--json", str(out)], capsys)
+    _assert_exits_2_saying(code, err, "every one of the 3 rows failed (the first: direct on 1000 triangles: not simulated: no film at 1000")
+    rows = json.loads(out.read_text())
+    assert [r["failed"] for r in rows] == ["not simulated: no film at 1000 triangles"] * 3
+    assert all(r["frame_ms_median"] > 0 and r["latency_measured_ms"] is None for r in rows)
+    assert "failed: the latency film of warp on 1000 triangles: not simulated: no film at 1000 triangles" in printed
+
+
+def test_a_renderer_bench_with_one_film_failed_exits_0_with_that_row_failed() -> None:
+    rows = [{"renderer": "direct", "triangles": 10, "failed": "the analyser failed: no swing"}, {"renderer": "warp", "triangles": 10, "failed": None}]
+    assert renderer_rows.every_row_failed(rows) is None
+    assert renderer_rows.every_row_failed(rows[:1]) == "every one of the 1 rows failed (the first: direct on 10 triangles: the analyser failed: no swing)"
