@@ -13,7 +13,7 @@ import pytest
 
 from predictors import PredictorError, Trace, write_trace
 from predictors import quaternion as quat
-from rig.bench import camera_calibration, predictor_scores, renderer_latency, renderer_rows, renderers, trackers
+from rig.bench import camera_calibration, live, predictor_scores, renderer_latency, renderer_rows, renderers, trackers
 from rig.cli import EXIT_USER_ERROR
 from rig.errors import RigError
 
@@ -155,3 +155,52 @@ def test_a_renderer_bench_with_one_film_failed_exits_0_with_that_row_failed() ->
     rows = [{"renderer": "direct", "triangles": 10, "failed": "the analyser failed: no swing"}, {"renderer": "warp", "triangles": 10, "failed": None}]
     assert renderer_rows.every_row_failed(rows) is None
     assert renderer_rows.every_row_failed(rows[:1]) == "every one of the 1 rows failed (the first: direct on 10 triangles: the analyser failed: no swing)"
+
+
+def test_a_live_bench_that_could_make_neither_measurement_writes_both_reasons_and_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def no_window(*_: Any) -> None:
+        raise RigError("cannot open a window (no display)")
+
+    def no_tracker(*_: Any) -> None:
+        raise RigError("no tracker sample arrived")
+
+    monkeypatch.setattr(live, "live_run", no_tracker)
+    monkeypatch.setattr(live, "swap_to_log", no_window)
+    out, plot = tmp_path / "live.json", tmp_path / "live.png"
+    code, printed, err = run_rig(["bench", "live", "--duration", "1", "--json", str(out), "--plot", str(plot)], capsys)
+    _assert_exits_2_saying(code, err, "every measurement failed (the live run: no tracker sample arrived; the swaps: cannot open a window")
+    report = json.loads(out.read_text())
+    assert [report[key]["failed"] for key, _ in live.MEASURED] == ["no tracker sample arrived"] * 2 + ["cannot open a window (no display)"]
+    assert "swap to logged              failed: cannot open a window (no display)" in printed
+    assert plot.stat().st_size > 0
+
+
+def test_a_live_bench_that_failed_alike_twice_says_why_once() -> None:
+    reason = {"failed": "cannot open a window (no display)"}
+    report = {"arrival_to_pose": reason, "frame_start_to_pose": reason, "swap_to_log": reason}
+    assert live.every_measurement_failed(report) == "every measurement failed: cannot open a window (no display)"
+
+
+def test_a_live_bench_whose_swaps_failed_keeps_the_live_run_and_exits_0(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    figures = {"count": 60, "median_us": 9000.0, "p95_us": 16000.0, "max_us": 17500.0}
+
+    def no_swaps(*_: Any) -> None:
+        raise RigError("no swap was recorded")
+
+    monkeypatch.setattr(live, "live_run", lambda *_: {"arrival_to_pose": figures, "frame_start_to_pose": figures})
+    monkeypatch.setattr(live, "swap_to_log", no_swaps)
+    code, printed, err = run_rig(["bench", "live", "--duration", "1", "--plot", str(tmp_path / "live.png")], capsys)
+    assert code == 0, err
+    assert "swap to logged              failed: no swap was recorded" in printed and "9000" in printed
+
+
+def test_a_live_run_that_timed_nothing_is_refused_with_what_was_missing(tmp_path: Path) -> None:
+    (tmp_path / "tracker.csv").write_text("t_sensor,t_arrival\n")
+    (tmp_path / "published_poses.csv").write_text("frame,t_pose,t_sensor\n")
+    (tmp_path / "app_frames.csv").write_text("index,t_start\n")
+    with pytest.raises(RigError, match="no pose with its sample's arrival was recorded"):
+        live.arrival_to_pose(tmp_path)
