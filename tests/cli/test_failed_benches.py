@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any, Callable
 
 import numpy as np
@@ -13,7 +14,7 @@ import pytest
 
 from predictors import PredictorError, Trace, write_trace
 from predictors import quaternion as quat
-from rig.bench import camera_calibration, live, predictor_scores, renderer_latency, renderer_rows, renderers, trackers
+from rig.bench import batch, camera_calibration, live, predictor_scores, renderer_latency, renderer_rows, renderers, trackers
 from rig.cli import EXIT_USER_ERROR
 from rig.errors import RigError
 
@@ -204,3 +205,48 @@ def test_a_live_run_that_timed_nothing_is_refused_with_what_was_missing(tmp_path
     (tmp_path / "app_frames.csv").write_text("index,t_start\n")
     with pytest.raises(RigError, match="no pose with its sample's arrival was recorded"):
         live.arrival_to_pose(tmp_path)
+
+
+def test_a_batch_bench_whose_runs_all_failed_writes_both_reasons_and_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def simulated(config: Any, folder: Path, **_: Any) -> Any:
+        return SimpleNamespace(video_path=folder / "video.avi")
+
+    def worker_died(arguments: list[str], *_: Any, **__: Any) -> float:
+        raise RigError(f"{Path(arguments[0]).name} exited -9: a worker died")
+
+    monkeypatch.setattr(batch, "simulate", simulated)
+    monkeypatch.setattr(batch, "_process_seconds", worker_died)
+    out, plot = tmp_path / "batch.json", tmp_path / "batch.png"
+    code, printed, err = run_rig(["bench", "batch", "--videos", "2", "--json", str(out), "--plot", str(plot)], capsys)
+    _assert_exits_2_saying(code, err, "every part failed (the batch: rig exited -9: a worker died; the clip: ")
+    report = json.loads(out.read_text())
+    assert report["scale_out"] == {"failed": "rig exited -9: a worker died"} and "exited -9" in report["fixed_cost"]["failed"]
+    assert report["unsimulated"] == []
+    assert "batch: failed: rig exited -9: a worker died" in printed and plot.stat().st_size > 0
+
+
+def test_a_batch_bench_whose_videos_cannot_be_simulated_says_why_each_was_left_out_and_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def unsimulable(config: Any, folder: Path, **_: Any) -> None:
+        raise RigError(f"cannot write {folder.name}")
+
+    monkeypatch.setattr(batch, "simulate", unsimulable)
+    out = tmp_path / "batch.json"
+    code, printed, err = run_rig(["bench", "batch", "--videos", "2", "--json", str(out)], capsys)
+    _assert_exits_2_saying(code, err, "every part failed (the batch: no video of the batch could be simulated; the clip: cannot write clip)")
+    assert json.loads(out.read_text())["unsimulated"] == [{"video": 0, "failed": "cannot write video00"}, {"video": 1, "failed": "cannot write video01"}]
+    assert "video 1 not simulated: cannot write video01" in printed
+
+
+def test_a_batch_bench_with_one_part_failed_exits_0_and_shows_the_other(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    clip = {"clip": "clip.avi", "decode_s": 1.0, "analyse_cold_cache_s": 3.0, "analyse_warm_cache_s": 2.0, "ratio_cold": 3.0, "ratio_warm": 2.0}
+    monkeypatch.setattr(batch, "videos", lambda *_: ([], []))
+    monkeypatch.setattr(batch, "clip_cost", lambda *_: clip)
+    code, printed, err = run_rig(["bench", "batch", "--videos", "2", "--plot", str(tmp_path / "batch.png")], capsys)
+    assert code == 0, err
+    assert "batch: failed: no video of the batch could be simulated" in printed and "analyse / decode alone = 3.00" in printed
