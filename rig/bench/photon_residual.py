@@ -18,6 +18,7 @@ from typing import Any
 
 from rig.bench.contract import Bench, Context, cell
 from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import machine_name
 from rig.bench.renderers import BenchGrid, plain, with_options
 from rig.session import DEFAULT_SERVER_MS, PHOTON_TARGETS
@@ -72,6 +73,7 @@ def residual_text(rows: list[dict[str, Any]]) -> str:
         lines.append(f"best predictor {best}: residual {aimed['latency_measured_ms']:+.2f} ms aimed at the photons, "
                      f"{scanout.get('latency_measured_ms') or float('nan'):+.2f} ms aimed at scan-out")  # fmt: skip
     lines += [f"run: {note}" for note in sorted({r["latency_note"] for r in rows if r.get("latency_note")})]
+    lines += [f"failed: {r['predictor']} aimed at {r['photon_target']}: {r['failed']}" for r in rows if r.get("failed")]
     return "\n".join(lines)
 
 
@@ -84,5 +86,5 @@ BENCH = Bench(
     name="photon-residual",
     help="latency left by each predictor aimed at the photons and at scan-out",
     spec=lambda args: ResidualSpec(with_options(args.spec, args), tuple(args.residual_predictor or RESIDUAL_PREDICTORS)),
-    run=run, table=residual_text, record=plain, options=_options,
+    run=run, table=residual_text, record=plain, options=_options, all_failed=every_row_failed,
 )

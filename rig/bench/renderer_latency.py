@@ -172,26 +172,35 @@ def film_figures(filmed: PointRun) -> dict[str, Any]:
     }
 
 
+def unsimulated_figures(config: SimulationConfig, error: Exception) -> dict[str, Any]:
+    """The figures of a run whose simulation was refused: nothing filmed, failed with the reason."""
+    reason = f"not simulated: {error}"
+    return {**_no_figures(config), "latency_note": reason, "failed": reason}
+
+
 def film_row(point: SweepPoint) -> dict[str, Any]:
     """A sweep job: the point's summary row (simulated, then analysed within the simulation's
     regions, as a lab marks them once for its camera), with its film's figures under "film"."""
     try:
         filmed = simulate_and_analyse(point)
     except USER_ERRORS as error:
-        reason = f"not simulated: {error}"
-        return unsimulated_row(point, error) | {"film": {**_no_figures(point.config), "latency_note": reason, "failed": reason}}
+        return unsimulated_row(point, error) | {"film": unsimulated_figures(point.config, error)}
     return filmed.row | {"film": film_figures(filmed)}
 
 
 def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: Path) -> dict[str, Any]:
     """Simulate `run` (with `app_frame_s` and `server_s` the costs expected, for the period), film it,
     analyse the video; its figures. Latencies are None when the expected one needs too long a period
-    or the analyser fails, and the note says why (`failed` too where the analyser failed)."""
+    or the run cannot be simulated or analysed, and the note says why (`failed` too where it could
+    not be simulated or analysed)."""
     unfilmed = beyond_range_figures(run, app_frame_s, server_s)
     if unfilmed is not None:
         return unfilmed
     point = SweepPoint(0, film_config(run, app_frame_s, server_s), {}, out_dir, AnalysisRequest(out_dir / "video.avi"), simulated_rois=True)
-    return film_figures(simulate_and_analyse(point))
+    try:
+        return film_figures(simulate_and_analyse(point))
+    except USER_ERRORS as error:
+        return unsimulated_figures(point.config, error)
 
 
 def film_latencies(

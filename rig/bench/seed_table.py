@@ -35,6 +35,7 @@ from declared import Range, setting
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
 from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import machine_name, open_warp, pose_of, scene_setup
 from rig.bench.renderers import BenchGrid, plain, time_direct, with_options
 from rig.commands.declared_options import declared_type
@@ -214,7 +215,9 @@ def seed_table_text(rows: list[dict[str, Any]]) -> str:
                                       f"({found['direct_frame_refreshes']:.2f} refreshes)" if found else _no_crossover(table))
         )  # fmt: skip
     notes = sorted({r["latency_note"] for r in rows if r.get("latency_note")})
-    return "\n".join(lines + [f"run: {note}" for note in notes])
+    lines += [f"run: {note}" for note in notes]
+    lines += [f"failed: {r['spec']} on {r['triangles']} triangles: {r['failed']}" for r in rows if r.get("failed")]
+    return "\n".join(lines)
 
 
 def spec(args: argparse.Namespace) -> SeedTableSpec:
@@ -239,5 +242,5 @@ BENCH = Bench(
     help="Smit et al.'s latencies (2010, Table 2) beside this machine's (see rig.bench.seed_table)",
     spec=spec, run=run, table=seed_table_text,
     record=lambda rows: plain(rows + seed_rows()),
-    plot=_plot, options=_options,
+    plot=_plot, options=_options, all_failed=every_row_failed,
 )

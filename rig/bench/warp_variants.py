@@ -22,6 +22,7 @@ import numpy as np
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
 from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import QUALITY_FIGURES, machine_name, open_warp, scene_setup
 from rig.bench.renderers import BenchGrid, measure_warp_quality, plain, time_direct, time_warp_rounds, with_options
 
@@ -107,6 +108,7 @@ def variants_text(rows: list[dict[str, Any]]) -> str:
         )
     lines.append(f"image figures: means over the warped frames (client:display 1:{rows[0]['rate_ratio']}); "
                  f"{', '.join(QUALITY_FIGURES)}" if rows else "no rows")  # fmt: skip
+    lines += [f"failed: {r['spec']} on {r['triangles']} triangles: {r['failed']}" for r in rows if r.get("failed")]
     return "\n".join(lines)
 
 
@@ -119,4 +121,5 @@ BENCH = Bench(
     name="variants",
     help="image error against latency saved for each warp variant and scene",
     spec=spec, run=run, table=variants_text, record=plain, plot=renderer_plots.plot_variants, options=_options,
+    all_failed=every_row_failed,
 )

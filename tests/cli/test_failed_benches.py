@@ -14,7 +14,9 @@ import pytest
 
 from predictors import PredictorError, Trace, write_trace
 from predictors import quaternion as quat
-from rig.bench import batch, camera_calibration, live, predictor_scores, renderer_latency, renderer_rows, renderers, trackers
+from rig.bench import (
+    batch, camera_calibration, live, predictor_scores, renderer_latency, renderer_rows, renderers, seed_table, trackers,
+)
 from rig.cli import EXIT_USER_ERROR
 from rig.errors import RigError
 
@@ -250,3 +252,21 @@ def test_a_batch_bench_with_one_part_failed_exits_0_and_shows_the_other(
     code, printed, err = run_rig(["bench", "batch", "--videos", "2", "--plot", str(tmp_path / "batch.png")], capsys)
     assert code == 0, err
     assert "batch: failed: no video of the batch could be simulated" in printed and "analyse / decode alone = 3.00" in printed
+
+
+@pytest.mark.parametrize(("mode", "rows"), [(["--photon-residual", "--residual-predictor", "hold"], 2), (["--variants"], 2), (["--seed-table"], 2)])
+def test_a_renderer_mode_whose_every_film_failed_writes_its_rows_and_exits_2(
+    mode: list[str], rows: int,
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:  # fmt: skip
+    def unfilmable(point: Any) -> None:
+        raise RigError("the film would hold too few frames")
+
+    monkeypatch.setattr(renderer_latency, "simulate_and_analyse", unfilmable)
+    monkeypatch.setattr(seed_table.SeedTableSpec, "sizes", lambda self: [1000])
+    out, plot = tmp_path / "mode.json", tmp_path / "mode.png"
+    code, printed, err = run_rig(["bench", "renderers", "--quick", *mode, "--json", str(out), "--plot", str(plot)], capsys)
+    _assert_exits_2_saying(code, err, f"every one of the {rows} rows failed (the first: ")
+    mine = [r for r in json.loads(out.read_text()) if r.get("source", "this machine") == "this machine"]
+    assert [r["failed"] for r in mine] == ["not simulated: the film would hold too few frames"] * rows
+    assert "failed: " in printed and "not simulated: the film would hold too few frames" in printed
