@@ -57,7 +57,7 @@ from rig.bench.contract import Bench, Context, Log, SpecFile, given
 from rig.bench.renderer_estimate import estimated_hours
 from rig.bench.renderer_latency import LatencyRun, film_latencies
 from rig.bench.renderer_rows import every_row_failed, table
-from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup
+from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup, warp_renderer
 from rig.bench.spec_reader import read_spec
 from rig.commands import options
 from rig.commands.declared_options import declared_type
@@ -279,6 +279,7 @@ def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
     (a load that cannot be drawn is failed rows with the reason, and the others still run); the
     latency films (simulate, then analyse: a sweep into the context's folder) on its executor."""
     log = context.log
+    warp_renderer(grid.warp)
     machine = machine_name()
     log(f"machine: {machine}")
     rows: list[dict[str, Any]] = []

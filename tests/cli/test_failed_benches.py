@@ -270,3 +270,12 @@ def test_a_renderer_mode_whose_every_film_failed_writes_its_rows_and_exits_2(
     mine = [r for r in json.loads(out.read_text()) if r.get("source", "this machine") == "this machine"]
     assert [r["failed"] for r in mine] == ["not simulated: the film would hold too few frames"] * rows
     assert "failed: " in printed and "not simulated: the film would hold too few frames" in printed
+
+
+@pytest.mark.parametrize("mode", [["--warp", "warp:bogus=1"], ["--variants", "--variant", "warp", "--variant", "warp:bogus=1"]])
+def test_a_renderer_bench_refuses_a_warp_spec_it_cannot_make_before_any_timing(
+    mode: list[str], run_rig: Callable[..., tuple[int, str, str]], capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, _, err = run_rig(["bench", "renderers", "--quick", *mode], capsys)
+    _assert_exits_2_saying(code, err, "renderer 'warp' has no option 'bogus'")
+    assert err.strip().count("\n") == 0, err
