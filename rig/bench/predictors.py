@@ -193,6 +193,8 @@ def run(args: argparse.Namespace, context: Context) -> Scores | CorpusRun:
         raise ConfigError("--leave-one-out needs at least two traces: it tunes on all but one")
     specs = args.predictor or [(name, {}) for name in predictors.names()]
     specs += [] if (BASELINE, {}) in specs else [(BASELINE, {})]
+    for name, params in specs:
+        predictors.make(name, **params)  # a parameter it does not take is refused before any work, not a failed row per trace
     failed: list[FailedEvaluation] = []
     results = evaluate_all(traces, specs, horizons, args.timing_repeats, context.progress("benchmarking predictors"), failed)
     for failure in failed:

@@ -106,6 +106,16 @@ def test_a_predictor_bench_whose_every_evaluation_raised_writes_the_failures_and
     assert (tmp_path / "predictors.png").stat().st_size > 0
 
 
+def test_a_predictor_bench_refuses_a_parameter_out_of_range_before_any_evaluation(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    evaluated: list[str] = []
+    monkeypatch.setattr(predictor_scores, "evaluate", lambda name, *_: evaluated.append(name))
+    code, _, err = run_rig(["bench", "predictors", "--trace", str(_tiny_trace(tmp_path)), "--predictor", "desp:position_alpha=7"], capsys)
+    _assert_exits_2_saying(code, err, "desp: position_alpha must be a positive number below 1, got 7")
+    assert evaluated == []
+
+
 def test_a_predictor_that_fails_on_a_trace_is_a_row_beside_the_scores_of_the_others(tmp_path: Path) -> None:
     t = np.arange(120) / 60.0
     trace = Trace.from_samples("tiny", t, np.outer(t, [0.2, 0.0, 0.0]), quat.from_rotation_vector(np.outer(t, [0, 1.0, 0])))
