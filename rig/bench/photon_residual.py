@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from rig.bench.contract import Bench, Context, cell
-from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_latency import check_predictors, film_latency
 from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import machine_name
 from rig.bench.renderers import BenchGrid, plain, with_options
@@ -39,6 +39,7 @@ def run(spec: ResidualSpec, context: Context) -> list[dict[str, Any]]:
     """A row per predictor and photon target, the server's cost modelled at DEFAULT_SERVER_MS (or
     the grid's `server_ms`)."""
     grid = replace(spec.grid, server_ms=spec.grid.server_ms if spec.grid.server_ms is not None else DEFAULT_SERVER_MS)
+    check_predictors(*spec.predictors)
     machine = machine_name()
     rows = []
     for predictor in spec.predictors:

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
+from predictors import make as make_predictor
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import USER_ERRORS
 from rig.service.sweep import (
@@ -176,6 +177,14 @@ def unsimulated_figures(config: SimulationConfig, error: Exception) -> dict[str,
     """The figures of a run whose simulation was refused: nothing filmed, failed with the reason."""
     reason = f"not simulated: {error}"
     return {**_no_figures(config), "latency_note": reason, "failed": reason}
+
+
+def check_predictors(*names: str | None) -> None:
+    """Make each predictor named (None: none) once: one that cannot be made is refused
+    (PredictorError) before a bench times or films anything, not a failed film per load."""
+    for name in names:
+        if name is not None:
+            make_predictor(name)
 
 
 def film_row(point: SweepPoint) -> dict[str, Any]:

@@ -55,7 +55,7 @@ from predictors import Pose
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, Log, SpecFile, given
 from rig.bench.renderer_estimate import estimated_hours
-from rig.bench.renderer_latency import LatencyRun, film_latencies
+from rig.bench.renderer_latency import LatencyRun, check_predictors, film_latencies
 from rig.bench.renderer_rows import every_row_failed, table
 from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup, warp_renderer
 from rig.bench.spec_reader import read_spec
@@ -280,6 +280,7 @@ def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
     latency films (simulate, then analyse: a sweep into the context's folder) on its executor."""
     log = context.log
     warp_renderer(grid.warp)
+    check_predictors(grid.predictor, grid.direct_predictor)
     machine = machine_name()
     log(f"machine: {machine}")
     rows: list[dict[str, Any]] = []

@@ -34,7 +34,7 @@ import numpy as np
 from declared import Range, setting
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
-from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_latency import check_predictors, film_latency
 from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import machine_name, open_warp, pose_of, scene_setup
 from rig.bench.renderers import BenchGrid, plain, time_direct, with_options
@@ -136,6 +136,7 @@ def _probe_warp(grid: BenchGrid, setup, pendulum) -> tuple[float, float]:
 def run(spec: SeedTableSpec, context: Context) -> list[dict[str, Any]]:
     """Our rows (see the module docstring), one per renderer and load size."""
     log, runs_dir, grid = context.log, context.folder, spec.grid
+    check_predictors(grid.predictor)
     machine = machine_name()
     log(f"machine: {machine}; load: {spec.load}; warp: {grid.warp}")
     rows: list[dict[str, Any]] = []

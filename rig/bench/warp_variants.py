@@ -21,7 +21,7 @@ import numpy as np
 
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
-from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_latency import check_predictors, film_latency
 from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import QUALITY_FIGURES, machine_name, open_warp, scene_setup, warp_renderer
 from rig.bench.renderers import BenchGrid, measure_warp_quality, plain, time_direct, time_warp_rounds, with_options
@@ -59,6 +59,7 @@ def run(spec: VariantSpec, context: Context) -> list[dict[str, Any]]:
     log, runs_dir = context.log, context.folder
     for variant in spec.variants:
         warp_renderer(variant)
+    check_predictors(spec.grid.predictor)
     machine = machine_name()
     log(f"machine: {machine}; load: {spec.load}")
     grid = spec.grid

@@ -282,10 +282,18 @@ def test_a_renderer_mode_whose_every_film_failed_writes_its_rows_and_exits_2(
     assert "failed: " in printed and "not simulated: the film would hold too few frames" in printed
 
 
-@pytest.mark.parametrize("mode", [["--warp", "warp:bogus=1"], ["--variants", "--variant", "warp", "--variant", "warp:bogus=1"]])
-def test_a_renderer_bench_refuses_a_warp_spec_it_cannot_make_before_any_timing(
-    mode: list[str], run_rig: Callable[..., tuple[int, str, str]], capsys: pytest.CaptureFixture[str],
+@pytest.mark.parametrize(("mode", "refusal"), [
+    (["--warp", "warp:bogus=1"], "renderer 'warp' has no option 'bogus'"),
+    (["--variants", "--variant", "warp", "--variant", "warp:bogus=1"], "renderer 'warp' has no option 'bogus'"),
+    (["--predictor", "bogus"], "unknown predictor 'bogus'"),
+    (["--direct-predictor", "bogus"], "unknown predictor 'bogus'"),
+    (["--seed-table", "--predictor", "bogus"], "unknown predictor 'bogus'"),
+    (["--variants", "--predictor", "bogus"], "unknown predictor 'bogus'"),
+    (["--photon-residual", "--residual-predictor", "bogus"], "unknown predictor 'bogus'"),
+])  # fmt: skip
+def test_a_renderer_bench_refuses_a_warp_or_predictor_it_cannot_make_before_any_timing(
+    mode: list[str], refusal: str, run_rig: Callable[..., tuple[int, str, str]], capsys: pytest.CaptureFixture[str],
 ) -> None:
     code, _, err = run_rig(["bench", "renderers", "--quick", *mode], capsys)
-    _assert_exits_2_saying(code, err, "renderer 'warp' has no option 'bogus'")
+    _assert_exits_2_saying(code, err, refusal)
     assert err.strip().count("\n") == 0, err
