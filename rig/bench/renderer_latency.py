@@ -173,9 +173,8 @@ def film_figures(filmed: PointRun) -> dict[str, Any]:
     }
 
 
-def unsimulated_figures(config: SimulationConfig, error: Exception) -> dict[str, Any]:
-    """The figures of a run whose simulation was refused: nothing filmed, failed with the reason."""
-    reason = f"not simulated: {error}"
+def failed_figures(config: SimulationConfig, reason: str) -> dict[str, Any]:
+    """The figures of a run that was not filmed (its simulation refused, its costs not timed): failed with `reason`."""
     return {**_no_figures(config), "latency_note": reason, "failed": reason}
 
 
@@ -193,7 +192,7 @@ def film_row(point: SweepPoint) -> dict[str, Any]:
     try:
         filmed = simulate_and_analyse(point)
     except USER_ERRORS as error:
-        return unsimulated_row(point, error) | {"film": unsimulated_figures(point.config, error)}
+        return unsimulated_row(point, error) | {"film": failed_figures(point.config, f"not simulated: {error}")}
     return filmed.row | {"film": film_figures(filmed)}
 
 
@@ -209,7 +208,7 @@ def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: 
     try:
         return film_figures(simulate_and_analyse(point))
     except USER_ERRORS as error:
-        return unsimulated_figures(point.config, error)
+        return failed_figures(point.config, f"not simulated: {error}")
 
 
 def film_latencies(

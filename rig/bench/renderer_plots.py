@@ -76,7 +76,8 @@ def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path
         for rows, filled, who in ((ours, True, "this machine"), (seed, False, "seed Table 2")):
             for renderer, colour in (("direct", "tab:red"), ("warp", "tab:blue")):
                 _latency_series(left, rows, renderer, colour, f"{renderer}, {who}", "o" if filled else "s", filled)
-                frame = {r["triangles"]: r["frame_ms_median"] / r["refresh_ms"] for r in rows if r["renderer"] == "direct"}
+                frame = {r["triangles"]: r["frame_ms_median"] / r["refresh_ms"] for r in rows
+                         if r["renderer"] == "direct" and r["frame_ms_median"] is not None}  # fmt: skip
                 points = sorted((frame[r["triangles"]], r["latency_refreshes"]) for r in rows
                                 if r["renderer"] == renderer and r["latency_refreshes"] is not None and r["triangles"] in frame)  # fmt: skip
                 if points:
@@ -86,8 +87,8 @@ def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path
                  title=f"latency against scene size, measured by filming\nthis machine: {label}")  # fmt: skip
         right.set(xscale="log", yscale="log", xlabel="direct frame time (display refreshes)", ylabel="latency (display refreshes)",
                   title="machine-independent: both in refreshes")  # fmt: skip
-        for axis in axes:
-            axis.legend(fontsize=8)
+        _legend_or_say(left, "no latency was measured\n(the table says why)")
+        _legend_or_say(right, "no latency was measured\n(the table says why)")
 
     _draw(path, draw)
 

@@ -297,3 +297,21 @@ def test_a_renderer_bench_refuses_a_warp_or_predictor_it_cannot_make_before_any_
     code, _, err = run_rig(["bench", "renderers", "--quick", *mode], capsys)
     _assert_exits_2_saying(code, err, refusal)
     assert err.strip().count("\n") == 0, err
+
+
+def test_a_seed_table_whose_first_load_cannot_be_drawn_stops_there_with_failed_rows_and_exits_2(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def undrawable(width: int, height: int, triangles: int, *_: Any) -> None:
+        raise RigError(f"{triangles} triangles are more than this GPU draws")
+
+    monkeypatch.setattr(seed_table, "scene_setup", undrawable)
+    out, plot = tmp_path / "seed.json", tmp_path / "seed.png"
+    code, printed, err = run_rig(["bench", "renderers", "--quick", "--seed-table", "--json", str(out), "--plot", str(plot)], capsys)
+    _assert_exits_2_saying(code, err, "every one of the 2 rows failed (the first: direct on 1000 triangles: not timed: 1000 triangles are more")
+    mine = [r for r in json.loads(out.read_text()) if r["source"] == "this machine"]
+    assert [(r["renderer"], r["triangles"], r["failed"]) for r in mine] == [
+        (renderer, 1000, "not timed: 1000 triangles are more than this GPU draws") for renderer in ("direct", "warp")
+    ]
+    assert "failed: warp on 1000 triangles: not timed: 1000 triangles are more than this GPU draws" in printed
+    assert plot.stat().st_size > 0
