@@ -15,7 +15,7 @@ import pytest
 from predictors import PredictorError, Trace, write_trace
 from predictors import quaternion as quat
 from rig.bench import (
-    batch, camera_calibration, live, predictor_scores, renderer_latency, renderer_rows, renderers, seed_table, trackers,
+    batch, camera_calibration, live, predictor_scores, renderer_latency, renderer_rows, renderers, seed_table, trackers, warp_variants,
 )
 from rig.cli import EXIT_USER_ERROR
 from rig.errors import RigError
@@ -314,4 +314,26 @@ def test_a_seed_table_whose_first_load_cannot_be_drawn_stops_there_with_failed_r
         (renderer, 1000, "not timed: 1000 triangles are more than this GPU draws") for renderer in ("direct", "warp")
     ]
     assert "failed: warp on 1000 triangles: not timed: 1000 triangles are more than this GPU draws" in printed
+    assert plot.stat().st_size > 0
+
+
+def test_a_warp_variant_that_cannot_be_opened_is_a_failed_row_beside_the_others(
+    run_rig: Callable[..., tuple[int, str, str]], tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    opened = warp_variants.open_warp
+
+    def two_views_refused(variant: str, *args: Any) -> Any:
+        if "views=2" in variant:
+            raise RigError("two views need more texture memory than this GPU has")
+        return opened(variant, *args)
+
+    monkeypatch.setattr(warp_variants, "open_warp", two_views_refused)
+    monkeypatch.setattr(warp_variants, "film_latency", lambda run, *_: renderer_latency.failed_figures(renderer_latency.run_config(run), "not filmed here"))
+    out, plot = tmp_path / "variants.json", tmp_path / "variants.png"
+    code, printed, err = run_rig(["bench", "renderers", "--quick", "--variants", "--json", str(out), "--plot", str(plot)], capsys)
+    _assert_exits_2_saying(code, err, "every one of the 2 rows failed")
+    warp, two_views = json.loads(out.read_text())
+    assert (warp["failed"], warp["ssim"] > 0.9) == ("not filmed here", True)
+    assert (two_views["failed"], two_views["ssim"]) == ("not timed: two views need more texture memory than this GPU has", None)
+    assert "warp:views=2,recon=grid,holes=1" in printed and "failed: not timed: two views need more texture memory" in printed
     assert plot.stat().st_size > 0
