@@ -137,7 +137,8 @@ def cost_ratios(results: Sequence[Evaluation]) -> dict[str, float]:
 @dataclass(frozen=True)
 class HeldOut:
     """A predictor tuned at `horizon_ms` on every trace but `trace`, scored on `trace`: its angular
-    and position RMS error there over constant velocity's, and its defaults' ratios beside them."""
+    and position RMS error there over constant velocity's, and its defaults' ratios beside them; or,
+    where the tuning or a score raised, NaN ratios and why (`failed`)."""
 
     predictor: str
     trace: str
@@ -147,36 +148,46 @@ class HeldOut:
     position: float
     defaults_angular: float
     defaults_position: float
+    failed: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready values (None for a ratio on a trace without that part)."""
         return {k: finite_or_none(v) if isinstance(v, float) else v for k, v in vars(self).items()}
 
 
+def _held_out(name: str, trace: Trace, others: Sequence[Trace], horizon_ms: float, max_iterations: int) -> HeldOut:
+    """`name` tuned on `others` and scored on `trace`, against its defaults and the baseline."""
+    from predictors.tuning import tune  # imports JAX: only when asked
+
+    horizon = horizon_ms / 1e3
+    params = tune(name, others, horizon, max_iterations=max_iterations).params
+    scores = {
+        key: evaluate(predictor, trace, [horizon], given, timing_repeats=0).scores[0]
+        for key, predictor, given in (("tuned", name, params), ("defaults", name, {}), ("baseline", BASELINE, {}))
+    }
+    base = scores["baseline"]
+    return HeldOut(
+        name, trace.name, horizon_ms, params,
+        _ratio(scores["tuned"].angular_rms_deg, base.angular_rms_deg),
+        _ratio(scores["tuned"].position_rms_mm, base.position_rms_mm),
+        _ratio(scores["defaults"].angular_rms_deg, base.angular_rms_deg),
+        _ratio(scores["defaults"].position_rms_mm, base.position_rms_mm),
+    )
+
+
 def leave_one_out(
     name: str, traces: Sequence[Trace], horizon_ms: float, max_iterations: int,
     progress: Callable[[float, float], object] | None = None,
 ) -> list[HeldOut]:
-    """Tune `name` on all traces but one and score it on that one, for each trace in turn."""
-    from predictors.tuning import tune  # imports JAX: only when asked
-
-    horizon = horizon_ms / 1e3
+    """Tune `name` on all traces but one and score it on that one, for each trace in turn; a fold
+    that raises is a failed `HeldOut` with its reason, and the others still run."""
     held = []
     for k, trace in enumerate(traces):
         others = [t for i, t in enumerate(traces) if i != k]
-        params = tune(name, others, horizon, max_iterations=max_iterations).params
-        scores = {
-            key: evaluate(predictor, trace, [horizon], given, timing_repeats=0).scores[0]
-            for key, predictor, given in (("tuned", name, params), ("defaults", name, {}), ("baseline", BASELINE, {}))
-        }
-        base = scores["baseline"]
-        held.append(HeldOut(
-            name, trace.name, horizon_ms, params,
-            _ratio(scores["tuned"].angular_rms_deg, base.angular_rms_deg),
-            _ratio(scores["tuned"].position_rms_mm, base.position_rms_mm),
-            _ratio(scores["defaults"].angular_rms_deg, base.angular_rms_deg),
-            _ratio(scores["defaults"].position_rms_mm, base.position_rms_mm),
-        ))
+        try:
+            held.append(_held_out(name, trace, others, horizon_ms, max_iterations))
+        except Exception as error:
+            held.append(HeldOut(name, trace.name, horizon_ms, {}, math.nan, math.nan, math.nan, math.nan, failure_reason(error)))
         if progress is not None:
             progress(k + 1, len(traces))
     return held

@@ -111,6 +111,9 @@ def held_out_table(held: Sequence[HeldOut]) -> str:
     """A Markdown table of leave-one-trace-out ratios to constant velocity: tuned, and defaults."""
     rows = ["| predictor | held-out trace | horizon | tuned: angular, position | defaults: angular, position |", "|---|---|---|---|---|"]
     for h in held:
+        if h.failed is not None:
+            rows.append(f"| {h.predictor} | {h.trace} | {h.horizon_ms:g} ms | failed: {h.failed} | |")
+            continue
         rows.append(
             f"| {h.predictor} | {h.trace} | {h.horizon_ms:g} ms | {h.angular:.3f}, {h.position:.3f} | "
             f"{h.defaults_angular:.3f}, {h.defaults_position:.3f} |"

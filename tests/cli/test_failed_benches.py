@@ -14,6 +14,7 @@ import pytest
 
 from predictors import PredictorError, Trace, write_trace
 from predictors import quaternion as quat
+from rig.bench import predictors as predictors_bench
 from rig.bench import (
     batch, camera_calibration, live, predictor_scores, renderer_latency, renderer_rows, renderers, seed_table, trackers, warp_variants,
 )
@@ -337,3 +338,19 @@ def test_a_warp_variant_that_cannot_be_opened_is_a_failed_row_beside_the_others(
     assert (two_views["failed"], two_views["ssim"]) == ("not timed: two views need more texture memory than this GPU has", None)
     assert "warp:views=2,recon=grid,holes=1" in printed and "failed: not timed: two views need more texture memory" in printed
     assert plot.stat().st_size > 0
+
+
+def test_a_leave_one_out_fold_that_raises_is_a_failed_row_beside_the_others(monkeypatch: pytest.MonkeyPatch) -> None:
+    def fold(name: str, trace: Trace, *_: Any) -> predictor_scores.HeldOut:
+        if trace.name == "b":
+            raise PredictorError("the fit diverged")
+        return predictor_scores.HeldOut(name, trace.name, 50.0, {"position_alpha": 0.5}, 0.9, 0.8, 1.0, 1.0)
+
+    monkeypatch.setattr(predictor_scores, "_held_out", fold)
+    t = np.arange(120) / 60.0
+    traces = [Trace.from_samples(name, t, np.outer(t, [0.2, 0.0, 0.0]), quat.from_rotation_vector(np.outer(t, [0, 1.0, 0]))) for name in "abc"]
+    held = predictor_scores.leave_one_out("desp", traces, 50.0, 5)
+    assert [(h.trace, h.failed) for h in held] == [("a", None), ("b", "the fit diverged"), ("c", None)]
+    assert held[1].to_dict()["angular"] is None
+    table = predictors_bench.held_out_table(held).splitlines()
+    assert table[3] == "| desp | b | 50 ms | failed: the fit diverged | |" and table[2].startswith("| desp | a | 50 ms | 0.900, 0.800 |")
