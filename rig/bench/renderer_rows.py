@@ -38,6 +38,13 @@ def table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def untimed_rows(where: dict[str, Any], warp: str, ratios: tuple[int, ...], reason: str) -> list[dict[str, Any]]:
+    """The rows of a load that could not be timed at one display size (`where`: the row's fields so
+    far, the load and size among them), direct and warp at each rate ratio, each failed with `reason`."""
+    failed = {**where, "failed": reason}
+    return [{**failed, "renderer": "direct", "spec": "direct"}, *({**failed, "renderer": "warp", "spec": warp, "rate_ratio": r} for r in ratios)]
+
+
 def every_row_failed(rows: list[dict[str, Any]]) -> str | None:
     """A sentence where every row failed (its load could not be timed, or its latency film
     failed), else None."""

@@ -56,7 +56,7 @@ from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, Log, SpecFile, given
 from rig.bench.renderer_estimate import estimated_hours
 from rig.bench.renderer_latency import LatencyRun, check_predictors, film_latencies
-from rig.bench.renderer_rows import every_row_failed, table
+from rig.bench.renderer_rows import every_row_failed, table, untimed_rows
 from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup, warp_renderer
 from rig.bench.spec_reader import read_spec
 from rig.commands import options
@@ -243,7 +243,9 @@ def warp_row(base: dict[str, Any], m: WarpMeasurement, triangles: int, size: tup
     }  # fmt: skip
 
 
-def timed_load(grid: BenchGrid, size: tuple[int, int], triangles: int, base: dict[str, Any], log: Log) -> tuple[dict[str, Any], WarpMeasurement, float]:
+def timed_load(
+    grid: BenchGrid, size: tuple[int, int], triangles: int, base: dict[str, Any], log: Log
+) -> tuple[dict[str, Any], WarpMeasurement, float]:
     """One load at one display size: its direct row, the warp renderer opened on it with its image
     error measured (the caller closes it, and times its rounds), and the direct frame's median (s)."""
     width, height = size
@@ -268,12 +270,6 @@ def timed_load(grid: BenchGrid, size: tuple[int, int], triangles: int, base: dic
     return row, m, float(np.median(direct))
 
 
-def untimed_rows(base: dict[str, Any], grid: BenchGrid, size: tuple[int, int], triangles: int, reason: str) -> list[dict[str, Any]]:
-    """The rows of a load that could not be timed at one display size, direct and warp, each failed with `reason`."""
-    where = {**base, "triangles": triangles, "width": size[0], "height": size[1], "failed": reason}
-    return [{**where, "renderer": "direct", "spec": "direct"}, *({**where, "renderer": "warp", "spec": grid.warp, "rate_ratio": ratio} for ratio in grid.ratios)]
-
-
 def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
     """Every row of the benchmark (see the module docstring). The timings run here, one at a time
     (a load that cannot be drawn is failed rows with the reason, and the others still run); the
@@ -296,7 +292,7 @@ def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
                     row, m, direct_s = timed_load(grid, (width, height), triangles, base, log)
                 except RigError as error:
                     log(f"{width}x{height} {triangles:>9} triangles: failed: {error}")
-                    rows += untimed_rows(base, grid, (width, height), triangles, str(error))
+                    rows += untimed_rows({**base, "triangles": triangles, "width": width, "height": height}, grid.warp, grid.ratios, str(error))
                     continue
                 rows.append(row)
                 measurements.append(m)

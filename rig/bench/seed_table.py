@@ -160,8 +160,8 @@ def run(spec: SeedTableSpec, context: Context) -> list[dict[str, Any]]:
         except RigError as error:
             log(f"{triangles} triangles: not timed: {error}; the table stops here")
             for renderer in ("direct", grid.warp):
-                figures = failed_figures(run_config(grid.latency_run(renderer, triangles, grid.predictor, load=spec.load)), f"not timed: {error}")
-                rows.append(_row(figures, renderer, spec.load, refresh_ms, machine))
+                config = run_config(grid.latency_run(renderer, triangles, grid.predictor, load=spec.load))
+                rows.append(_row(failed_figures(config, f"not timed: {error}"), renderer, spec.load, refresh_ms, machine))
             break
         if direct_s > spec.max_frame_s:
             log(f"{triangles} triangles: a direct frame takes {direct_s:.1f} s, over {spec.max_frame_s:g} s; the table stops here")

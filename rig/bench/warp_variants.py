@@ -136,7 +136,8 @@ def variants_text(rows: list[dict[str, Any]]) -> str:
         )
     lines.append(f"image figures: means over the warped frames (client:display 1:{rows[0]['rate_ratio']}); "
                  f"{', '.join(QUALITY_FIGURES)}" if rows else "no rows")  # fmt: skip
-    lines += [f"failed: {r['spec']} on {r['triangles']} triangles: {r['failed']}" for r in rows if r["failed"] and r["server_ms_median"] is not None]
+    films_failed = [r for r in rows if r["failed"] and r["server_ms_median"] is not None]
+    lines += [f"failed: {r['spec']} on {r['triangles']} triangles: {r['failed']}" for r in films_failed]
     return "\n".join(lines)
 
 
