@@ -13,7 +13,9 @@
   machine) and then filled (every later run).
 
 Every figure is wall time on this machine with whatever else runs on it; compare ratios taken in
-one run.
+one run. A video that cannot be simulated is left out of the batch, saying why; a part that cannot
+be measured (no video, a run that fails or a worker that dies) is failed with the reason, and the
+other part is still measured.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from typing import Any
 from rig.bench.batch_settings import BatchBenchOptions
 from rig.bench.contract import Bench, Context, Log
 from rig.commands.declared_options import config_from_args
-from rig.errors import ConfigError
+from rig.errors import ConfigError, RigError
 from rig.executor import worker_environment
 from rig.service.simulate import simulate
 from rig.sim.config import SimulationConfig
@@ -42,24 +44,30 @@ DECODE_ONLY = "import sys; from analysis.video.sources import open_frames; sum(1
 
 
 def _process_seconds(arguments: list[str], environment: dict[str, str], allowed: tuple[int, ...] = (0,)) -> float:
-    """Wall time of a command; RuntimeError with its error output if it exits otherwise than `allowed`."""
+    """Wall time of a command; RigError with its error output if it exits otherwise than `allowed`."""
     started = time.perf_counter()
     done = subprocess.run(arguments, capture_output=True, text=True, env=environment)
     if done.returncode not in allowed:
-        raise RuntimeError(f"{' '.join(arguments)} exited {done.returncode}: {done.stderr.strip()[-500:]}")
+        raise RigError(f"{' '.join(arguments)} exited {done.returncode}: {done.stderr.strip()[-500:]}")
     return time.perf_counter() - started
 
 
 
 
-def videos(folder: Path, count: int, duration_s: float, log: Log) -> list[Path]:
-    """`count` simulated videos over a few pendulum periods, each with its own seed."""
-    made = []
+def videos(folder: Path, count: int, duration_s: float, log: Log) -> tuple[list[Path], list[dict[str, Any]]]:
+    """`count` simulated videos over a few pendulum periods, each with its own seed; and those that
+    could not be simulated, each with its reason."""
+    made, failed = [], []
     for index in range(count):
         config = SimulationConfig(duration_s=duration_s, seed=index, pendulum=PendulumConfig(period_s=PERIODS_S[index % len(PERIODS_S)]))
-        made.append(simulate(config, folder / f"video{index:02d}", overwrite=True).video_path)
+        try:
+            made.append(simulate(config, folder / f"video{index:02d}", overwrite=True).video_path)
+        except RigError as error:
+            failed.append({"video": index, "failed": str(error)})
+            log(f"video {index + 1}/{count} not simulated: {error}")
+            continue
         log(f"simulated {index + 1}/{count}")
-    return made
+    return made, failed
 
 
 def batch_seconds(videos: list[Path], workers: int | None, environment: dict[str, str] | None = None) -> float:
@@ -75,7 +83,10 @@ def batch_seconds(videos: list[Path], workers: int | None, environment: dict[str
 
 def scale_out(paths: list[Path], workers: int, rounds: int, log: Log) -> dict[str, Any]:
     """The batch serially and on Dask, alternately `rounds` times (a shared machine's load drifts
-    between runs), and the one-video batch likewise; medians, and the speed-up of each round."""
+    between runs), and the one-video batch likewise; medians, and the speed-up of each round.
+    RigError where there is no video or a run fails."""
+    if not paths:
+        raise RigError("no video of the batch could be simulated")
     batch_seconds(paths[:1], None)  # fills the compiled-fit cache, as any earlier run on the machine has
     as_worker = worker_environment(workers)
     serial, parallel, serial_as_worker, one_serial, one_dask = [], [], [], [], []
@@ -125,27 +136,50 @@ def fixed_cost(clip: Path, log: Log) -> dict[str, Any]:
     }
 
 
+def clip_cost(folder: Path, duration_s: float, log: Log) -> dict[str, Any]:
+    """A clip simulated into `folder`, then its fixed cost (`fixed_cost`)."""
+    clip = simulate(replace(SimulationConfig(duration_s=duration_s), seed=99), folder, overwrite=True).video_path
+    return fixed_cost(clip, log)
+
+
 def run(spec: BatchBenchOptions, context: Context) -> dict[str, Any]:
-    """The batch's scale-out and a clip's fixed cost (see the module docstring)."""
-    paths = videos(context.folder / "batch", spec.videos, spec.duration_s, context.log)
-    clip = simulate(replace(SimulationConfig(duration_s=spec.clip_duration_s), seed=99), context.folder / "clip", overwrite=True).video_path
-    return {"scale_out": scale_out(paths, spec.workers, spec.rounds, context.log), "fixed_cost": fixed_cost(clip, context.log)}
+    """The batch's scale-out and a clip's fixed cost (see the module docstring); a part that cannot
+    be measured is `{"failed": reason}` in its place, the videos left out under "unsimulated"."""
+    paths, unsimulated = videos(context.folder / "batch", spec.videos, spec.duration_s, context.log)
+    report: dict[str, Any] = {"unsimulated": unsimulated}
+    for part, measure in (("scale_out", lambda: scale_out(paths, spec.workers, spec.rounds, context.log)),
+                          ("fixed_cost", lambda: clip_cost(context.folder / "clip", spec.clip_duration_s, context.log))):  # fmt: skip
+        try:
+            report[part] = measure()
+        except RigError as error:
+            context.log(f"{part.replace('_', ' ')} failed: {error}")
+            report[part] = {"failed": str(error)}
+    return report
+
+
+def every_part_failed(report: dict[str, Any]) -> str | None:
+    """A sentence where neither the scale-out nor the fixed cost could be measured, else None."""
+    if "failed" not in report["scale_out"] or "failed" not in report["fixed_cost"]:
+        return None
+    return f"every part failed (the batch: {report['scale_out']['failed']}; the clip: {report['fixed_cost']['failed']})"
 
 
 def table(report: dict[str, Any]) -> str:
     s, f = report["scale_out"], report["fixed_cost"]
-    return "\n".join(
-        [
-            f"batch of {s['videos']} videos (median of {s['rounds']} rounds): serial {s['serial_s']:.1f} s, "
-            f"{s['workers']} Dask workers {s['dask_s']:.1f} s, speed-up {s['speed_up']:.2f} "
-            f"(rounds: {', '.join(f'{r:.2f}' for r in s['speed_up_per_round'])})",
-            f"ceiling: serially with a worker's threads (OpenCV {s['worker_opencv_threads']}) {s['serial_as_worker_s']:.1f} s, so "
-            f"{s['workers']} workers can be at most {s['ceiling_speed_up']:.2f} times as fast as serially, before the cluster's start",
-            f"Dask overhead for one video: {s['dask_overhead_s']:+.1f} s ({s['one_video_dask_s']:.1f} s against {s['one_video_serial_s']:.1f} s)",
-            f"fixed cost of a clip in a fresh process: analyse / decode alone = {f['ratio_cold']:.2f} (empty cache), "
-            f"{f['ratio_warm']:.2f} (filled cache); decode alone {f['decode_s']:.1f} s",
-        ]
-    )
+    left_out = [f"video {v['video']} not simulated: {v['failed']}" for v in report.get("unsimulated", ())]
+    batch_lines = [f"batch: failed: {s['failed']}"] if "failed" in s else [
+        f"batch of {s['videos']} videos (median of {s['rounds']} rounds): serial {s['serial_s']:.1f} s, "
+        f"{s['workers']} Dask workers {s['dask_s']:.1f} s, speed-up {s['speed_up']:.2f} "
+        f"(rounds: {', '.join(f'{r:.2f}' for r in s['speed_up_per_round'])})",
+        f"ceiling: serially with a worker's threads (OpenCV {s['worker_opencv_threads']}) {s['serial_as_worker_s']:.1f} s, so "
+        f"{s['workers']} workers can be at most {s['ceiling_speed_up']:.2f} times as fast as serially, before the cluster's start",
+        f"Dask overhead for one video: {s['dask_overhead_s']:+.1f} s ({s['one_video_dask_s']:.1f} s against {s['one_video_serial_s']:.1f} s)",
+    ]
+    clip_lines = [f"fixed cost of a clip: failed: {f['failed']}"] if "failed" in f else [
+        f"fixed cost of a clip in a fresh process: analyse / decode alone = {f['ratio_cold']:.2f} (empty cache), "
+        f"{f['ratio_warm']:.2f} (filled cache); decode alone {f['decode_s']:.1f} s",
+    ]
+    return "\n".join(batch_lines + clip_lines + left_out)
 
 
 def plot(report: dict[str, Any], path: Path) -> None:
@@ -155,17 +189,31 @@ def plot(report: dict[str, Any], path: Path) -> None:
     s, f = report["scale_out"], report["fixed_cost"]
     figure = Figure(figsize=(10, 3.8), layout="constrained")
     batch, clip = figure.subplots(1, 2)
+    for axis, part, draw in ((batch, s, _draw_batch), (clip, f, _draw_clip)):
+        if "failed" in part:
+            axis.set_axis_off()
+            axis.text(0.5, 0.5, "failed (the table says why)", ha="center", va="center", transform=axis.transAxes)
+        else:
+            draw(axis, part)
+    figure.savefig(path, dpi=100)
+
+
+def _draw_batch(batch: Any, s: dict[str, Any]) -> None:
     batch.bar(["serial", "serial with\na worker's threads", f"{s['workers']} Dask workers"],
               [s["serial_s"], s["serial_as_worker_s"], s["dask_s"]], color=["C0", "grey", "C1"])  # fmt: skip
     batch.set_ylabel("wall time (s)")
     batch.set_xlabel(f"batch of {s['videos']} videos")
     batch.set_title(f"speed-up {s['speed_up']:.2f}, ceiling {s['ceiling_speed_up']:.2f}")
+
+
+def _draw_clip(clip: Any, f: dict[str, Any]) -> None:
     clip.bar(["decode alone", "analyse,\nempty cache", "analyse,\nfilled cache"],
              [f["decode_s"], f["analyse_cold_cache_s"], f["analyse_warm_cache_s"]], color=["grey", "C3", "C2"])  # fmt: skip
     clip.set_ylabel("wall time in a fresh process (s)")
     clip.set_xlabel("one clip")
     clip.set_title(f"fixed cost: {f['ratio_warm']:.2f} x decoding (filled cache)")
-    figure.savefig(path, dpi=100)
 
 
-BENCH = Bench(run=run, table=table, plot=plot, spec=lambda args: config_from_args(BatchBenchOptions, args, ConfigError))
+BENCH = Bench(
+    run=run, table=table, plot=plot, spec=lambda args: config_from_args(BatchBenchOptions, args, ConfigError), all_failed=every_part_failed,
+)

@@ -11,7 +11,8 @@
    the swap's return to its row being written and flushed to the swap log (`display_swaps.csv`).
 
 Figures are medians, 95th percentiles and maxima in microseconds; the machine is shared, so compare
-them within one run.
+them within one run. A measurement that cannot be made (no X display, a run that timed nothing) is
+its row failed with the reason, and the other is still made.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ import numpy as np
 
 from rig.bench.contract import Bench, Context
 from rig.clock import MonotonicClock
+from rig.errors import RigError
 from rig.devices.window import SWAP_COLUMNS, SwapRecord, WindowDisplay, WindowSettings
 from rig.live.run import LiveConfig, run_live
 from rig.live.selftest.emulator import EmulatedPendulum
@@ -42,6 +44,9 @@ TRACKER_HZ = 1000.0
 REFRESH_HZ = 60.0
 SIZE = (160, 120)
 SWAPS = 300
+MEASURED = (("arrival_to_pose", "sample arrival to pose"), ("frame_start_to_pose", "  of which the frame's own"),
+            ("swap_to_log", "swap to logged"))  # fmt: skip
+"""Each figure of the report, and its row's label."""
 
 
 def _column(path: Path, *names: str) -> list[np.ndarray]:
@@ -50,8 +55,11 @@ def _column(path: Path, *names: str) -> list[np.ndarray]:
     return [np.array([float(row[name]) for row in rows]) for name in names]
 
 
-def _figures(seconds: np.ndarray) -> dict[str, Any]:
+def _figures(seconds: np.ndarray, what: str) -> dict[str, Any]:
+    """The median, 95th percentile and maximum (us) of `what`; RigError where nothing was timed."""
     us = np.asarray(seconds) * 1e6
+    if us.size == 0:
+        raise RigError(f"nothing was timed: no {what} was recorded")
     return {"count": int(us.size), "median_us": float(np.median(us)), "p95_us": float(np.percentile(us, 95)), "max_us": float(us.max())}
 
 
@@ -64,7 +72,8 @@ def arrival_to_pose(out_dir: Path) -> dict[str, Any]:
     start_of = dict(zip(index.astype(int).tolist(), start.tolist()))
     waits = [p - arrival_of[s] for p, s in zip(published, behind) if s in arrival_of]
     own = [p - start_of[int(f)] for p, f in zip(published, frame) if int(f) in start_of]
-    return {"arrival_to_pose": _figures(np.array(waits)), "frame_start_to_pose": _figures(np.array(own))}
+    return {"arrival_to_pose": _figures(np.array(waits), "pose with its sample's arrival"),
+            "frame_start_to_pose": _figures(np.array(own), "pose with its frame's start")}
 
 
 def swap_to_log(out_dir: Path, swaps: int = SWAPS) -> dict[str, Any]:
@@ -85,13 +94,11 @@ def swap_to_log(out_dir: Path, swaps: int = SWAPS) -> dict[str, Any]:
                 display.present(image, clock.now(), k)
         finally:
             display.close()
-    return {"swap_to_log": _figures(np.array(delays))}
+    return {"swap_to_log": _figures(np.array(delays), "swap")}
 
 
-def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
-    """Both measurements (see the module docstring) after a live run of `args.duration` seconds, their
-    files in the context's folder."""
-    out_dir, duration_s = context.folder, args.duration
+def live_run(out_dir: Path, duration_s: float, context: Context) -> dict[str, Any]:
+    """The live run's figures, arrival to pose and the frame's own share, its files in `out_dir`/run."""
     clock = MonotonicClock()
     pendulum = Pendulum(PendulumConfig(), t_end=duration_s + 30.0)
     layout = make_layout(pendulum, CameraConfig(), DisplayConfig(width=SIZE[0], height=SIZE[1]))
@@ -105,19 +112,47 @@ def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
                  frame_clock=FixedRateFrameClock(REFRESH_HZ), clock=clock, overwrite=True)  # fmt: skip
     finally:
         emulator.close()
+    return arrival_to_pose(out_dir / "run")
+
+
+def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
+    """Both measurements (see the module docstring) after a live run of `args.duration` seconds, their
+    files in the context's folder; one that cannot be made is `{"failed": reason}` in its place."""
+    out_dir = context.folder
+    report: dict[str, Any] = {}
+    try:
+        report.update(live_run(out_dir, args.duration, context))
+    except RigError as error:
+        context.log(f"live run failed: {error}")
+        report.update({"arrival_to_pose": {"failed": str(error)}, "frame_start_to_pose": {"failed": str(error)}})
     context.log(f"swap to log: {SWAPS} swaps")
     load = os.getloadavg()[0]
     started = time.monotonic()
-    report = {**arrival_to_pose(out_dir / "run"), **swap_to_log(out_dir), "cpus": os.cpu_count(), "load_average_1min": load}
-    report["swap_bench_s"] = time.monotonic() - started
-    return report
+    try:
+        report.update(swap_to_log(out_dir))
+    except RigError as error:
+        context.log(f"swap to log failed: {error}")
+        report["swap_to_log"] = {"failed": str(error)}
+    return {**report, "cpus": os.cpu_count(), "load_average_1min": load, "swap_bench_s": time.monotonic() - started}
+
+
+def every_measurement_failed(report: dict[str, Any]) -> str | None:
+    """A sentence where neither measurement could be made, else None."""
+    if not all("failed" in report[key] for key, _ in MEASURED):
+        return None
+    live_failed, swaps_failed = report["arrival_to_pose"]["failed"], report["swap_to_log"]["failed"]
+    if live_failed == swaps_failed:
+        return f"every measurement failed: {live_failed}"
+    return f"every measurement failed (the live run: {live_failed}; the swaps: {swaps_failed})"
 
 
 def table(report: dict[str, Any]) -> str:
     lines = [f"{'what':<28}{'frames':>8}{'median us':>12}{'p95 us':>10}{'max us':>10}"]
-    for key, label in (("arrival_to_pose", "sample arrival to pose"), ("frame_start_to_pose", "  of which the frame's own"),
-                       ("swap_to_log", "swap to logged")):  # fmt: skip
+    for key, label in MEASURED:
         f = report[key]
+        if "failed" in f:
+            lines.append(f"{label:<28}failed: {f['failed']}")
+            continue
         lines.append(f"{label:<28}{f['count']:>8}{f['median_us']:>12.0f}{f['p95_us']:>10.0f}{f['max_us']:>10.0f}")
     return "\n".join(lines)
 
@@ -126,14 +161,18 @@ def plot(report: dict[str, Any], path: Path) -> None:
     """Each figure's median, with a bar to its 95th percentile."""
     from matplotlib.figure import Figure
 
-    keys = ("arrival_to_pose", "frame_start_to_pose", "swap_to_log")
     figure = Figure(figsize=(6.0, 3.0))
     axes = figure.subplots()
-    for i, key in enumerate(keys):
+    for i, (key, _) in enumerate(MEASURED):
         f = report[key]
-        axes.errorbar([f["median_us"]], [i], xerr=[[0.0], [f["p95_us"] - f["median_us"]]], fmt="o", capsize=4)
-    axes.set_yticks(range(len(keys)), ["sample arrival to pose", "frame start to pose", "swap to logged"])
-    axes.set_xscale("log")
+        if "failed" in f:
+            axes.annotate("failed (the table says why)", (0.5, i), xycoords=("axes fraction", "data"), ha="center", va="center")
+        else:
+            axes.errorbar([f["median_us"]], [i], xerr=[[0.0], [f["p95_us"] - f["median_us"]]], fmt="o", capsize=4)
+    axes.set_yticks(range(len(MEASURED)), ["sample arrival to pose", "frame start to pose", "swap to logged"])
+    axes.set_ylim(-0.5, len(MEASURED) - 0.5)
+    if axes.has_data():
+        axes.set_xscale("log")
     axes.set_xlabel("microseconds (median, bar to the 95th percentile)")
     figure.tight_layout()
     figure.savefig(path, dpi=120)
@@ -142,5 +181,5 @@ def plot(report: dict[str, Any], path: Path) -> None:
 BENCH = Bench(
     run=run, table=table,
     notes=lambda report: f"machine noise: {report['cpus']} CPUs, 1-minute load average {report['load_average_1min']:.2f}",
-    plot=plot,
+    plot=plot, all_failed=every_measurement_failed,
 )

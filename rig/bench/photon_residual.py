@@ -16,7 +16,8 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from rig.bench.contract import Bench, Context, cell
-from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_latency import check_predictors, film_latency
+from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import machine_name
 from rig.bench.renderer_specs import BenchGrid
 from rig.bench.renderers import plain, with_options
@@ -38,6 +39,7 @@ def run(spec: ResidualSpec, context: Context) -> list[dict[str, Any]]:
     """A row per predictor and photon target, the server's cost modelled at DEFAULT_SERVER_MS (or
     the grid's `server_ms`)."""
     grid = replace(spec.grid, server_ms=spec.grid.server_ms if spec.grid.server_ms is not None else DEFAULT_SERVER_MS)
+    check_predictors(*spec.predictors)
     machine = machine_name()
     rows = []
     for predictor in spec.predictors:
@@ -72,10 +74,11 @@ def residual_text(rows: list[dict[str, Any]]) -> str:
         lines.append(f"best predictor {best}: residual {aimed['latency_measured_ms']:+.2f} ms aimed at the photons, "
                      f"{scanout.get('latency_measured_ms') or float('nan'):+.2f} ms aimed at scan-out")  # fmt: skip
     lines += [f"run: {note}" for note in sorted({r["latency_note"] for r in rows if r.get("latency_note")})]
+    lines += [f"failed: {r['predictor']} aimed at {r['photon_target']}: {r['failed']}" for r in rows if r.get("failed")]
     return "\n".join(lines)
 
 
 BENCH = Bench(
     spec=lambda args: ResidualSpec(with_options(args.spec, args), tuple(args.residual_predictor or RESIDUAL_PREDICTORS)),
-    run=run, table=residual_text, record=plain,
+    run=run, table=residual_text, record=plain, all_failed=every_row_failed,
 )

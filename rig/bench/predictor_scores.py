@@ -8,8 +8,25 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
-from predictors import Evaluation, Trace, evaluate
+from predictors import Evaluation, PredictorError, Trace, evaluate
 from rig.bench.predictors_settings import BASELINE
+
+
+@dataclass(frozen=True)
+class FailedEvaluation:
+    """A predictor that could not be scored on a trace, and why: a row of the bench beside the scores."""
+
+    predictor: str
+    trace: str
+    failed: str
+
+    def to_dict(self) -> dict[str, str]:
+        return {"trace": self.trace, "predictor": self.predictor, "failed": self.failed}
+
+
+def failure_reason(error: Exception) -> str:
+    """Why an evaluation failed, in one line: a predictor's refusal as it says it, anything else with its kind."""
+    return str(error) if isinstance(error, PredictorError) else f"{type(error).__name__}: {error}"
 
 
 def label(name: str, params: dict[str, Any]) -> str:
@@ -23,13 +40,21 @@ def evaluate_all(
     horizons: Sequence[float],
     timing_repeats: int,
     progress: Callable[[float, float], object] | None = None,
+    failures: list[FailedEvaluation] | None = None,
 ) -> list[Evaluation]:
-    """Every predictor spec on every trace."""
+    """Every predictor spec on every trace. Given `failures`, an evaluation that raises is added
+    there with its reason and the others still run (a predictor that cannot score a trace is a
+    result of the bench); without it, the error propagates."""
     results = []
     total = len(traces) * len(specs)
     for i, trace in enumerate(traces):
         for j, (name, params) in enumerate(specs):
-            results.append(evaluate(name, trace, [h / 1e3 for h in horizons], params, timing_repeats))
+            try:
+                results.append(evaluate(name, trace, [h / 1e3 for h in horizons], params, timing_repeats))
+            except Exception as error:
+                if failures is None:
+                    raise
+                failures.append(FailedEvaluation(label(name, params), trace.name, failure_reason(error)))
             if progress is not None:
                 progress(i * len(specs) + j + 1, total)
     return results
@@ -111,7 +136,8 @@ def cost_ratios(results: Sequence[Evaluation]) -> dict[str, float]:
 @dataclass(frozen=True)
 class HeldOut:
     """A predictor tuned at `horizon_ms` on every trace but `trace`, scored on `trace`: its angular
-    and position RMS error there over constant velocity's, and its defaults' ratios beside them."""
+    and position RMS error there over constant velocity's, and its defaults' ratios beside them; or,
+    where the tuning or a score raised, NaN ratios and why (`failed`)."""
 
     predictor: str
     trace: str
@@ -121,36 +147,46 @@ class HeldOut:
     position: float
     defaults_angular: float
     defaults_position: float
+    failed: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready values (None for a ratio on a trace without that part)."""
         return {k: finite_or_none(v) if isinstance(v, float) else v for k, v in vars(self).items()}
 
 
+def _held_out(name: str, trace: Trace, others: Sequence[Trace], horizon_ms: float, max_iterations: int) -> HeldOut:
+    """`name` tuned on `others` and scored on `trace`, against its defaults and the baseline."""
+    from predictors.tuning import tune  # imports JAX: only when asked
+
+    horizon = horizon_ms / 1e3
+    params = tune(name, others, horizon, max_iterations=max_iterations).params
+    scores = {
+        key: evaluate(predictor, trace, [horizon], given, timing_repeats=0).scores[0]
+        for key, predictor, given in (("tuned", name, params), ("defaults", name, {}), ("baseline", BASELINE, {}))
+    }
+    base = scores["baseline"]
+    return HeldOut(
+        name, trace.name, horizon_ms, params,
+        _ratio(scores["tuned"].angular_rms_deg, base.angular_rms_deg),
+        _ratio(scores["tuned"].position_rms_mm, base.position_rms_mm),
+        _ratio(scores["defaults"].angular_rms_deg, base.angular_rms_deg),
+        _ratio(scores["defaults"].position_rms_mm, base.position_rms_mm),
+    )
+
+
 def leave_one_out(
     name: str, traces: Sequence[Trace], horizon_ms: float, max_iterations: int,
     progress: Callable[[float, float], object] | None = None,
 ) -> list[HeldOut]:
-    """Tune `name` on all traces but one and score it on that one, for each trace in turn."""
-    from predictors.tuning import tune  # imports JAX: only when asked
-
-    horizon = horizon_ms / 1e3
+    """Tune `name` on all traces but one and score it on that one, for each trace in turn; a fold
+    that raises is a failed `HeldOut` with its reason, and the others still run."""
     held = []
     for k, trace in enumerate(traces):
         others = [t for i, t in enumerate(traces) if i != k]
-        params = tune(name, others, horizon, max_iterations=max_iterations).params
-        scores = {
-            key: evaluate(predictor, trace, [horizon], given, timing_repeats=0).scores[0]
-            for key, predictor, given in (("tuned", name, params), ("defaults", name, {}), ("baseline", BASELINE, {}))
-        }
-        base = scores["baseline"]
-        held.append(HeldOut(
-            name, trace.name, horizon_ms, params,
-            _ratio(scores["tuned"].angular_rms_deg, base.angular_rms_deg),
-            _ratio(scores["tuned"].position_rms_mm, base.position_rms_mm),
-            _ratio(scores["defaults"].angular_rms_deg, base.angular_rms_deg),
-            _ratio(scores["defaults"].position_rms_mm, base.position_rms_mm),
-        ))
+        try:
+            held.append(_held_out(name, trace, others, horizon_ms, max_iterations))
+        except Exception as error:
+            held.append(HeldOut(name, trace.name, horizon_ms, {}, math.nan, math.nan, math.nan, math.nan, failure_reason(error)))
         if progress is not None:
             progress(k + 1, len(traces))
     return held

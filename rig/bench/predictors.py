@@ -44,7 +44,7 @@ from rig.bench import corpus_bench
 from rig.bench.contract import Bench, Context
 from rig.bench.corpus_bench import CorpusRun
 from rig.bench.predictors_settings import BASELINE
-from rig.bench.predictor_scores import HeldOut, Ratios, cost_ratios, evaluate_all, label, leave_one_out, ratios
+from rig.bench.predictor_scores import FailedEvaluation, HeldOut, Ratios, cost_ratios, evaluate_all, label, leave_one_out, ratios
 from rig.errors import ConfigError
 from rig.service.tune import check_scorable, in_time_order
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -103,6 +103,9 @@ def held_out_table(held: Sequence[HeldOut]) -> str:
     """A Markdown table of leave-one-trace-out ratios to constant velocity: tuned, and defaults."""
     rows = ["| predictor | held-out trace | horizon | tuned: angular, position | defaults: angular, position |", "|---|---|---|---|---|"]
     for h in held:
+        if h.failed is not None:
+            rows.append(f"| {h.predictor} | {h.trace} | {h.horizon_ms:g} ms | failed: {h.failed} | |")
+            continue
         rows.append(
             f"| {h.predictor} | {h.trace} | {h.horizon_ms:g} ms | {h.angular:.3f}, {h.position:.3f} | "
             f"{h.defaults_angular:.3f}, {h.defaults_position:.3f} |"
@@ -118,7 +121,11 @@ def plot(results: Sequence[Evaluation], horizon_ms: float, path: Path) -> None:
     from matplotlib.figure import Figure
 
     traces = list(dict.fromkeys(r.trace for r in results))
-    figure = Figure(figsize=(4.5 * len(traces), 7.0))
+    figure = Figure(figsize=(4.5 * max(len(traces), 1), 7.0))
+    if not traces:
+        figure.text(0.5, 0.5, "no predictor was scored on any trace: each failed (see the table)", ha="center")
+        figure.savefig(path, dpi=100)
+        return
     axes = figure.subplots(2, len(traces), squeeze=False)
     for column, trace in enumerate(traces):
         of_trace = [r for r in results if r.trace == trace]
@@ -143,7 +150,8 @@ def plot(results: Sequence[Evaluation], horizon_ms: float, path: Path) -> None:
 @dataclass(frozen=True)
 class Scores:
     """What the bench found: the horizons (ms) and the one plotted, every evaluation, the ratios to
-    the baseline, kalman-cv's cost over desp's per trace, and the leave-one-out results."""
+    the baseline (on the traces where it was scored), kalman-cv's cost over desp's per trace, the
+    leave-one-out results, and the evaluations that failed with their reasons."""
 
     horizons_ms: tuple[float, ...]
     plot_horizon_ms: float
@@ -151,6 +159,7 @@ class Scores:
     ratios: list[Ratios]
     costs: dict[str, float]
     held: list[HeldOut]
+    failed: list[FailedEvaluation]
 
 
 def run(args: argparse.Namespace, context: Context) -> Scores | CorpusRun:
@@ -179,10 +188,25 @@ def run(args: argparse.Namespace, context: Context) -> Scores | CorpusRun:
         raise ConfigError("--leave-one-out needs at least two traces: it tunes on all but one")
     specs = args.predictor or [(name, {}) for name in predictors.names()]
     specs += [] if (BASELINE, {}) in specs else [(BASELINE, {})]
-    results = evaluate_all(traces, specs, horizons, args.timing_repeats, context.progress("benchmarking predictors"))
+    for name, params in specs:
+        predictors.make(name, **params)  # a parameter it does not take is refused before any work, not a failed row per trace
+    failed: list[FailedEvaluation] = []
+    results = evaluate_all(traces, specs, horizons, args.timing_repeats, context.progress("benchmarking predictors"), failed)
+    for failure in failed:
+        context.log(f"{failure.predictor} on {failure.trace} failed: {failure.failed}")
+    scored = {r.trace for r in results if r.predictor == BASELINE and not r.params}
     held = [h for name in args.leave_one_out or () for h in leave_one_out(name, traces, plot_horizon, args.tune_iterations,
                                                                              context.progress(f"tuning {name}, each trace held out in turn"))]  # fmt: skip
-    return Scores(horizons, plot_horizon, results, ratios(results, horizons), cost_ratios(results), held)
+    compared = ratios([r for r in results if r.trace in scored], horizons)
+    return Scores(horizons, plot_horizon, results, compared, cost_ratios(results), held, failed)
+
+
+def every_evaluation_failed(scores: Scores | CorpusRun) -> str | None:
+    """A sentence where no predictor was scored on any trace (each evaluation failed), else None."""
+    if isinstance(scores, CorpusRun) or scores.results or not scores.failed:
+        return None
+    first = scores.failed[0]
+    return f"every one of the {len(scores.failed)} evaluations failed (the first: {first.predictor} on {first.trace}: {first.failed})"
 
 
 def text(scores: Scores | CorpusRun) -> str:
@@ -192,8 +216,10 @@ def text(scores: Scores | CorpusRun) -> str:
     horizons = scores.horizons_ms
     shown = [h for h in horizons if h > 0.0] or list(horizons)
     at = " / ".join(f"{h:g}" for h in shown)
-    lines = [table(scores.results, horizons), f"\nangular RMS error / constant velocity ({BASELINE}) at {at} ms:",
-             ratio_table(scores.ratios, "angular", shown)]  # fmt: skip
+    lines = [table(scores.results, horizons)]
+    lines += [f"| {f.trace} | {f.predictor} | failed: {f.failed} |" for f in scores.failed]
+    if scores.ratios:
+        lines += [f"\nangular RMS error / constant velocity ({BASELINE}) at {at} ms:", ratio_table(scores.ratios, "angular", shown)]
     if any(math.isfinite(v) for entry in scores.ratios for by_horizon in entry.position.values() for v in by_horizon.values()):
         lines += [f"\nposition RMS error / constant velocity at {at} ms (traces with position):", ratio_table(scores.ratios, "position", shown)]
     lines += [f"kalman-cv / desp cost on {trace}: {ratio:.2f}" for trace, ratio in scores.costs.items()]
@@ -215,6 +241,7 @@ def record(scores: Scores | CorpusRun) -> dict[str, Any]:
         "ratios": [entry.to_dict(horizons) for entry in scores.ratios],
         "leave_one_out": [h.to_dict() for h in scores.held],
         "results": [r.to_dict() for r in scores.results],
+        "failed": [f.to_dict() for f in scores.failed],
     }
 
 
@@ -222,4 +249,5 @@ BENCH = Bench(
     run=run, table=text, record=record,
     plot=lambda scores, path: (corpus_bench.plot(scores, path) if isinstance(scores, CorpusRun)
                                else plot(scores.results, scores.plot_horizon_ms, path)),
+    all_failed=every_evaluation_failed,
 )

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
+from predictors import make as make_predictor
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import USER_ERRORS
 from rig.service.sweep import (
@@ -125,13 +126,14 @@ def film_config(run: LatencyRun, app_frame_s: float, server_s: float) -> Simulat
 
 
 def _no_figures(config: SimulationConfig) -> dict[str, Any]:
-    """A run's figures with nothing filmed: what it is, every latency None."""
+    """A run's figures with nothing filmed: what it is, every latency None, nothing failed."""
     cost = config.warp_ms if composes(config.renderer) else config.app_frame_ms
     return {"renderer": config.renderer, "triangles": config.scene_triangles, "width": config.display.width,
             "height": config.display.height, "predictor": config.predictor, "photon_target": config.photon_target,
             "cost_source": "measured" if cost is None else "modelled",
             "latency_measured_ms": None, "latency_true_ms": None, "latency_sd_ms": None,
-            "frame_delay_sd_ms": None, "frame_ms_median": None, "missed_pct": None, "latency_period_s": None}  # fmt: skip
+            "frame_delay_sd_ms": None, "frame_ms_median": None, "missed_pct": None, "latency_period_s": None,
+            "failed": None}  # fmt: skip
 
 
 def beyond_range_figures(run: LatencyRun, app_frame_s: float, server_s: float) -> dict[str, Any] | None:
@@ -159,7 +161,7 @@ def film_figures(filmed: PointRun) -> dict[str, Any]:
     note = (f"{filmed.simulation.cost_line()}; simulated at {config.display.width}x{config.display.height}, "
             f"predictor {config.predictor}, target {config.photon_target}")  # fmt: skip
     if filmed.result is None:
-        return {**figures, "latency_note": f"{note}; the analyser failed: {row['error']}"}
+        return {**figures, "latency_note": f"{note}; the analyser failed: {row['error']}", "failed": f"the analyser failed: {row['error']}"}
     if filmed.result.ambiguous:
         note += "; AMBIGUOUS (near half a period)"
     windowed = filmed.result.windowed
@@ -171,25 +173,42 @@ def film_figures(filmed: PointRun) -> dict[str, Any]:
     }
 
 
+def failed_figures(config: SimulationConfig, reason: str) -> dict[str, Any]:
+    """The figures of a run that was not filmed (its simulation refused, its costs not timed): failed with `reason`."""
+    return {**_no_figures(config), "latency_note": reason, "failed": reason}
+
+
+def check_predictors(*names: str | None) -> None:
+    """Make each predictor named (None: none) once: one that cannot be made is refused
+    (PredictorError) before a bench times or films anything, not a failed film per load."""
+    for name in names:
+        if name is not None:
+            make_predictor(name)
+
+
 def film_row(point: SweepPoint) -> dict[str, Any]:
     """A sweep job: the point's summary row (simulated, then analysed within the simulation's
     regions, as a lab marks them once for its camera), with its film's figures under "film"."""
     try:
         filmed = simulate_and_analyse(point)
     except USER_ERRORS as error:
-        return unsimulated_row(point, error) | {"film": {**_no_figures(point.config), "latency_note": f"not simulated: {error}"}}
+        return unsimulated_row(point, error) | {"film": failed_figures(point.config, f"not simulated: {error}")}
     return filmed.row | {"film": film_figures(filmed)}
 
 
 def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: Path) -> dict[str, Any]:
     """Simulate `run` (with `app_frame_s` and `server_s` the costs expected, for the period), film it,
     analyse the video; its figures. Latencies are None when the expected one needs too long a period
-    or the analyser fails, and the note says why."""
+    or the run cannot be simulated or analysed, and the note says why (`failed` too where it could
+    not be simulated or analysed)."""
     unfilmed = beyond_range_figures(run, app_frame_s, server_s)
     if unfilmed is not None:
         return unfilmed
     point = SweepPoint(0, film_config(run, app_frame_s, server_s), {}, out_dir, AnalysisRequest(out_dir / "video.avi"), simulated_rois=True)
-    return film_figures(simulate_and_analyse(point))
+    try:
+        return film_figures(simulate_and_analyse(point))
+    except USER_ERRORS as error:
+        return failed_figures(point.config, f"not simulated: {error}")
 
 
 def film_latencies(

@@ -19,6 +19,16 @@ def _draw(path: Path, draw: Callable[[Any, list[Any]], None]) -> None:
     figure.savefig(path, dpi=110)
 
 
+def _legend_or_say(axis: Any, nothing: str) -> None:
+    """The axis's legend where anything is drawn on it; else (every row failed) only `nothing`, said in words."""
+    if axis.get_legend_handles_labels()[0]:
+        axis.legend(fontsize=8)
+        return
+    axis.clear()
+    axis.set_axis_off()
+    axis.text(0.5, 0.5, nothing, ha="center", va="center", transform=axis.transAxes)
+
+
 def _latency_series(axis: Any, rows: list[dict[str, Any]], renderer: str, colour: str, label: str, marker: str = "o", filled: bool = True) -> None:
     points = {r["triangles"]: r for r in rows if r["renderer"] == renderer and r["latency_measured_ms"] is not None}
     n = sorted(points)
@@ -37,13 +47,14 @@ def plot_rows(rows: list[dict[str, Any]], path: Path) -> None:
             points = sorted((r["triangles"], r["latency_true_ms"]) for r in rows if r["renderer"] == renderer and r["latency_true_ms"] is not None)
             if points:
                 left.plot(*zip(*points), "x--", color=colour, alpha=0.6, label=f"{renderer}, true")
-            for k in sorted({r["triangles"] for r in rows if r["renderer"] == renderer and str(r["latency_note"]).startswith("beyond")}):
-                left.annotate("beyond range", (k, 1.0), xycoords=("data", "axes fraction"), ha="center", va="top",
-                              color=colour, fontsize=8, rotation=90)  # fmt: skip
+            unmeasured = {r["triangles"]: "failed" if r["failed"] else "beyond range" for r in rows if r["renderer"] == renderer
+                          and (r["failed"] or str(r["latency_note"]).startswith("beyond"))}  # fmt: skip
+            for k, why in sorted(unmeasured.items()):
+                left.annotate(why, (k, 1.0), xycoords=("data", "axes fraction"), ha="center", va="top", color=colour, fontsize=8, rotation=90)
         left.set(xscale="log", yscale="log", xlabel="load triangles", ylabel="latency (ms); bars: sd swing by swing",
                  title="latency against scene size, costs measured")  # fmt: skip
-        left.legend(fontsize=8)
-        warp = [r for r in rows if r["renderer"] == "warp"]
+        _legend_or_say(left, "no latency was measured\n(the table says why)")
+        warp = [r for r in rows if r["renderer"] == "warp" and r["frames_timed"] is not None]
         for (width, height), marker in zip(sorted({(r["width"], r["height"]) for r in warp}), "os^Dv"):
             for ratio, colour in zip(sorted({r["rate_ratio"] for r in warp}), ("tab:green", "tab:orange", "tab:purple", "tab:brown")):
                 chosen = [r for r in warp if (r["width"], r["height"], r["rate_ratio"]) == (width, height, ratio)]
@@ -51,7 +62,7 @@ def plot_rows(rows: list[dict[str, Any]], path: Path) -> None:
                               color=colour, label=f"{width}x{height}, client:display 1:{ratio}")  # fmt: skip
         right.set(xlabel="warp time per display frame (ms, median)", ylabel="pixels with Lab error > 10 (%)",
                   title="image error against warp time (one point per N)")  # fmt: skip
-        right.legend(fontsize=8)
+        _legend_or_say(right, "no load was timed\n(the table says why)")
 
     _draw(path, draw)
 
@@ -65,7 +76,8 @@ def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path
         for rows, filled, who in ((ours, True, "this machine"), (seed, False, "seed Table 2")):
             for renderer, colour in (("direct", "tab:red"), ("warp", "tab:blue")):
                 _latency_series(left, rows, renderer, colour, f"{renderer}, {who}", "o" if filled else "s", filled)
-                frame = {r["triangles"]: r["frame_ms_median"] / r["refresh_ms"] for r in rows if r["renderer"] == "direct"}
+                frame = {r["triangles"]: r["frame_ms_median"] / r["refresh_ms"] for r in rows
+                         if r["renderer"] == "direct" and r["frame_ms_median"] is not None}  # fmt: skip
                 points = sorted((frame[r["triangles"]], r["latency_refreshes"]) for r in rows
                                 if r["renderer"] == renderer and r["latency_refreshes"] is not None and r["triangles"] in frame)  # fmt: skip
                 if points:
@@ -75,8 +87,8 @@ def plot_seed_table(ours: list[dict[str, Any]], seed: list[dict[str, Any]], path
                  title=f"latency against scene size, measured by filming\nthis machine: {label}")  # fmt: skip
         right.set(xscale="log", yscale="log", xlabel="direct frame time (display refreshes)", ylabel="latency (display refreshes)",
                   title="machine-independent: both in refreshes")  # fmt: skip
-        for axis in axes:
-            axis.legend(fontsize=8)
+        _legend_or_say(left, "no latency was measured\n(the table says why)")
+        _legend_or_say(right, "no latency was measured\n(the table says why)")
 
     _draw(path, draw)
 

@@ -84,10 +84,17 @@ class WarpMeasurement:
         return means
 
 
-def open_warp(spec: str, setup: RenderSetup, pendulum: Pendulum, ratios: tuple[int, ...]) -> WarpMeasurement:
-    """The warp renderer of `spec`, open on `setup`."""
+def warp_renderer(spec: str) -> WarpRenderer:
+    """The warp renderer of `spec`, not yet open; ConfigError where `spec` is not one (a bench checks
+    its specs so before any work: a typo is refused, not a row failed after the timings)."""
     renderer = make_renderer(spec)
     if not isinstance(renderer, WarpRenderer):
         raise ConfigError(f"the renderer bench's warp spec must be a warp renderer, got {spec!r}")
+    return renderer
+
+
+def open_warp(spec: str, setup: RenderSetup, pendulum: Pendulum, ratios: tuple[int, ...]) -> WarpMeasurement:
+    """The warp renderer of `spec`, open on `setup`."""
+    renderer = warp_renderer(spec)
     renderer.open(setup)
     return WarpMeasurement(renderer, pendulum, errors={r: [] for r in ratios})

@@ -1,6 +1,7 @@
 """`rig bench renderers` (its command line declared in `rig.bench.renderers_settings`): what it measures.
 
-For each display resolution and load of N triangles:
+For each display resolution and load of N triangles (a load that cannot be drawn is rows failed with
+the reason, and the others still run; a latency film that fails is its rows' reason too):
 
 * direct: the real frame time on this machine (render and readback, wall clock);
 * warp (the grid's warp spec, `warp` by default): the client's frame time, the server's time per
@@ -42,11 +43,12 @@ import numpy as np
 
 from predictors import Pose
 from rig.bench import renderer_plots
-from rig.bench.contract import Bench, Context, cell, given
-from rig.bench.renderer_latency import film_latencies
-from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup
+from rig.bench.contract import Bench, Context, Log, given
+from rig.bench.renderer_latency import check_predictors, film_latencies
+from rig.bench.renderer_rows import every_row_failed, table, untimed_rows
+from rig.bench.renderer_setup import IDENTITY, WarpMeasurement, machine_name, open_warp, pose_of, scene_setup, warp_renderer
 from rig.bench.renderer_specs import BenchGrid, read_grid
-from rig.commands import options
+from rig.errors import RigError
 from rig.render.direct import DirectRenderer
 from rig.render.image_error import dssim, lab_error_percent, psnr_db, ssim
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, RenderSetup
@@ -57,11 +59,12 @@ ROW_FIELDS = (
     "frame_ms_median", "frame_ms_p95", "frame_gpu_ms_median", "frame_cpu_ms_median", "frames_timed", "client_ms_median",
     "primitives", "cost_source", "predictor", "photon_target",
     "latency_measured_ms", "latency_true_ms", "latency_sd_ms", "frame_delay_sd_ms", "missed_pct", "latency_period_s", "latency_note",
-    "lab_error_pct", "ssim", "dssim", "psnr_db", "hole_pct", "timing", "machine",
+    "lab_error_pct", "ssim", "dssim", "psnr_db", "hole_pct", "timing", "machine", "failed",
 )  # fmt: skip
+"""A row's fields; `failed` says why its load could not be timed or its latency film failed (None: neither)."""
 LATENCY_FIELDS = (
     "cost_source", "predictor", "photon_target", "latency_measured_ms", "latency_true_ms", "latency_sd_ms",
-    "frame_delay_sd_ms", "missed_pct", "latency_period_s", "latency_note",
+    "frame_delay_sd_ms", "missed_pct", "latency_period_s", "latency_note", "failed",
 )  # fmt: skip
 """The fields a latency run fills in a row."""
 
@@ -145,10 +148,40 @@ def warp_row(base: dict[str, Any], m: WarpMeasurement, triangles: int, size: tup
     }  # fmt: skip
 
 
+def timed_load(
+    grid: BenchGrid, size: tuple[int, int], triangles: int, base: dict[str, Any], log: Log
+) -> tuple[dict[str, Any], WarpMeasurement, float]:
+    """One load at one display size: its direct row, the warp renderer opened on it with its image
+    error measured (the caller closes it, and times its rounds), and the direct frame's median (s)."""
+    width, height = size
+    setup, pendulum = scene_setup(width, height, triangles, grid.refresh_hz)
+    started = time.perf_counter()
+    direct, direct_cpu = time_direct(setup, grid)
+    log(f"{width}x{height} {triangles:>9} triangles: direct {np.median(direct) * 1e3:9.1f} ms "
+        f"({len(direct)} frames, {time.perf_counter() - started:.0f} s)")  # fmt: skip
+    row = {
+        **base, "renderer": "direct", "spec": "direct", "triangles": triangles, "width": width, "height": height,
+        "frame_ms_median": _percentile_ms(direct, 50), "frame_ms_p95": _percentile_ms(direct, 95),
+        "frame_cpu_ms_median": _percentile_ms(direct_cpu, 50), "frames_timed": len(direct),
+        "timing": "wall clock, render and readback; frame_cpu_ms_median: this process's CPU time, all threads",
+    }  # fmt: skip
+    m = open_warp(grid.warp, setup, pendulum, grid.ratios)
+    try:
+        measure_warp_quality(m, grid)
+    except BaseException:
+        m.renderer.close()
+        raise
+    log(f"{width}x{height} {triangles:>9} triangles: warp client {np.median(m.client_s) * 1e3:9.1f} ms")
+    return row, m, float(np.median(direct))
+
+
 def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
-    """Every row of the benchmark (see the module docstring). The timings run here, one at a time;
-    the latency films (simulate, then analyse: a sweep into the context's folder) on its executor."""
+    """Every row of the benchmark (see the module docstring). The timings run here, one at a time
+    (a load that cannot be drawn is failed rows with the reason, and the others still run); the
+    latency films (simulate, then analyse: a sweep into the context's folder) on its executor."""
     log = context.log
+    warp_renderer(grid.warp)
+    check_predictors(grid.predictor, grid.direct_predictor)
     machine = machine_name()
     log(f"machine: {machine}")
     rows: list[dict[str, Any]] = []
@@ -157,31 +190,26 @@ def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
     base["machine"] = machine
     for resolution_index, (width, height) in enumerate(grid.resolutions):
         measurements: list[WarpMeasurement] = []
+        timed: list[int] = []
         try:
             for triangles in grid.triangles:
-                setup, pendulum = scene_setup(width, height, triangles, grid.refresh_hz)
-                started = time.perf_counter()
-                direct, direct_cpu = time_direct(setup, grid)
-                log(f"{width}x{height} {triangles:>9} triangles: direct {np.median(direct) * 1e3:9.1f} ms "
-                    f"({len(direct)} frames, {time.perf_counter() - started:.0f} s)")  # fmt: skip
-                rows.append({
-                    **base, "renderer": "direct", "spec": "direct", "triangles": triangles, "width": width, "height": height,
-                    "frame_ms_median": _percentile_ms(direct, 50), "frame_ms_p95": _percentile_ms(direct, 95),
-                    "frame_cpu_ms_median": _percentile_ms(direct_cpu, 50), "frames_timed": len(direct),
-                    "timing": "wall clock, render and readback; frame_cpu_ms_median: this process's CPU time, all threads",
-                })  # fmt: skip
-                m = open_warp(grid.warp, setup, pendulum, grid.ratios)
+                try:
+                    row, m, direct_s = timed_load(grid, (width, height), triangles, base, log)
+                except RigError as error:
+                    log(f"{width}x{height} {triangles:>9} triangles: failed: {error}")
+                    rows += untimed_rows({**base, "triangles": triangles, "width": width, "height": height}, grid.warp, grid.ratios, str(error))
+                    continue
+                rows.append(row)
                 measurements.append(m)
-                measure_warp_quality(m, grid)
-                log(f"{width}x{height} {triangles:>9} triangles: warp client {np.median(m.client_s) * 1e3:9.1f} ms")
+                timed.append(triangles)
                 if resolution_index == 0 and triangles in (grid.latency_triangles or grid.triangles):
-                    expected["direct", triangles] = (float(np.median(direct)), 0.0)
+                    expected["direct", triangles] = (direct_s, 0.0)
                     expected["warp", triangles] = (float(np.median(m.client_s)), 0.0)
             time_warp_rounds(measurements, grid)
         finally:
             for m in measurements:
                 m.renderer.close()
-        for triangles, m in zip(grid.triangles, measurements):
+        for triangles, m in zip(timed, measurements):
             log(f"{width}x{height} {triangles:>9} triangles: warp {np.median(m.wall_s) * 1e3:7.1f} ms per display frame")
             if ("warp", triangles) in expected and resolution_index == 0:
                 expected["warp", triangles] = (expected["warp", triangles][0], float(np.median(m.wall_s)))
@@ -201,34 +229,13 @@ def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
     for (labels, *_), figures in zip(films, film_latencies(films, context.folder, comment, context.workers, context.scheduler, progress)):
         measured = figures["latency_measured_ms"]
         shown = f"{measured:.1f} ms measured, {figures['latency_true_ms']:.1f} ms true" if measured is not None else figures["latency_note"]
+        if figures["failed"] is not None:
+            shown = f"failed: {figures['failed']}"
         log(f"latency {labels['renderer']:6} {labels['triangles']:>9} triangles: {shown}")
         for row in rows:
             if (row["renderer"], row["triangles"], (row["width"], row["height"])) == (labels["renderer"], labels["triangles"], grid.resolutions[0]):
                 row.update({name: figures[name] for name in LATENCY_FIELDS})
     return rows
-
-
-def table(rows: list[dict[str, Any]]) -> str:
-    """The grid's rows as a fixed-width table, with the latency notes and the machine below."""
-    lines = [
-        f"{'renderer':8} {'N':>9} {'size':>9} {'ratio':>5} {'frame ms':>9} {'p95':>8} {'gpu ms':>7} {'cpu ms':>8} {'client ms':>9} "
-        f"{'lat meas':>8} {'lat true':>8} {'sd':>5} {'missed':>6} {'Lab>10 %':>8} {'SSIM':>6} {'PSNR':>5} {'holes %':>7}"
-    ]  # fmt: skip
-    for r in rows:
-        ratio = f"1:{r['rate_ratio']}" if r["rate_ratio"] else "-"
-        missed = f"{r['missed_pct']:.0f}%" if r["missed_pct"] is not None else "-"
-        lines.append(
-            f"{r['renderer']:8} {r['triangles']:>9} {r['width']}x{r['height']:<4} {ratio:>5} {cell(r['frame_ms_median']):>9} "
-            f"{cell(r['frame_ms_p95']):>8} {cell(r['frame_gpu_ms_median']):>7} {cell(r['frame_cpu_ms_median']):>8} "
-            f"{cell(r['client_ms_median']):>9} "
-            f"{cell(r['latency_measured_ms']):>8} {cell(r['latency_true_ms']):>8} {cell(r['latency_sd_ms']):>5} {missed:>6} "
-            f"{cell(r['lab_error_pct'], '.2f'):>8} {cell(r['ssim'], '.3f'):>6} {cell(r['psnr_db']):>5} {cell(r['hole_pct'], '.2f'):>7}"
-        )
-    specs = sorted({r["spec"] for r in rows if r["renderer"] == "warp"})
-    lines.append(f"warp: {', '.join(specs)}; sd: the latency's spread swing by swing, from the video" if specs else "")
-    lines += [f"latency: {note}" for note in sorted({r["latency_note"] for r in rows if r["latency_note"]})]
-    lines.append(f"machine: {rows[0]['machine']}" if rows else "no rows")
-    return "\n".join(lines)
 
 
 def plain(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -246,5 +253,5 @@ def with_options(grid: BenchGrid, args: argparse.Namespace) -> BenchGrid:
 
 BENCH = Bench(
     spec=lambda args: with_options(args.spec, args), read_spec=read_grid,
-    run=run, table=table, record=plain, plot=renderer_plots.plot_rows,
+    run=run, table=table, record=plain, plot=renderer_plots.plot_rows, all_failed=every_row_failed,
 )

@@ -33,10 +33,12 @@ import numpy as np
 
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
-from rig.bench.renderer_latency import film_latency
+from rig.bench.renderer_latency import check_predictors, failed_figures, film_latency, run_config
+from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import machine_name, open_warp, pose_of, scene_setup
 from rig.bench.renderer_specs import BenchGrid, SeedTableSpec
 from rig.bench.renderers import plain, time_direct, with_options
+from rig.errors import RigError
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest
 from rig.sim.camera import CameraConfig
 
@@ -105,20 +107,38 @@ def _probe_warp(grid: BenchGrid, setup, pendulum) -> tuple[float, float]:
     return client, float(np.median(m.wall_s[1:]))
 
 
+def _row(figures: dict[str, Any], renderer: str, load: str, refresh_ms: float, machine: str) -> dict[str, Any]:
+    """Our row of one renderer spec's figures on a load."""
+    latency = figures["latency_measured_ms"]
+    return {
+        **figures, "source": "this machine", "renderer": "direct" if renderer == "direct" else "warp", "spec": renderer, "load": load,
+        "latency_refreshes": latency / refresh_ms if latency is not None else None, "refresh_ms": refresh_ms, "machine": machine,
+    }  # fmt: skip
+
+
 def run(spec: SeedTableSpec, context: Context) -> list[dict[str, Any]]:
-    """Our rows (see the module docstring), one per renderer and load size."""
+    """Our rows (see the module docstring), one per renderer and load size; a load that cannot be
+    timed is its rows failed with the reason, and the table stops there."""
     log, runs_dir, grid = context.log, context.folder, spec.grid
+    check_predictors(grid.predictor)
     machine = machine_name()
     log(f"machine: {machine}; load: {spec.load}; warp: {grid.warp}")
     rows: list[dict[str, Any]] = []
     refresh_ms = 1e3 / grid.refresh_hz
     for triangles in spec.sizes():
-        setup, pendulum = scene_setup(*grid.resolutions[0], triangles, grid.refresh_hz, spec.load)
-        direct_s = float(np.median(time_direct(setup, grid)[0]))
+        try:
+            setup, pendulum = scene_setup(*grid.resolutions[0], triangles, grid.refresh_hz, spec.load)
+            direct_s = float(np.median(time_direct(setup, grid)[0]))
+            client_s, server_s = _probe_warp(grid, setup, pendulum)
+        except RigError as error:
+            log(f"{triangles} triangles: not timed: {error}; the table stops here")
+            for renderer in ("direct", grid.warp):
+                config = run_config(grid.latency_run(renderer, triangles, grid.predictor, load=spec.load))
+                rows.append(_row(failed_figures(config, f"not timed: {error}"), renderer, spec.load, refresh_ms, machine))
+            break
         if direct_s > spec.max_frame_s:
             log(f"{triangles} triangles: a direct frame takes {direct_s:.1f} s, over {spec.max_frame_s:g} s; the table stops here")
             break
-        client_s, server_s = _probe_warp(grid, setup, pendulum)
         for renderer, app_s, comp_s in (("direct", direct_s, 0.0), (grid.warp, client_s, server_s)):
             started = time.perf_counter()
             run = grid.latency_run(renderer, triangles, grid.predictor, load=spec.load)
@@ -126,11 +146,7 @@ def run(spec: SeedTableSpec, context: Context) -> list[dict[str, Any]]:
             latency = figures["latency_measured_ms"]
             if figures["frame_ms_median"] is None:
                 figures["frame_ms_median"] = app_s * 1e3 if renderer == "direct" else comp_s * 1e3
-            rows.append({
-                **figures, "source": "this machine", "renderer": "direct" if renderer == "direct" else "warp", "spec": renderer,
-                "load": spec.load, "latency_refreshes": latency / refresh_ms if latency is not None else None, "refresh_ms": refresh_ms,
-                "machine": machine,
-            })  # fmt: skip
+            rows.append(_row(figures, renderer, spec.load, refresh_ms, machine))
             shown = f"{latency:.1f} ms (sd {figures['latency_sd_ms'] or 0:.1f})" if latency is not None else figures["latency_note"]
             log(f"{triangles:>9} triangles {renderer:8}: frame {figures['frame_ms_median'] or 0:8.1f} ms, latency {shown} "
                 f"({time.perf_counter() - started:.0f} s)")  # fmt: skip
@@ -187,7 +203,9 @@ def seed_table_text(rows: list[dict[str, Any]]) -> str:
                                       f"({found['direct_frame_refreshes']:.2f} refreshes)" if found else _no_crossover(table))
         )  # fmt: skip
     notes = sorted({r["latency_note"] for r in rows if r.get("latency_note")})
-    return "\n".join(lines + [f"run: {note}" for note in notes])
+    lines += [f"run: {note}" for note in notes]
+    lines += [f"failed: {r['spec']} on {r['triangles']} triangles: {r['failed']}" for r in rows if r.get("failed")]
+    return "\n".join(lines)
 
 
 def spec(args: argparse.Namespace) -> SeedTableSpec:
@@ -203,5 +221,5 @@ def _plot(rows: list[dict[str, Any]], path: Path) -> None:
 BENCH = Bench(
     spec=spec, run=run, table=seed_table_text,
     record=lambda rows: plain(rows + seed_rows()),
-    plot=_plot,
+    plot=_plot, all_failed=every_row_failed,
 )

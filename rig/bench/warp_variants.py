@@ -21,10 +21,12 @@ import numpy as np
 
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
-from rig.bench.renderer_latency import film_latency
-from rig.bench.renderer_setup import QUALITY_FIGURES, machine_name, open_warp, scene_setup
+from rig.bench.renderer_latency import check_predictors, failed_figures, film_latency, run_config
+from rig.bench.renderer_rows import every_row_failed
+from rig.bench.renderer_setup import QUALITY_FIGURES, machine_name, open_warp, scene_setup, warp_renderer
 from rig.bench.renderer_specs import BenchGrid
 from rig.bench.renderers import measure_warp_quality, plain, time_direct, time_warp_rounds, with_options
+from rig.errors import RigError
 
 DEFAULT_VARIANTS = (
     "warp", "warp:recon=quad", "warp:recon=mesh", "warp:recon=grid", "warp:views=2", "warp:holes=1", "warp:holes=2",
@@ -54,28 +56,52 @@ def spec(args: argparse.Namespace) -> VariantSpec:
     return replace(chosen, grid=with_options(chosen.grid, args), **given(args, "load"), **({"variants": tuple(args.variant)} if args.variant else {}))
 
 
+def untimed_row(spec: VariantSpec, variant: str, triangles: int, reason: str, machine: str) -> dict[str, Any]:
+    """The row of a variant on a load that could not be timed: no figures, failed with `reason`."""
+    run = spec.grid.latency_run(variant, triangles, spec.grid.predictor, load=spec.load)
+    return {
+        **failed_figures(run_config(run), reason), **dict.fromkeys(QUALITY_FIGURES), "spec": variant, "renderer": "warp",
+        "rate_ratio": spec.grid.ratios[0], "load": spec.load, "server_ms_median": None, "client_ms_median": None,
+        "direct_latency_ms": None, "latency_saved_ms": None, "machine": machine,
+    }  # fmt: skip
+
+
 def run(spec: VariantSpec, context: Context) -> list[dict[str, Any]]:
-    """A row per variant and load size (see the module docstring)."""
+    """A row per variant and load size (see the module docstring); a load or variant that cannot be
+    timed is its row failed with the reason, and the others still run."""
     log, runs_dir = context.log, context.folder
+    for variant in spec.variants:
+        warp_renderer(variant)
+    check_predictors(spec.grid.predictor)
     machine = machine_name()
     log(f"machine: {machine}; load: {spec.load}")
     grid = spec.grid
     size, ratio = grid.resolutions[0], grid.ratios[0]
     rows: list[dict[str, Any]] = []
     for triangles in grid.triangles:
-        setup, pendulum = scene_setup(*size, triangles, grid.refresh_hz, spec.load)
-        direct_s = float(np.median(time_direct(setup, grid)[0]))
+        try:
+            setup, pendulum = scene_setup(*size, triangles, grid.refresh_hz, spec.load)
+            direct_s = float(np.median(time_direct(setup, grid)[0]))
+        except RigError as error:
+            log(f"{triangles:>9} triangles: not timed: {error}")
+            rows += [untimed_row(spec, variant, triangles, f"not timed: {error}", machine) for variant in spec.variants]
+            continue
         direct_run = grid.latency_run("direct", triangles, grid.predictor, load=spec.load)
         direct = film_latency(direct_run, direct_s, 0.0, runs_dir / f"variants-direct-{triangles}")
         log(f"{triangles:>9} triangles: direct latency {direct['latency_measured_ms'] or float('nan'):.1f} ms")
         for variant in spec.variants:
             started = time.perf_counter()
-            m = open_warp(variant, setup, pendulum, grid.ratios)
             try:
-                measure_warp_quality(m, grid)
-                time_warp_rounds([m], grid)
-            finally:
-                m.renderer.close()
+                m = open_warp(variant, setup, pendulum, grid.ratios)
+                try:
+                    measure_warp_quality(m, grid)
+                    time_warp_rounds([m], grid)
+                finally:
+                    m.renderer.close()
+            except RigError as error:
+                log(f"{triangles:>9} triangles {variant:45}: not timed: {error}")
+                rows.append(untimed_row(spec, variant, triangles, f"not timed: {error}", machine))
+                continue
             client_s, server_s = float(np.median(m.client_s)), float(np.median(m.wall_s))
             run = grid.latency_run(variant, triangles, grid.predictor, load=spec.load)
             figures = film_latency(run, client_s, server_s, runs_dir / f"variants-{variant.replace(':', '_').replace(',', '_')}-{triangles}")
@@ -100,6 +126,9 @@ def variants_text(rows: list[dict[str, Any]]) -> str:
               f"{'ms/frame':>8} {'missed':>6} {'latency':>8} {'saved':>7}")  # fmt: skip
     lines = [header]
     for r in rows:
+        if r["server_ms_median"] is None:
+            lines.append(f"{r['triangles']:>9} {r['spec']:45} failed: {r['failed']}")
+            continue
         figures = [cell(r[name], ".3f") for name in ("lab_error_pct", "ssim", "dssim", "hole_pct")]
         latency, saved = cell(r["latency_measured_ms"]), cell(r["latency_saved_ms"])
         lines.append(
@@ -108,7 +137,11 @@ def variants_text(rows: list[dict[str, Any]]) -> str:
         )
     lines.append(f"image figures: means over the warped frames (client:display 1:{rows[0]['rate_ratio']}); "
                  f"{', '.join(QUALITY_FIGURES)}" if rows else "no rows")  # fmt: skip
+    films_failed = [r for r in rows if r["failed"] and r["server_ms_median"] is not None]
+    lines += [f"failed: {r['spec']} on {r['triangles']} triangles: {r['failed']}" for r in films_failed]
     return "\n".join(lines)
 
 
-BENCH = Bench(spec=spec, run=run, table=variants_text, record=plain, plot=renderer_plots.plot_variants)
+BENCH = Bench(
+    spec=spec, run=run, table=variants_text, record=plain, plot=renderer_plots.plot_variants, all_failed=every_row_failed,
+)
