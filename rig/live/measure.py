@@ -23,13 +23,13 @@ from typing import Any, Callable
 
 import numpy as np
 
-from analysis import AnalysisOptions
+from analysis import AnalysisError, AnalysisOptions
 from analysis.board.photodiode_latency import estimate_from_recording
 from rig.board.instrument import BoardInstrument
 from rig.devices.camera.opencv_camera import opencv_camera
 from rig.errors import RigError
 from rig.fresh_outputs import removed_unless_recorded
-from rig.live.health import INVALID
+from rig.live.health import INVALID, VALID
 from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
 from rig.live.run import EXTERNAL, LiveConfig, run_live, write_summary
 from rig.live.video_vs_log import video_against_log
@@ -107,7 +107,16 @@ def analyse_run(out_dir: Path, fps: float | None, options: AnalysisOptions, boar
         write_report(report)
         return report
     request = AnalysisRequest(out_dir / "video.avi", replace(options, fps=fps), tracks_csv=out_dir / "tracks.csv")
-    video = analyse(request, progress).to_dict()
+    try:
+        video = analyse(request, progress).to_dict()
+    except AnalysisError as error:
+        if run["health"]["status"] == VALID:
+            raise
+        # The film's fault may be the rig's own: say so before the bench is changed for nothing.
+        raise AnalysisError(
+            f"{error}; but the run itself was {run['health']['verdict']}, which may be why: measure again with the "
+            "machine less loaded before changing the bench"
+        ) from None
     log = logged_latency(out_dir, run["renderer"] == EXTERNAL, run)
     run["video_vs_log"] = video_against_log(out_dir, video, log)
     write_summary(out_dir, run)

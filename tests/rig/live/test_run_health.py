@@ -13,9 +13,11 @@ from typing import Callable
 import numpy as np
 import pytest
 
+from analysis import AnalysisError, AnalysisOptions
 from predictors import SAMPLE_COLUMNS, PoseSample, sample_row
 from rig.devices.window import SWAP_COLUMNS
 from rig.live import health as thresholds
+from rig.live import measure as live_measure
 from rig.live.health import DEGRADED, INVALID, VALID, run_health
 from rig.live.log_latency import log_latency
 from rig.live.video_vs_log import video_against_log
@@ -183,3 +185,20 @@ def test_the_documented_thresholds_are_the_declared_ones() -> None:
     assert documented.keys() == {"STALL_S", "WARM_UP_S", "HITCH_S", "MIN_PRESENTED_SHARE", "MAX_LATE_SHARE",
                                   "MAX_CAMERA_DROP_SHARE"}
     assert all(float(value) == getattr(thresholds, name) for name, value in documented.items())
+
+
+@pytest.mark.parametrize(("status", "blames_the_run"), [("degraded", True), ("valid", False)])
+def test_a_film_that_cannot_be_analysed_names_a_degraded_run_before_the_bench(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, status: str, blames_the_run: bool,
+) -> None:
+    def no_blob(*_: object) -> None:
+        raise AnalysisError("no moving blob stands out in the sphere ROI; check that the pendulum swings")
+
+    monkeypatch.setattr(live_measure, "analyse", no_blob)
+    verdict = "degraded: the rig hitched: no new image for 150 ms from 2.0 s into the run" if blames_the_run else "valid"
+    run = {"health": {"status": status, "reasons": [], "verdict": verdict}, "renderer": "warp"}
+    with pytest.raises(AnalysisError) as raised:
+        live_measure.analyse_run(tmp_path, 240.0, AnalysisOptions(), None, run)
+    message = str(raised.value)
+    assert message.startswith("no moving blob stands out")
+    assert ("the run itself was degraded: the rig hitched: no new image for 150 ms" in message) is blames_the_run
