@@ -98,7 +98,8 @@ def swap_to_log(out_dir: Path, swaps: int = SWAPS) -> dict[str, Any]:
 
 
 def live_run(out_dir: Path, duration_s: float, context: Context) -> dict[str, Any]:
-    """The live run's figures, arrival to pose and the frame's own share, its files in `out_dir`/run."""
+    """The live run's figures, arrival to pose and the frame's own share, and its health's verdict
+    (`rig.live.health`: a stalled or hitching run's figures hold its stalls), its files in `out_dir`/run."""
     clock = MonotonicClock()
     pendulum = Pendulum(PendulumConfig(), t_end=duration_s + 30.0)
     layout = make_layout(pendulum, CameraConfig(), DisplayConfig(width=SIZE[0], height=SIZE[1]))
@@ -108,11 +109,11 @@ def live_run(out_dir: Path, duration_s: float, context: Context) -> dict[str, An
     try:
         config = LiveConfig(tracker=f"lsl:{name}", renderer="direct", duration_s=duration_s, window=WindowSettings(size=SIZE),
                             streams=None)  # fmt: skip
-        run_live(config, out_dir / "run", view=View(layout.world_to_clip, layout.sphere_radius_m),
-                 frame_clock=FixedRateFrameClock(REFRESH_HZ), clock=clock, overwrite=True)  # fmt: skip
+        result = run_live(config, out_dir / "run", view=View(layout.world_to_clip, layout.sphere_radius_m),
+                          frame_clock=FixedRateFrameClock(REFRESH_HZ), clock=clock, overwrite=True)  # fmt: skip
     finally:
         emulator.close()
-    return arrival_to_pose(out_dir / "run")
+    return {**arrival_to_pose(out_dir / "run"), "run_health": result.summary["health"]["verdict"]}
 
 
 def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
@@ -154,6 +155,8 @@ def table(report: dict[str, Any]) -> str:
             lines.append(f"{label:<28}failed: {f['failed']}")
             continue
         lines.append(f"{label:<28}{f['count']:>8}{f['median_us']:>12.0f}{f['p95_us']:>10.0f}{f['max_us']:>10.0f}")
+    if "run_health" in report:
+        lines.append(f"the live run's health: {report['run_health']}")
     return "\n".join(lines)
 
 

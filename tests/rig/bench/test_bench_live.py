@@ -38,6 +38,9 @@ def test_the_table_notes_and_plot_show_every_figure(tmp_path: Path) -> None:
     lines = live.table(REPORT).splitlines()
     assert lines[1].split() == ["sample", "arrival", "to", "pose", "600", "9000", "16000", "17500"]
     assert lines[3].split() == ["swap", "to", "logged", "300", "35", "80", "400"]
+    assert len(lines) == 4
+    verdict = "degraded: the rig hitched: no new image for 150 ms from 2.0 s into the run"
+    assert live.table({**REPORT, "run_health": verdict}).splitlines()[4] == f"the live run's health: {verdict}"
     assert live.BENCH.notes(REPORT) == "machine noise: 2 CPUs, 1-minute load average 1.23"
     live.plot(REPORT, tmp_path / "live.png")
     assert (tmp_path / "live.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and (tmp_path / "live.png").stat().st_size > 10_000
