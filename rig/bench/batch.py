@@ -52,8 +52,6 @@ def _process_seconds(arguments: list[str], environment: dict[str, str], allowed:
     return time.perf_counter() - started
 
 
-
-
 def videos(folder: Path, count: int, duration_s: float, log: Log) -> tuple[list[Path], list[dict[str, Any]]]:
     """`count` simulated videos over a few pendulum periods, each with its own seed; and those that
     could not be simulated, each with its reason."""

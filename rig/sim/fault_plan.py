@@ -33,13 +33,11 @@ class FaultPlan:
         return bool(self.corrupt or self.drop or self.garbage)
 
 
-
 def _probability(name: str, text: str) -> float:
     value = _number(name, text)
     if not 0.0 <= value < 1.0:
         raise ConfigError(f"fault {name}={text}: expected a probability in [0, 1)")
     return value
-
 
 
 def _number(name: str, text: str) -> float:
@@ -52,13 +50,11 @@ def _number(name: str, text: str) -> float:
     return value
 
 
-
 def _period(name: str, text: str) -> tuple[float, float]:
     at, sep, seconds = text.partition(":")
     if not sep:
         raise ConfigError(f"fault {name}={text}: expected AT:SECONDS, such as {name}=4:0.5")
     return _number(name, at), _number(name, seconds)
-
 
 
 def parse_faults(spec: str) -> FaultPlan:

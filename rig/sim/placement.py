@@ -30,7 +30,6 @@ class Placement:
     display: tuple[float, float, float]
 
 
-
 def placement(spec: str) -> Placement:
     """The placement a layout names (`LAYOUTS`) or spells out as LX,LY,LW/DX,DY,DW; ConfigError if neither."""
     text = LAYOUTS.get(spec, spec)

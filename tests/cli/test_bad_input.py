@@ -91,7 +91,6 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return lab
 
 
-
 @pytest.fixture
 def silent_board() -> Iterator[str]:
     """A socket:// port that accepts the connection and never says a word."""
@@ -238,8 +237,6 @@ CASES = [
     ("board-record-out-is-a-file", "board record --port loop:// --out {lab}/a-file --duration 1", "is a file"),
     ("unknown-command", "teleport", "invalid choice"),
 ]
-
-
 
 
 @pytest.mark.parametrize("argv, word", [pytest.param(argv, word, id=name) for name, argv, word in CASES])

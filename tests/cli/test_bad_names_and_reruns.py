@@ -73,17 +73,14 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return lab
 
 
-
 def _listing(folder: Path) -> set[Path]:
     return set(folder.rglob("*"))
-
 
 
 def _rig_process(argv: list[str], cwd: Path) -> tuple[int, str, str]:
     """The console script in its own process: a crash is a negative status, not this test's death."""
     done = subprocess.run([str(RIG), *argv], cwd=cwd, capture_output=True, timeout=COMMAND_LIMIT_S, env={**os.environ, "PYTHONFAULTHANDLER": "1"})
     return done.returncode, done.stdout.decode(errors="backslashreplace"), done.stderr.decode(errors="backslashreplace")
-
 
 
 def _closed_port() -> int:

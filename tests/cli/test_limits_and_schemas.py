@@ -52,7 +52,6 @@ def _trace(path: Path, times: list[float]) -> None:
     path.write_text(f"t,px,py,pz,qw,qx,qy,qz\n{rows}")
 
 
-
 # (id, argv with {lab} for the lab folder, words the message must hold)
 CASES = [
     # simulate: each number within what a lab's rig can be
@@ -158,7 +157,6 @@ CASES = [
      ("--max-iterations", "from 0 to 10000")),
     ("tune-two-sample-trace", "tune kalman-cv --trace {lab}/two-samples.csv --horizon-ms 20 --out {lab}/p.json", ("at least 10 samples",)),
 ]
-
 
 
 @pytest.mark.parametrize("argv, words", [pytest.param(argv, words, id=name) for name, argv, words in CASES])

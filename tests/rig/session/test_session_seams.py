@@ -157,7 +157,6 @@ def test_a_tracker_that_never_sends_is_reported(tmp_path) -> None:
         Session(parts, 0.0, 0.2, record).run()
 
 
-
 def new_images(shown: list[dict[str, str]]) -> list[tuple[int, int]]:
     """(refresh, image) of every refresh that showed a new image."""
     return [(int(r["refresh"]), int(r["image"])) for r in shown if r["missed"] == "0"]
