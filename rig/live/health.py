@@ -199,6 +199,21 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()))
 
 
+def _pauses(stream: dict[str, Any], stalled: str, hitched: str, first: str, silent: str) -> tuple[list[str], list[str]]:
+    """The invalid and the degraded reasons of one stream's pauses (the display's images, the
+    tracker's samples): its first item after the warm-up, and its longest silence."""
+    invalid, degraded = [], []
+    if stream["first_s"] > WARM_UP_S:
+        invalid.append(f"{stalled}: its first {first} came {stream['first_s'] * 1e3:.0f} ms after the run began")
+    gap, at = stream["longest_gap_ms"], stream["longest_gap_at_s"]
+    silence = f"{silent} for {gap:.0f} ms from {at:.1f} s into the run"
+    if gap > STALL_S * 1e3:
+        invalid.append(f"{stalled}: {silence}")
+    elif gap > HITCH_S * 1e3:
+        degraded.append(f"{hitched}: {silence}")
+    return invalid, degraded
+
+
 def judge(health: dict[str, Any]) -> Verdict:
     """The verdict on a run's health (see the module docstring and the thresholds)."""
     invalid, degraded = [], []
@@ -206,26 +221,18 @@ def judge(health: dict[str, Any]) -> Verdict:
     if display is None or display["refreshes_presented"] == 0:
         invalid.append("the rig stalled: the display showed no image")
     else:
-        gap, at = display["longest_gap_ms"], display["longest_gap_at_s"]
-        if display["first_s"] > WARM_UP_S:
-            invalid.append(f"the rig stalled: its first image came {display['first_s'] * 1e3:.0f} ms after the run began")
-        if gap > STALL_S * 1e3:
-            invalid.append(f"the rig stalled: no new image for {gap:.0f} ms from {at:.1f} s into the run")
-        elif gap > HITCH_S * 1e3:
-            degraded.append(f"the rig hitched: no new image for {gap:.0f} ms from {at:.1f} s into the run")
+        stalls, hitches = _pauses(display, "the rig stalled", "the rig hitched", "image", "no new image")
+        invalid += stalls
+        degraded += hitches
         if display["presented_share"] < MIN_PRESENTED_SHARE:
             degraded.append(f"the display showed a new image at {display['presented_share']:.0%} of refreshes "
                             f"({display['refreshes_presented']} of {display['refreshes_expected']})")  # fmt: skip
         late = display["late_swaps"]
         if late is not None and late > MAX_LATE_SHARE * display["refreshes_presented"]:
             degraded.append(f"{late} of {display['refreshes_presented']} swaps were late")
-    gap, at = tracker["longest_gap_ms"], tracker["longest_gap_at_s"]
-    if tracker["first_s"] > WARM_UP_S:
-        invalid.append(f"the tracker stalled: its first sample came {tracker['first_s'] * 1e3:.0f} ms after the run began")
-    if gap > STALL_S * 1e3:
-        invalid.append(f"the tracker stalled: no sample arrived for {gap:.0f} ms from {at:.1f} s into the run")
-    elif gap > HITCH_S * 1e3:
-        degraded.append(f"the tracker dropped out: no sample arrived for {gap:.0f} ms from {at:.1f} s into the run")
+    stalls, hitches = _pauses(tracker, "the tracker stalled", "the tracker dropped out", "sample", "no sample arrived")
+    invalid += stalls
+    degraded += hitches
     if camera is not None and camera["dropped_share"] > MAX_CAMERA_DROP_SHARE:
         worst = max(camera["drops"], key=lambda drop: drop["frames"])
         degraded.append(f"the camera dropped {camera['dropped']} frames ({camera['dropped_share']:.1%}), "
