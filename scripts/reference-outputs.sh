@@ -14,9 +14,10 @@ if [[ $# -ne 1 ]]; then
     echo "usage: $0 OUT_DIR (made afresh; the runs' files are left there)" >&2
     exit 2
 fi
-out=$1
-rm -rf "$out"
-mkdir -p "$out"
+rm -rf "$1"
+mkdir -p "$1"
+# The runs are named relative to OUT, so paths the outputs hold read the same wherever OUT is.
+cd "$1"
 declare -A runs=(
     [default]=""
     [warp-kalman-cv]="--renderer warp --predictor kalman-cv"
@@ -24,11 +25,11 @@ declare -A runs=(
 )
 for name in default warp-kalman-cv board; do
     # shellcheck disable=SC2086  # the options are words
-    rig simulate --out "$out/$name" --duration 4 ${runs[$name]} > /dev/null
+    rig simulate --out "$name" --duration 4 ${runs[$name]} > /dev/null
     board=()
-    [[ -d "$out/$name/board" ]] && board=(--board "$out/$name/board")
-    rig analyse "$out/$name/video.avi" "${board[@]}" --json > "$out/$name.analysis.json" || [[ $? -eq 3 ]]
-    python3 - "$out/$name.analysis.json" > "$out/$name.analysis.stable.json" <<'EOF'
+    [[ -d "$name/board" ]] && board=(--board "$name/board")
+    rig analyse "$name/video.avi" "${board[@]}" --json > "$name.analysis.json" || [[ $? -eq 3 ]]
+    python3 - "$name.analysis.json" > "$name.analysis.stable.json" <<'EOF'
 import json, sys
 def stable(value):
     if isinstance(value, dict):
@@ -38,6 +39,6 @@ def stable(value):
     return value
 print(json.dumps(stable(json.load(open(sys.argv[1]))), indent=1, sort_keys=True))
 EOF
-    rm "$out/$name.analysis.json"
+    rm "$name.analysis.json"
 done
-(cd "$out" && find . -type f | LC_ALL=C sort | xargs sha256sum)
+find . -type f | LC_ALL=C sort | xargs sha256sum
