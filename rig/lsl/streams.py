@@ -27,8 +27,6 @@ from dataclasses import dataclass
 POSE_CHANNELS = ("frame", "t_photon", "t_sensor", "px", "py", "pz", "qw", "qx", "qy", "qz")
 POSE_UNITS = ("count", "seconds", "seconds", "metres", "metres", "metres", "normalised", "normalised", "normalised", "normalised")
 MARKER_CHANNELS = ("frame", "t_swap")
-MARKER_UNITS = ("count", "seconds")
-NO_FRAME = -1
 
 
 @dataclass(frozen=True)

@@ -109,9 +109,6 @@ class OneWayMapping:
                 second = bound
         self._window_end, self._best, self._second, self._best_at = window_end, best, second, best_at
 
-    def sensor_time(self, device_time: float, t_arrival: float) -> float:
-        return self.sensor_times([device_time], [t_arrival])[0]
-
     def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
         """Each record's device time less the modelled offset at its arrival (the current window's
         best bound while the model is empty, or while a restarted clock is far from it), never
@@ -182,9 +179,6 @@ class CorrectedMapping:
         queued, add = self._queued, self.add_correction
         while queued:
             add(*queued.popleft())
-
-    def sensor_time(self, device_time: float, t_arrival: float) -> float:
-        return self.model.to_rig_time(device_time)
 
     def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
         return self.model.to_rig_times(device_times)  # type: ignore[arg-type]

@@ -121,9 +121,6 @@ class LatencyHistogram:
         self._counts = array("q", bytes(8 * _BINS))
         self.count = 0
 
-    def add(self, latency_s: float) -> None:
-        self.add_many([latency_s])
-
     def add_many(self, latencies_s: Iterable[float]) -> None:
         counts, last = self._counts, _BINS - 1
         for latency_s in latencies_s:
