@@ -22,7 +22,7 @@ import tty
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from rig.devices.trackers.lsl_tracker import CHANNELS, pylsl
+from rig.devices.trackers.lsl_tracker import pose_outlet
 from rig.emulate.encode import Emission, RecordEncoder
 from rig.emulate.outbox import WRITE_WAIT_S, Outbox
 from rig.emulate.streamer import ReaderGone
@@ -243,17 +243,7 @@ class LslSink:
         self.address = f"lsl:{name}"
         self._rate = rate_hz
         self._source_id = source_id
-        self._outlet: Any = self._make_outlet()
-
-    def _make_outlet(self) -> Any:
-        lsl = pylsl()
-        info = lsl.StreamInfo(self.name, "MoCap", len(CHANNELS), self._rate, lsl.cf_double64, self._source_id)
-        channels = info.desc().append_child("channels")
-        for label in CHANNELS:
-            channel = channels.append_child("channel")
-            channel.append_child_value("label", label)
-            channel.append_child_value("unit", "metres" if label.startswith("p") else "normalised")
-        return lsl.StreamOutlet(info)
+        self._outlet: Any = pose_outlet(name, rate_hz, source_id)
 
     def wait_for_reader(self, stop_at: float) -> bool:
         while time.monotonic() < stop_at:
@@ -275,7 +265,7 @@ class LslSink:
         self._outlet = None
 
     def reconnect(self, stop_at: float) -> bool:
-        self._outlet = self._make_outlet()
+        self._outlet = pose_outlet(self.name, self._rate, self._source_id)
         return self.wait_for_reader(stop_at)
 
     def close(self) -> None:

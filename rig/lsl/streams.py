@@ -37,11 +37,3 @@ class StreamNames:
     tracker: str = "RigTracker"
     markers: str = "RigRendererMarkers"
 
-
-def describe_channels(info: object, labels: tuple[str, ...], units: tuple[str, ...]) -> None:
-    """Label and unit every channel in an LSL StreamInfo's description, as XDF readers expect."""
-    channels = info.desc().append_child("channels")  # type: ignore[attr-defined]
-    for label, unit in zip(labels, units):
-        channel = channels.append_child("channel")
-        channel.append_child_value("label", label)
-        channel.append_child_value("unit", unit)
