@@ -25,7 +25,7 @@ from collections import deque
 from typing import Any, Protocol, Sequence
 
 from rig.board.clock_sync import CLOCK_RESTART_S, ClockModel, OffsetInterval
-from rig.devices.trackers.profile import SECONDS_PER, TIME, Profile
+from rig.devices.trackers.profile import TIME, Profile
 
 WINDOW_S = 0.5
 
@@ -200,5 +200,5 @@ def mapping_for(profile: Profile) -> ClockMapping:
     time_field = profile.field(TIME)
     if time_field is None:
         return ArrivalTime()
-    step = profile.scale.get(TIME, 1.0) * SECONDS_PER[profile.time_unit]
+    step = profile.scale.get(TIME, 1.0) * profile.unit(TIME)
     return OneWayMapping(abs(step) if time_field.integer_bits else 0.0)
