@@ -15,7 +15,7 @@
 from __future__ import annotations
 
 from array import array
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from operator import lt
 from typing import Any, Iterable
 
@@ -37,9 +37,6 @@ class TrackerCounters:
     dropped: int | None = None
     out_of_order: int = 0
     reconnects: int = 0
-
-    def as_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
 
 class SequenceCheck:

@@ -26,7 +26,7 @@ import os
 import threading
 import time
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from functools import partial
 from itertools import repeat
 from operator import sub
@@ -234,7 +234,7 @@ class TrackerStream:
             "tracker": self.name,
             "link": self.transport.description,
             **self._describe(),
-            "counters": self.counters.as_dict(),
+            "counters": asdict(self.counters),
             "reader_cpu_us_per_sample": self.reader_cpu_s / max(self.counters.received, 1) * 1e6,
             "reading_cpu_us_per_sample": (self.reader_cpu_s + self.decode_cpu_s) / max(self.counters.received, 1) * 1e6,
             "latency": self.latency.summary() if self.mapping.latency_known else None,
