@@ -38,7 +38,9 @@ class _ByteSink:
     """What a pty and a TCP sink share: records encoded as the profile says, their bytes damaged as the
     faults say, written through an `Outbox` with waits of at most `write_wait_s`."""
 
-    def __init__(self, encoder: RecordEncoder, faults: ByteFaults, sleep: Callable[[float], None], write_wait_s: float) -> None:
+    def __init__(
+        self, encoder: RecordEncoder, faults: ByteFaults, sleep: Callable[[float], None], write_wait_s: float
+    ) -> None:
         self._encoder = encoder
         self._faults = faults
         self._sleep = sleep
