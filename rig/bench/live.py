@@ -83,7 +83,7 @@ def swap_to_log(out_dir: Path, swaps: int = SWAPS) -> dict[str, Any]:
     with CsvRecord(out_dir / "bench_swaps.csv", SWAP_COLUMNS, overwrite=True) as log:
 
         def write(swap: SwapRecord) -> None:
-            log.write(swap.row())
+            log.write(swap)
             delays.append(clock.now() - swap.t_swap)
 
         display = WindowDisplay(WindowSettings(size=SIZE), frame_clock=FixedRateFrameClock(REFRESH_HZ), swap_log=write)

@@ -54,6 +54,11 @@ class EmulatorOptions:
         flag=Flag("--drift-ppm", group=SERIAL),
     )  # fmt: skip
 
+    def tracker(self) -> TrackerConfig:
+        """The simulated tracker of these numbers (its settings not declared here at their defaults)."""
+        shared = TrackerConfig.__dataclass_fields__.keys() & self.__dataclass_fields__.keys()
+        return TrackerConfig(**{name: getattr(self, name) for name in shared})
+
 
 def _faults(text: str) -> FaultPlan:
     try:
@@ -73,14 +78,7 @@ def _run(args: argparse.Namespace) -> int:
     config = EmulatorConfig(
         transport=transport,
         address=address,
-        tracker=TrackerConfig(
-            rate_hz=numbers.rate_hz,
-            position_noise_m=numbers.position_noise_m,
-            orientation_noise_deg=numbers.orientation_noise_deg,
-            transport_delay_s=numbers.transport_delay_s,
-            jitter_s=numbers.jitter_s,
-            dropout=numbers.dropout,
-        ),
+        tracker=numbers.tracker(),
         duration_s=numbers.duration_s,
         profile=getattr(args, "profile", DEFAULT_PROFILE),
         trace=args.trace,

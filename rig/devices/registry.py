@@ -28,7 +28,7 @@ from rig.devices.trackers.lsl_tracker import lsl_tracker
 from rig.devices.trackers.serial_tracker import serial_tracker
 from rig.devices.window.spec import window_display
 from rig.errors import ConfigError, RigError
-from rig.plugins import load_plugin, plugin_names
+from rig.plugins import load_plugin
 
 SIMULATED = "sim"
 Device = TypeVar("Device")
@@ -54,10 +54,6 @@ class DeviceKind(Generic[Device]):
     protocol: type
     """`Device` itself, a runtime-checkable protocol (which a type[...] field cannot hold)."""
     built_in: Mapping[str, DeviceFactory]
-
-    def schemes(self) -> list[str]:
-        """Every scheme a spec of this kind may start with, sorted: built-in and installed third-party."""
-        return plugin_names(self.group, self.built_in)
 
     def make(self, spec: str, context: DeviceContext) -> Device:
         """A new, unconnected device for `spec`. Raises ConfigError for a scheme nothing is

@@ -15,18 +15,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from rig.devices.trackers.checksums import CHECKSUMS
-from rig.devices.trackers.profile import (
-    EULER,
-    METRES_PER,
-    POSITION,
-    QUATERNION,
-    RADIANS_PER,
-    RATE,
-    SECONDS_PER,
-    SEQUENCE,
-    TIME,
-    Profile,
-)
+from rig.devices.trackers.profile import EULER, POSITION, QUATERNION, RATE, SEQUENCE, TIME, Profile
 
 
 @dataclass(frozen=True)
@@ -49,13 +38,12 @@ class RecordEncoder:
         self._check = CHECKSUMS[profile.checksum]
 
     def _physical(self, emission: Emission) -> dict[str, float]:
+        """The record's values by field name, in the rig's units."""
         profile = self.profile
-        values: dict[str, float] = {SEQUENCE: float(emission.seq), TIME: emission.device_time / SECONDS_PER[profile.time_unit]}
-        metres = METRES_PER[profile.position_unit]
-        radians = RADIANS_PER[profile.angle_unit]
-        values.update({name: v / metres for name, v in zip(POSITION, emission.position)})
+        values: dict[str, float] = {SEQUENCE: float(emission.seq), TIME: emission.device_time}
+        values.update(zip(POSITION, emission.position))
         values.update(zip(QUATERNION, emission.orientation))
-        values.update({name: v / radians for name, v in zip(RATE, emission.angular_rate)})
+        values.update(zip(RATE, emission.angular_rate))
         if profile.euler:
             w, x, y, z = emission.orientation
             with warnings.catch_warnings():
@@ -63,17 +51,17 @@ class RecordEncoder:
                 # angle to zero; the three it gives still make the same rotation, as a device sends it.
                 warnings.filterwarnings("ignore", "Gimbal lock detected", UserWarning)
                 angles = Rotation.from_quat([x, y, z, w]).as_euler(profile.euler)
-            values.update({name: float(a) / radians for name, a in zip(EULER, angles)})
+            values.update(zip(EULER, angles.tolist()))
         return values
 
     def raw_values(self, emission: Emission) -> list[float | int]:
         """The record's fields in profile order, scaled, integers rounded and wrapped."""
-        values = self._physical(emission)
+        profile, values = self.profile, self._physical(emission)
         raw: list[float | int] = []
-        for field in self.profile.fields:
+        for field in profile.fields:
             if field.code.endswith("x"):
                 continue
-            value = values.get(field.name, 0.0) / self.profile.scale.get(field.name, 1.0)
+            value = values.get(field.name, 0.0) / profile.unit(field.name) / profile.scale.get(field.name, 1.0)
             bits = field.integer_bits
             if bits is not None:
                 signed = field.code.islower()

@@ -22,7 +22,7 @@ import tty
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from rig.devices.trackers.lsl_tracker import CHANNELS, pylsl
+from rig.devices.trackers.lsl_tracker import pose_outlet
 from rig.emulate.encode import Emission, RecordEncoder
 from rig.emulate.outbox import WRITE_WAIT_S, Outbox
 from rig.emulate.streamer import ReaderGone
@@ -34,19 +34,46 @@ READER_GRACE_S = 0.1
 POLL_S = 0.02
 
 
-class PtySink:
+class _ByteSink:
+    """What a pty and a TCP sink share: records encoded as the profile says, their bytes damaged as the
+    faults say, written through an `Outbox` with waits of at most `write_wait_s`."""
+
+    def __init__(
+        self, encoder: RecordEncoder, faults: ByteFaults, sleep: Callable[[float], None], write_wait_s: float
+    ) -> None:
+        self._encoder = encoder
+        self._faults = faults
+        self._sleep = sleep
+        self._write_wait_s = write_wait_s
+        self._outbox: Outbox | None = None
+
+    def _reader_gone(self) -> bool:
+        raise NotImplementedError
+
+    def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
+        """Writes the records at once, as many as the port takes: (damaged per record written, the
+        first ones of `emissions`; the monotonic time of the write). ReaderGone once the reader has gone."""
+        if self._reader_gone():
+            raise ReaderGone
+        chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
+        written = time.monotonic()
+        try:
+            taken = self._outbox.send(chunks)  # type: ignore[union-attr]
+        except OSError:  # reset or a broken pipe: the reader went between the check and the write
+            raise ReaderGone from None
+        return list(damaged[:taken]), written
+
+
+class PtySink(_ByteSink):
     """A pseudo-terminal whose slave is reachable at `link` (a symlink kept pointing at the live one)."""
 
     def __init__(
         self, link: Path, encoder: RecordEncoder, faults: ByteFaults, *, sleep: Callable[[float], None] = time.sleep,
         write_wait_s: float = WRITE_WAIT_S,
     ) -> None:  # fmt: skip
+        super().__init__(encoder, faults, sleep, write_wait_s)
         self.link = Path(link)
         self.address = str(self.link)
-        self._encoder = encoder
-        self._faults = faults
-        self._sleep = sleep
-        self._write_wait_s = write_wait_s
         self._master = -1
         self._terminal = ""
         self._open()
@@ -82,10 +109,11 @@ class PtySink:
         except OSError:
             return False
 
-    def _reader_present(self) -> bool:
+    def _reader_gone(self) -> bool:
+        """Whether nobody has the terminal open."""
         poller = select.poll()
         poller.register(self._master, select.POLLHUP)
-        return not any(event & select.POLLHUP for _, event in poller.poll(0))
+        return any(event & select.POLLHUP for _, event in poller.poll(0))
 
     def _writable(self, timeout_s: float) -> bool:
         """Whether the terminal has room within `timeout_s`; ReaderGone if its reader hangs up meanwhile."""
@@ -97,22 +125,12 @@ class PtySink:
         return bool(events)
 
     def wait_for_reader(self, stop_at: float) -> bool:
-        while not self._reader_present():
+        while self._reader_gone():
             if time.monotonic() >= stop_at:
                 return False
             self._sleep(POLL_S)
         self._sleep(READER_GRACE_S)
         return True
-
-    def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
-        """Writes the records at once, as many as the terminal takes: (damaged per record written, the
-        first ones of `emissions`; the monotonic time of the write). ReaderGone once nobody has the
-        terminal open."""
-        if not self._reader_present():
-            raise ReaderGone
-        chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
-        written = time.monotonic()
-        return list(damaged[: self._outbox.send(chunks)]), written
 
     def linger(self, seconds: float) -> None:
         poller = select.poll()
@@ -144,7 +162,7 @@ def _why_not(error: OSError, link: Path) -> str:
     return f"cannot make a link there ({error.strerror}); name a path in a folder you can write"
 
 
-class TcpSink:
+class TcpSink(_ByteSink):
     """A TCP server on 127.0.0.1 (port 0: any free one) that streams to one client at a time, through
     a send buffer of `send_buffer_bytes` (None: the system's, which grows to megabytes)."""
 
@@ -152,13 +170,9 @@ class TcpSink:
         self, port: int, encoder: RecordEncoder, faults: ByteFaults, *, sleep: Callable[[float], None] = time.sleep,
         write_wait_s: float = WRITE_WAIT_S, send_buffer_bytes: int | None = None,
     ) -> None:  # fmt: skip
-        self._encoder = encoder
-        self._faults = faults
-        self._sleep = sleep
-        self._write_wait_s = write_wait_s
+        super().__init__(encoder, faults, sleep, write_wait_s)
         self._send_buffer = send_buffer_bytes
         self._client: socket.socket | None = None
-        self._outbox: Outbox | None = None
         self._listener = self._listen(port)
         self.port = self._listener.getsockname()[1]
         self.address = f"socket://127.0.0.1:{self.port}"
@@ -191,7 +205,7 @@ class TcpSink:
                 return True
         return False
 
-    def _client_gone(self) -> bool:
+    def _reader_gone(self) -> bool:
         """Whether the client has closed its end: a reader sends nothing, so anything to read is its end."""
         client = self._client
         if client is None:
@@ -204,18 +218,6 @@ class TcpSink:
             return False
         except OSError:
             return True
-
-    def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
-        """As PtySink.send: as many records as the socket takes; ReaderGone once the client has gone."""
-        if self._client_gone():
-            raise ReaderGone
-        chunks, damaged = zip(*(self._faults.apply(self._encoder.encode(e), rate_hz) for e in emissions))
-        written = time.monotonic()
-        try:
-            taken = self._outbox.send(chunks)
-        except OSError:  # reset or a broken pipe: the client went between the check and the write
-            raise ReaderGone from None
-        return list(damaged[:taken]), written
 
     def linger(self, seconds: float) -> None:
         if self._client is not None:
@@ -243,17 +245,7 @@ class LslSink:
         self.address = f"lsl:{name}"
         self._rate = rate_hz
         self._source_id = source_id
-        self._outlet: Any = self._make_outlet()
-
-    def _make_outlet(self) -> Any:
-        lsl = pylsl()
-        info = lsl.StreamInfo(self.name, "MoCap", len(CHANNELS), self._rate, lsl.cf_double64, self._source_id)
-        channels = info.desc().append_child("channels")
-        for label in CHANNELS:
-            channel = channels.append_child("channel")
-            channel.append_child_value("label", label)
-            channel.append_child_value("unit", "metres" if label.startswith("p") else "normalised")
-        return lsl.StreamOutlet(info)
+        self._outlet: Any = pose_outlet(name, rate_hz, source_id)
 
     def wait_for_reader(self, stop_at: float) -> bool:
         while time.monotonic() < stop_at:
@@ -275,7 +267,7 @@ class LslSink:
         self._outlet = None
 
     def reconnect(self, stop_at: float) -> bool:
-        self._outlet = self._make_outlet()
+        self._outlet = pose_outlet(self.name, self._rate, self._source_id)
         return self.wait_for_reader(stop_at)
 
     def close(self) -> None:

@@ -183,7 +183,7 @@ def run_live(
         else:
             swaps = files.enter_context(CsvRecord(out_dir / SWAPS_FILE, SWAP_COLUMNS, overwrite=overwrite))
             display = WindowDisplay(config.window, scanout_fraction=config.scanout_fraction, frame_clock=frame_clock,
-                                    swap_log=lambda swap: swaps.write(swap.row()))  # fmt: skip
+                                    swap_log=swaps.write)  # fmt: skip
         publisher = LslPublisher(config.streams, display, published)
         swing = SwingWatch() if config.until_still else None
         tracker = TappedTracker(make_tracker(config.tracker), publisher.samples, *([swing] if swing else []))

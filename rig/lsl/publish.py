@@ -20,8 +20,8 @@ import numpy as np
 from predictors import Pose, PoseSample
 from rig.clock import Clock
 from rig.devices.protocols import Display
-from rig.devices.trackers.lsl_tracker import CHANNELS, lsl_origin, pylsl
-from rig.lsl.streams import POSE_CHANNELS, POSE_UNITS, StreamNames, describe_channels
+from rig.devices.trackers.lsl_tracker import describe_channels, lsl_origin, pose_outlet, pylsl
+from rig.lsl.streams import POSE_CHANNELS, POSE_UNITS, StreamNames
 from rig.render.protocol import (
     AppFrameRequest,
     AppFrameResult,
@@ -67,10 +67,8 @@ class LslPublisher:
         view.append_child_value("world_to_clip", " ".join(repr(float(v)) for v in np.asarray(setup.world_to_clip).ravel()))
         view.append_child_value("sphere_radius_m", repr(float(setup.sphere_radius_m)))
         pose.desc().append_child_value("refresh_hz", repr(float(refresh_hz)))
-        tracker = lsl.StreamInfo(self.names.tracker, "MoCap", len(CHANNELS), 0.0, lsl.cf_double64, f"latency-rig-{self.names.tracker}")
-        describe_channels(tracker, CHANNELS, ("metres",) * 3 + ("normalised",) * 4)
         self._pose = lsl.StreamOutlet(pose)
-        self._tracker = lsl.StreamOutlet(tracker)
+        self._tracker = pose_outlet(self.names.tracker, 0.0, f"latency-rig-{self.names.tracker}")
 
     def lsl_time(self, t: float) -> float:
         """A rig time on the LSL clock."""

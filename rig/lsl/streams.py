@@ -27,8 +27,6 @@ from dataclasses import dataclass
 POSE_CHANNELS = ("frame", "t_photon", "t_sensor", "px", "py", "pz", "qw", "qx", "qy", "qz")
 POSE_UNITS = ("count", "seconds", "seconds", "metres", "metres", "metres", "normalised", "normalised", "normalised", "normalised")
 MARKER_CHANNELS = ("frame", "t_swap")
-MARKER_UNITS = ("count", "seconds")
-NO_FRAME = -1
 
 
 @dataclass(frozen=True)
@@ -39,11 +37,3 @@ class StreamNames:
     tracker: str = "RigTracker"
     markers: str = "RigRendererMarkers"
 
-
-def describe_channels(info: object, labels: tuple[str, ...], units: tuple[str, ...]) -> None:
-    """Label and unit every channel in an LSL StreamInfo's description, as XDF readers expect."""
-    channels = info.desc().append_child("channels")  # type: ignore[attr-defined]
-    for label, unit in zip(labels, units):
-        channel = channels.append_child("channel")
-        channel.append_child_value("label", label)
-        channel.append_child_value("unit", unit)

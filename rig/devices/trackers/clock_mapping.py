@@ -25,7 +25,7 @@ from collections import deque
 from typing import Any, Protocol, Sequence
 
 from rig.board.clock_sync import CLOCK_RESTART_S, ClockModel, OffsetInterval
-from rig.devices.trackers.profile import SECONDS_PER, TIME, Profile
+from rig.devices.trackers.profile import TIME, Profile
 
 WINDOW_S = 0.5
 
@@ -109,9 +109,6 @@ class OneWayMapping:
                 second = bound
         self._window_end, self._best, self._second, self._best_at = window_end, best, second, best_at
 
-    def sensor_time(self, device_time: float, t_arrival: float) -> float:
-        return self.sensor_times([device_time], [t_arrival])[0]
-
     def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
         """Each record's device time less the modelled offset at its arrival (the current window's
         best bound while the model is empty, or while a restarted clock is far from it), never
@@ -183,9 +180,6 @@ class CorrectedMapping:
         while queued:
             add(*queued.popleft())
 
-    def sensor_time(self, device_time: float, t_arrival: float) -> float:
-        return self.model.to_rig_time(device_time)
-
     def sensor_times(self, device_times: Sequence[float | None], arrivals: Sequence[float]) -> list[float]:
         return self.model.to_rig_times(device_times)  # type: ignore[arg-type]
 
@@ -206,5 +200,5 @@ def mapping_for(profile: Profile) -> ClockMapping:
     time_field = profile.field(TIME)
     if time_field is None:
         return ArrivalTime()
-    step = profile.scale.get(TIME, 1.0) * SECONDS_PER[profile.time_unit]
+    step = profile.scale.get(TIME, 1.0) * profile.unit(TIME)
     return OneWayMapping(abs(step) if time_field.integer_bits else 0.0)

@@ -15,7 +15,7 @@
 from __future__ import annotations
 
 from array import array
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from operator import lt
 from typing import Any, Iterable
 
@@ -37,9 +37,6 @@ class TrackerCounters:
     dropped: int | None = None
     out_of_order: int = 0
     reconnects: int = 0
-
-    def as_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
 
 class SequenceCheck:
@@ -120,9 +117,6 @@ class LatencyHistogram:
     def __init__(self) -> None:
         self._counts = array("q", bytes(8 * _BINS))
         self.count = 0
-
-    def add(self, latency_s: float) -> None:
-        self.add_many([latency_s])
 
     def add_many(self, latencies_s: Iterable[float]) -> None:
         counts, last = self._counts, _BINS - 1

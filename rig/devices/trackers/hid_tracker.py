@@ -12,10 +12,9 @@ from __future__ import annotations
 import errno
 from typing import Callable, Protocol
 
-from rig.devices.trackers.clock_mapping import mapping_for
 from rig.devices.trackers.decoders import HidReportDecoder
 from rig.devices.trackers.profile import load_profile
-from rig.devices.trackers.stream import TrackerStream
+from rig.devices.trackers.stream import TrackerStream, profile_stream
 from rig.devices.trackers.transport import ThreadReader
 from rig.errors import ConfigError, RigError
 
@@ -106,12 +105,5 @@ def hid_tracker(address: str, open_device: Callable[[int, int], HidDevice] = ope
     if profile.format != "hid":
         raise ConfigError(f"profile {profile.name} is a {profile.format} profile; a HID tracker needs format = \"hid\"")
     decoder = HidReportDecoder(profile)
-    return TrackerStream(
-        f"hid:{address}",
-        HidTransport(vendor, product, decoder.report_bytes, open_device),
-        decoder,
-        mapping_for(profile),
-        unit_tolerance=profile.unit_tolerance,
-        sequence_bits=profile.sequence_bits,
-        describe=lambda: {"profile": profile.describe()},
-    )
+    transport = HidTransport(vendor, product, decoder.report_bytes, open_device)
+    return profile_stream(f"hid:{address}", transport, decoder, profile)

@@ -37,6 +37,7 @@ except ImportError:
     LslReader = None
 
 CHANNELS = ("px", "py", "pz", "qw", "qx", "qy", "qz")
+CHANNEL_UNITS = ("metres",) * 3 + ("normalised",) * 4
 _STAMP, _POSITION, _ORIENTATION = itemgetter(0), itemgetter(1, 2, 3), itemgetter(4, 5, 6, 7)
 RESOLVE_TIMEOUT_S = 2.0
 RESOLVE_POLL_S = 0.1
@@ -124,6 +125,23 @@ def _time_correction(inlet: Any, timeout_s: float) -> tuple[float, float]:
     offset = function(inlet.obj, ctypes.byref(remote), ctypes.byref(uncertainty), timeout_s, ctypes.byref(error))
     lsl.util.handle_error(error)
     return offset, uncertainty.value
+
+
+def describe_channels(info: Any, labels: tuple[str, ...], units: tuple[str, ...]) -> None:
+    """Label and unit every channel in an LSL StreamInfo's description, as XDF readers expect."""
+    channels = info.desc().append_child("channels")
+    for label, unit in zip(labels, units):
+        channel = channels.append_child("channel")
+        channel.append_child_value("label", label)
+        channel.append_child_value("unit", unit)
+
+
+def pose_outlet(name: str, rate_hz: float, source_id: str) -> Any:
+    """An outlet of a pose stream as `lsl:NAME` reads one (type "MoCap", `CHANNELS`), stamped by its pusher."""
+    lsl = pylsl()
+    info = lsl.StreamInfo(name, "MoCap", len(CHANNELS), rate_hz, lsl.cf_double64, source_id)
+    describe_channels(info, CHANNELS, CHANNEL_UNITS)
+    return lsl.StreamOutlet(info)
 
 
 def lsl_origin(clock: Clock) -> float:

@@ -119,6 +119,14 @@ class Profile:
     def field(self, name: str) -> Field | None:
         return next((f for f in self.fields if f.name == name), None)
 
+    def unit(self, name: str) -> float:
+        """One unit of field `name` in the rig's units (m, rad, rad/s, s; 1 for the rest), its scale aside."""
+        if name in POSITION:
+            return METRES_PER[self.position_unit]
+        if name in EULER or name in RATE:
+            return RADIANS_PER[self.angle_unit]
+        return SECONDS_PER[self.time_unit] if name == TIME else 1.0
+
     def describe(self) -> dict[str, Any]:
         """The profile as the sidecar of a recording keeps it."""
         return {

@@ -23,18 +23,7 @@ from typing import Callable, Iterable, Sequence
 
 from predictors.scalar_quaternion import Quaternion, multiply
 from rig.board.clock_sync import TickUnwrapper
-from rig.devices.trackers.profile import (
-    EULER,
-    METRES_PER,
-    POSITION,
-    QUATERNION,
-    RADIANS_PER,
-    RATE,
-    SECONDS_PER,
-    SEQUENCE,
-    TIME,
-    Profile,
-)
+from rig.devices.trackers.profile import EULER, POSITION, QUATERNION, RATE, SEQUENCE, TIME, Profile
 
 
 @dataclass(slots=True)
@@ -88,10 +77,10 @@ class ReadingMaker:
 
     def __init__(self, profile: Profile) -> None:
         self._euler = profile.euler
-        self._position = _group(profile, POSITION, METRES_PER[profile.position_unit])
-        self._quaternion = _group(profile, QUATERNION, 1.0)
-        self._euler_angles = _group(profile, EULER, RADIANS_PER[profile.angle_unit])
-        self._rate = _group(profile, RATE, RADIANS_PER[profile.angle_unit])
+        self._position = _group(profile, POSITION)
+        self._quaternion = _group(profile, QUATERNION)
+        self._euler_angles = _group(profile, EULER)
+        self._rate = _group(profile, RATE)
         names = _value_names(profile)
         seq_field = profile.field(SEQUENCE)
         self._seq = itemgetter(names.index(SEQUENCE)) if seq_field else None
@@ -102,7 +91,7 @@ class ReadingMaker:
         bits = time_field.integer_bits if time_field else None
         self._unwrap = TickUnwrapper(bits) if bits else None
         self._time_scale = profile.scale.get(TIME, 1.0)
-        self._seconds = SECONDS_PER[profile.time_unit]
+        self._seconds = profile.unit(TIME)
 
     def make_many(self, records: Sequence[Sequence[float]], arrivals: list[float], discarded: dict[int, int]) -> Readings:
         """The readings of records, in order, with their arrivals and the records discarded before
@@ -142,13 +131,13 @@ def _value_names(profile: Profile) -> list[str]:
     return [f.name for f in profile.fields if not f.code.endswith("x")]
 
 
-def _group(profile: Profile, names: tuple[str, ...], unit: float) -> _Group | None:
+def _group(profile: Profile, names: tuple[str, ...]) -> _Group | None:
     """How to pick the fields `names` out of a record's values, and their factors (None: all 1, on
     float fields); None where the profile has no such fields."""
     if not profile.has(*names):
         return None
     indices = [_value_names(profile).index(name) for name in names]
-    factors = tuple(profile.scale.get(name, 1.0) * unit for name in names)
+    factors = tuple(profile.scale.get(name, 1.0) * profile.unit(name) for name in names)
     floats = all(profile.field(name).integer_bits is None for name in names)  # type: ignore[union-attr]
     return itemgetter(*indices), (None if floats and all(f == 1.0 for f in factors) else factors)
 

@@ -17,11 +17,10 @@ from urllib.parse import parse_qsl, urlencode
 
 import serial
 
-from rig.devices.trackers.clock_mapping import mapping_for
 from rig.devices.trackers.decoders import decoder_for
 from rig.devices.trackers.default_profiles import SERIAL as DEFAULT_PROFILE
 from rig.devices.trackers.profile import load_profile
-from rig.devices.trackers.stream import TrackerStream
+from rig.devices.trackers.stream import TrackerStream, profile_stream
 from rig.devices.trackers.transport import Reader, ThreadReader
 from rig.errors import ConfigError, RigError
 
@@ -140,12 +139,4 @@ def serial_tracker(address: str, open_port: Callable[[str, int], SerialPort] = o
         log.warning(FD_READER_MISSING)
     if profile.format == "hid":
         raise ConfigError(f"profile {profile.name} describes HID reports; a serial tracker needs a text or binary profile")
-    return TrackerStream(
-        f"serial:{address}",
-        SerialTransport(url, baud, open_port),
-        decoder_for(profile),
-        mapping_for(profile),
-        unit_tolerance=profile.unit_tolerance,
-        sequence_bits=profile.sequence_bits,
-        describe=lambda: {"profile": profile.describe()},
-    )
+    return profile_stream(f"serial:{address}", SerialTransport(url, baud, open_port), decoder_for(profile), profile)

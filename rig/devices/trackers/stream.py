@@ -26,7 +26,7 @@ import os
 import threading
 import time
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from functools import partial
 from itertools import repeat
 from operator import sub
@@ -35,9 +35,10 @@ from typing import Any, Callable, NamedTuple
 from predictors import PoseSample
 from rig.clock import Clock
 from rig.devices.protocols import Fault
-from rig.devices.trackers.clock_mapping import ClockMapping
+from rig.devices.trackers.clock_mapping import ClockMapping, mapping_for
 from rig.devices.trackers.counters import LatencyHistogram, SequenceCheck, TrackerCounters
 from rig.devices.trackers.decoders import Decoder
+from rig.devices.trackers.profile import Profile
 from rig.devices.trackers.readings import keep_possible
 from rig.devices.trackers.transport import Reader, Transport, monotonic_origin_ns
 from rig.errors import RigError
@@ -233,7 +234,7 @@ class TrackerStream:
             "tracker": self.name,
             "link": self.transport.description,
             **self._describe(),
-            "counters": self.counters.as_dict(),
+            "counters": asdict(self.counters),
             "reader_cpu_us_per_sample": self.reader_cpu_s / max(self.counters.received, 1) * 1e6,
             "reading_cpu_us_per_sample": (self.reader_cpu_s + self.decode_cpu_s) / max(self.counters.received, 1) * 1e6,
             "latency": self.latency.summary() if self.mapping.latency_known else None,
@@ -359,3 +360,16 @@ class TrackerStream:
             self._event("restored", self.transport.description)
             return True
         return False
+
+
+def profile_stream(name: str, transport: Transport, decoder: Decoder, profile: Profile) -> TrackerStream:
+    """A stream of the records `profile` lays out: its clock mapping, checks and record counter."""
+    return TrackerStream(
+        name,
+        transport,
+        decoder,
+        mapping_for(profile),
+        unit_tolerance=profile.unit_tolerance,
+        sequence_bits=profile.sequence_bits,
+        describe=lambda: {"profile": profile.describe()},
+    )

@@ -20,8 +20,7 @@ model's otherwise. The window is opened by `open_window` (tests give a fake). Ro
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Callable, Protocol
+from typing import Any, Callable, NamedTuple, Protocol
 
 import numpy as np
 
@@ -38,10 +37,6 @@ KEEP_MEASURED = 512
 EARLY_SWAP_GUARD = 0.1
 """An image held for a later refresh is swapped this share of a period after the blank before it:
 a vsync swap then lands at the blank it was held for, not the one before."""
-SWAP_COLUMNS = (
-    "image", "aimed_refresh", "refresh", "late", "t_ready", "t_drawn", "t_swap_call", "t_swap", "t_blank_driver",
-    "t_gpu_done",
-)  # fmt: skip
 
 
 class FrameClock(Protocol):
@@ -59,13 +54,14 @@ class FrameClock(Protocol):
         """The first refresh whose blank is strictly after `t`."""
 
 
-@dataclass(frozen=True)
-class SwapRecord:
-    """One swap, as `SWAP_COLUMNS` lists (times on the rig clock, None where not measured)."""
+class SwapRecord(NamedTuple):
+    """One swap, a row of the swap log (`SWAP_COLUMNS`): the refresh it was aimed at, the one it
+    reached and how many later that was; times on the rig clock, None where not measured."""
 
     image: int
     aimed_refresh: int
     refresh: int
+    late: int
     t_ready: float
     t_drawn: float
     t_swap_call: float
@@ -73,11 +69,8 @@ class SwapRecord:
     t_blank_driver: float | None
     t_gpu_done: float | None
 
-    def row(self) -> list[Any]:
-        return [
-            self.image, self.aimed_refresh, self.refresh, self.refresh - self.aimed_refresh, self.t_ready, self.t_drawn,
-            self.t_swap_call, self.t_swap, self.t_blank_driver, self.t_gpu_done,
-        ]  # fmt: skip
+
+SWAP_COLUMNS = SwapRecord._fields
 
 
 class WindowDisplay:
@@ -214,7 +207,8 @@ class WindowDisplay:
         self.swaps += 1
         self.late_swaps += refresh > aimed
         if self._swap_log is not None:
-            self._swap_log(SwapRecord(image_id, aimed, refresh, t_ready, t_drawn, t_call, t_swap, t_blank, gpu_done))
+            times = (t_ready, t_drawn, t_call, t_swap, t_blank, gpu_done)
+            self._swap_log(SwapRecord(image_id, aimed, refresh, refresh - aimed, *times))
         return refresh
 
     def _reached(self, aimed: int, t_swap: float) -> tuple[int, float | None]:

@@ -128,13 +128,6 @@ class GlWindow:
         x, y = self.glfw.get_window_pos(self.handle)
         return (x, y, self.width, self.height)
 
-    @property
-    def nominal_refresh_hz(self) -> float | None:
-        """The refresh rate the monitor says it runs at (None where it says nothing)."""
-        monitor = self.glfw.get_window_monitor(self.handle) or self.glfw.get_primary_monitor()
-        rate = self.glfw.get_video_mode(monitor).refresh_rate if monitor else 0
-        return float(rate) if rate else None
-
     def extension_supported(self, name: str) -> bool:
         return bool(self.glfw.extension_supported(name))
 

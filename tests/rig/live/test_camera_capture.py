@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from rig.clock import MonotonicClock
-from rig.devices.camera import apply_settings, opencv_camera, parse_camera_address
+from rig.devices.camera.opencv_camera import apply_settings, opencv_camera, parse_camera_address
 from rig.devices.camera.opencv_camera import CameraSettings
 from rig.devices.protocols import CameraFrame
 from rig.errors import ConfigError, RigError
