@@ -41,7 +41,8 @@ from predictors import Pose, quaternion
 from rig.errors import RigError
 from rig.render import gl
 from rig.render.protocol import AppFrameRequest, AppFrameResult, DisplayFrameRequest, DisplayFrameResult, RenderSetup
-from rig.render.warp_client import BACKGROUND_ID, LOAD_ID, OBJECT_COUNT, SPHERE_ID, ClientScene, ClientTarget, ClientView
+from rig.render.scene import BACKGROUND_ID, LOAD_ID, OBJECT_COUNT, SPHERE_ID, Scene
+from rig.render.warp_client import ClientTarget, surface_pass
 from rig.render.warp_holes import HoleFinder, build_leaves, hole_blocks, leaves_hit
 from rig.render.warp_matrices import UntrackedMotion, pose_matrix, translation, warp_matrix, widened_projection
 from rig.render.warp_options import WarpOptions
@@ -99,7 +100,7 @@ class WarpRenderer:
         self.reconstruction = self.options.recon
         self._ctx: moderngl.Context | None = None
         self._setup: RenderSetup | None = None
-        self._resources: list = []
+        self._objects: gl.GLObjects | None = None
         self._frames: dict[int, _ClientFrame] = {}
         self._free_targets: list[list[ClientTarget]] = []
         self._reference: dict[float | None, np.ndarray] = {}
@@ -113,6 +114,7 @@ class WarpRenderer:
             raise RigError("the warp renderer is already open; close() it before opening it again")
         ctx = gl.create_context()
         self._ctx = ctx
+        self._objects = gl.GLObjects(ctx)
         try:
             with ctx:
                 gl.check_setup(setup, ctx)
@@ -129,20 +131,22 @@ class WarpRenderer:
         border = tuple(int(math.ceil(options.border * s)) for s in self.server_size)
         self.client_size = (self.server_size[0] + 2 * border[0], self.server_size[1] + 2 * border[1])
         self._grid_motion_px = float(max(1, *border))  # the border: the largest image motion a client frame is drawn for
-        self._client_view = ClientView(widened_projection(world_to_clip, self.server_size, border))
+        self._client_world_to_clip = widened_projection(world_to_clip, self.server_size, border)
         self._world_to_clip = world_to_clip
         self._load_mesh_to_body = np.linalg.inv(world_to_clip)
         self._spin_centre, self._spin_axis = _view_axis(world_to_clip)
         triangles = gl.load_triangles(setup.scene_triangles, setup.seed, setup.scene_load)
         self._leaves = build_leaves(triangles) if options.holes >= 1 else None
-        self._scene = ClientScene(ctx, setup.sphere_radius_m, triangles, self._leaves.order if self._leaves else None)
-        self._resources.append(self._scene)
-        self._server = WarpServer(ctx, self.client_size, self.server_size, OBJECT_COUNT, options.recon, options.fill)
-        self._resources.append(self._server)
+        keep = self._objects.keep
+        leaf_order = self._leaves.order if self._leaves else None
+        self._scene = keep(Scene(ctx, setup.sphere_radius_m, triangles, leaf_order))
+        self._surface = surface_pass(self._objects)
+        self._server = keep(
+            WarpServer(ctx, self.client_size, self.server_size, OBJECT_COUNT, options.recon, options.fill)
+        )
         self._holes = None
         if self._leaves is not None:
-            self._holes = HoleFinder(ctx, self.server_size, OBJECT_COUNT)
-            self._resources.append(self._holes)
+            self._holes = keep(HoleFinder(ctx, self.server_size, OBJECT_COUNT))
             r = setup.sphere_radius_m
             leaves = self._leaves
             self._holes.set_boxes(
@@ -189,8 +193,9 @@ class WarpRenderer:
         start = time.perf_counter()
         with self._ctx:
             for target, poses in zip(targets, views):
-                self._scene.draw(target, self._client_view, self._load_model(poses.load), poses.sphere)
-                self._scene.prepare_surface(target)
+                load_to_clip = self._client_world_to_clip @ self._load_model(poses.load)
+                self._scene.draw(target.framebuffer, self._client_world_to_clip, load_to_clip, poses.sphere)
+                target.prepare_surface(self._surface)
             if setup.wait_for_gpu:
                 self._ctx.finish()
         elapsed = time.perf_counter() - start
@@ -223,9 +228,9 @@ class WarpRenderer:
         with self._ctx:
             targets = [t for frame in self._frames.values() for t in frame.targets]
             targets += [t for free in self._free_targets for t in free]
-            for resource in [*targets, *reversed(self._resources)]:
-                resource.release()
-        self._resources.clear()
+            for target in targets:
+                target.release()
+            self._objects.release()
         self._frames = {}
         self._free_targets = []
         self._reference = {}
@@ -252,13 +257,13 @@ class WarpRenderer:
         (`rig.render.gl`).
         """
         self._check_open()
-        view = ClientView(self._world_to_clip)
+        view = self._world_to_clip
         key = float(t) if self.options.spin else None
         with self._ctx:
             target = ClientTarget(self._ctx, self.server_size)
             try:
                 if key not in self._reference:
-                    self._scene.draw(target, view, self._load_model(self._load_pose(t)), None)
+                    self._scene.draw(target.framebuffer, view, view @ self._load_model(self._load_pose(t)), None)
                     self._reference = {key: target.read()[0]}
                 target.framebuffer.use()
                 target.framebuffer.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
@@ -312,7 +317,7 @@ class WarpRenderer:
         """(objects, 4, 4) warp matrices for objects where the client drew them: S_obj inverse(C_obj)
         cancels, leaving the cameras and each object's projection."""
         eye = np.eye(4)
-        view = self._client_view.world_to_clip
+        view = self._client_world_to_clip
         rows = np.empty((OBJECT_COUNT, 4, 4))
         rows[BACKGROUND_ID] = rows[LOAD_ID] = warp_matrix(self._world_to_clip, eye, eye, eye, eye, view)
         rows[SPHERE_ID] = warp_matrix(gl.FRONT_HALF_DEPTH @ self._world_to_clip, eye, eye, eye, eye, gl.FRONT_HALF_DEPTH @ view)
@@ -322,7 +327,7 @@ class WarpRenderer:
         """Per client view, the warp matrices to the newest poses: the sphere's from the tracker,
         the load's (`load`, None while it does not move) from its untracked motion."""
         eye = np.eye(4)
-        view = self._client_view.world_to_clip
+        view = self._client_world_to_clip
         result = []
         for poses in frame.views:
             rows = self._static_rows.copy()
@@ -344,15 +349,15 @@ class WarpRenderer:
             self._world_to_clip, gl.FRONT_HALF_DEPTH @ self._world_to_clip @ translation(sphere), self._world_to_clip @ load_model,
         ])  # fmt: skip
         server = self._server
-        levels, proxy = self._holes.find(object_to_clip, (server.warped, server.warped_id, server.warped_depth), self.options.holes, moved)
+        levels, proxy = self._holes.find(object_to_clip, server.warped, self.options.holes, moved)
         hit = leaves_hit(self._leaves, object_to_clip[LOAD_ID], hole_blocks(levels, proxy, LOAD_ID))
         ranges = [(int(self._leaves.first[i]), int(self._leaves.count[i])) for i in hit]
-        server.warped_fbo.use()
+        server.warped.framebuffer.use()
         if ranges:
-            self._scene.draw_load_leaves(self._world_to_clip, load_model, ranges)
+            self._scene.draw_load_leaves(object_to_clip[LOAD_ID], ranges)
         redraw_sphere = bool(np.any((levels > 0) & (proxy == SPHERE_ID)))
         if redraw_sphere:
-            self._scene.draw_sphere(ClientView(self._world_to_clip), sphere)
+            self._scene.draw_sphere(self._world_to_clip, sphere)
         self.last_holes = {
             **{f"level_{level}": int(np.sum(levels == level + 1)) for level in range(3)},
             "leaves": len(ranges), "triangles": sum(count for _, count in ranges), "sphere": int(redraw_sphere),
