@@ -96,8 +96,6 @@ class WarpRenderer:
 
     def __init__(self, **options: Any) -> None:
         self.options = WarpOptions(**options)
-        self.views = self.options.views
-        self.reconstruction = self.options.recon
         self._ctx: moderngl.Context | None = None
         self._setup: RenderSetup | None = None
         self._objects: gl.GLObjects | None = None
@@ -185,9 +183,9 @@ class WarpRenderer:
         if request.index in self._frames:
             raise RigError(f"application frame {request.index} was already rendered; indices must be new")
         pose = request.predict(request.t_start)
-        times = [request.t_start, 2.0 * request.t_photon - request.t_start][: self.views]
+        times = [request.t_start, 2.0 * request.t_photon - request.t_start][: self.options.views]
         views = [_ViewPoses(np.array(pose.position), self._load_pose(times[0]))]
-        if self.views == 2:
+        if self.options.views == 2:
             views.append(_ViewPoses(np.array(request.predict(times[1]).position), self._load_pose(times[1])))
         targets = self._free_targets.pop() if self._free_targets else [self._new_target() for _ in views]
         start = time.perf_counter()
@@ -282,8 +280,9 @@ class WarpRenderer:
         return self._setup
 
     def _new_target(self) -> ClientTarget:
+        grid_motion_px = self._grid_motion_px if self.options.recon == "grid" else None
         with self._ctx:
-            return ClientTarget(self._ctx, self.client_size, self._grid_motion_px if self.reconstruction == "grid" else None)
+            return ClientTarget(self._ctx, self.client_size, grid_motion_px)
 
     def _switch_to(self, index: int) -> _ClientFrame:
         """The client frame `index`, releasing older ones the first time it is shown."""
