@@ -48,7 +48,7 @@ from rig.bench.predictor_scores import FailedEvaluation, HeldOut, Ratios, cost_r
 from rig.errors import ConfigError
 from rig.service.tune import check_scorable, in_time_order
 from rig.sim.pendulum import Pendulum, PendulumConfig
-from rig.sim.tracker import TrackerConfig, simulate_tracker
+from rig.sim.tracker import TrackerConfig, measure
 
 TRACES = Path(__file__).resolve().parents[2] / "data" / "traces"
 RECORDINGS = (TRACES / "hmd_orientation_user1.csv", TRACES / "quest_pro_robot_traj2.csv")
@@ -60,7 +60,7 @@ def pendulum_trace(duration_s: float, seed: int) -> Trace:
     pendulum = Pendulum(PendulumConfig(), t_end=duration_s + 1.0)
     truth_t = np.arange(int(duration_s * _TRUTH_RATE_HZ) + 1) / _TRUTH_RATE_HZ
     truth = Trace.from_samples("pendulum", truth_t, *pendulum.sensor_pose(truth_t))
-    samples = simulate_tracker(pendulum, TrackerConfig(), 0.0, duration_s, seed)
+    samples = measure(pendulum, TrackerConfig(), 0.0, duration_s, seed).pose_samples()
     return truth.with_samples(
         np.array([s.t_sensor for s in samples]),
         np.array([s.t_arrival for s in samples]),

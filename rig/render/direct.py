@@ -7,9 +7,7 @@ renderer shows grows with the cost of its scene (`RenderSetup.scene_triangles`).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 
-import moderngl
 import numpy as np
 
 from rig.errors import RigError
@@ -21,39 +19,16 @@ from rig.render.protocol import (
     DisplayFrameResult,
     RenderSetup,
 )
+from rig.render.scene import Scene
 
 MSAA_SAMPLES = 4
 """Samples per pixel: smooth sphere edges give the camera a sub-pixel centroid to find."""
-
-
-@dataclass
-class _Scene:
-    """The GL objects of an open renderer, released together on close."""
-
-    ctx: moderngl.Context
-    resources: list = field(default_factory=list)
-    draw_fbo: moderngl.Framebuffer | None = None
-    image_fbo: moderngl.Framebuffer | None = None
-    sphere_program: moderngl.Program | None = None
-    sphere_vao: moderngl.VertexArray | None = None
-    load_vao: moderngl.VertexArray | None = None
-    load_triangle_count: int = 0
-
-    def keep(self, resource):
-        """Remember `resource` for release and return it."""
-        self.resources.append(resource)
-        return resource
-
-    def release(self) -> None:
-        with self.ctx:
-            for resource in reversed(self.resources):
-                resource.release()
-        self.resources.clear()
-        self.ctx.release()
+LOAD_TO_CLIP = np.eye(4)
+"""The load's triangles are drawn where `gl.load_triangles` made them, in the display's NDC."""
 
 
 class DirectRenderer:
-    """Draws a bright sphere at the predicted position in front of dim load geometry.
+    """Draws a bright sphere at the predicted position in front of dim load geometry (`rig.render.scene`).
 
     The sphere is rotation-symmetric, so only the pose's position moves it. A frame's cost is the
     wall time of its GL work on this machine, from the first draw call until the image is read back.
@@ -64,34 +39,52 @@ class DirectRenderer:
 
     def __init__(self) -> None:
         self._setup: RenderSetup | None = None
-        self._scene: _Scene | None = None
+        self._objects: gl.GLObjects | None = None
 
     @property
     def load_triangle_count(self) -> int:
         """How many load triangles each frame draws (0 while closed)."""
-        return self._scene.load_triangle_count if self._scene is not None else 0
+        return self._scene.triangle_count if self._objects is not None else 0
 
     def open(self, setup: RenderSetup) -> None:
-        if self._scene is not None:
+        if self._objects is not None:
             raise RigError("the direct renderer is already open; close() it before opening it again")
-        scene = _Scene(gl.create_context())
+        self._objects = objects = gl.GLObjects(gl.create_context())
         try:
-            with scene.ctx:
-                gl.check_setup(setup, scene.ctx)
-                _build(scene, setup)
+            with objects.ctx:
+                gl.check_setup(setup, objects.ctx)
+                self._build(objects, setup)
         except BaseException:
-            scene.release()
+            self.close()
             raise
-        self._scene = scene
         self._setup = setup
 
+    def _build(self, objects: gl.GLObjects, setup: RenderSetup) -> None:
+        """A multisampled framebuffer to draw into, one to resolve it into for readback, and the scene."""
+        ctx, keep = objects.ctx, objects.keep
+        size = (setup.width, setup.height)
+        samples = min(MSAA_SAMPLES, int(ctx.info["GL_MAX_SAMPLES"]))
+        self._draw_fbo = keep(
+            ctx.framebuffer(
+                color_attachments=[keep(ctx.renderbuffer(size, components=4, samples=samples))],
+                depth_attachment=keep(ctx.depth_renderbuffer(size, samples=samples)),
+            )
+        )
+        self._image_fbo = keep(ctx.framebuffer(color_attachments=[keep(ctx.renderbuffer(size, components=4))]))
+        triangles = gl.load_triangles(setup.scene_triangles, setup.seed, setup.scene_load)
+        self._scene = keep(Scene(ctx, setup.sphere_radius_m, triangles))
+
     def render_app_frame(self, request: AppFrameRequest) -> AppFrameResult:
-        if self._scene is None or self._setup is None:
+        """Draw the sphere at the pose predicted for the frame's photons, then the load behind it,
+        and read the image back."""
+        if self._objects is None or self._setup is None:
             raise RigError("the direct renderer is not open; call open(setup) before rendering")
         pose = request.predict(request.t_photon)
         start = time.perf_counter()
-        with self._scene.ctx:
-            image = _draw(self._scene, pose.position)
+        with self._objects.ctx:
+            self._scene.draw(self._draw_fbo, self._setup.world_to_clip, LOAD_TO_CLIP, pose.position)
+            self._objects.ctx.copy_framebuffer(self._image_fbo, self._draw_fbo)
+            image = gl.read_rgb(self._image_fbo)
         return AppFrameResult(time.perf_counter() - start, pose, image)
 
     def render_display_frame(self, request: DisplayFrameRequest) -> DisplayFrameResult:
@@ -101,59 +94,9 @@ class DirectRenderer:
         )
 
     def close(self) -> None:
-        if self._scene is not None:
-            self._scene.release()
-        self._scene = None
+        if self._objects is not None:
+            with self._objects.ctx:
+                self._objects.release()
+            self._objects.ctx.release()
+        self._objects = None
         self._setup = None
-
-
-def _build(scene: _Scene, setup: RenderSetup) -> None:
-    ctx = scene.ctx
-    size = (setup.width, setup.height)
-    samples = min(MSAA_SAMPLES, int(ctx.info["GL_MAX_SAMPLES"]))
-    scene.draw_fbo = scene.keep(
-        ctx.framebuffer(
-            color_attachments=[scene.keep(ctx.renderbuffer(size, components=4, samples=samples))],
-            depth_attachment=scene.keep(ctx.depth_renderbuffer(size, samples=samples)),
-        )
-    )
-    scene.image_fbo = scene.keep(
-        ctx.framebuffer(color_attachments=[scene.keep(ctx.renderbuffer(size, components=4))])
-    )
-
-    mesh = gl.sphere_mesh(setup.sphere_radius_m)
-    scene.sphere_program = scene.keep(gl.sphere_program(ctx, setup.world_to_clip))
-    scene.sphere_vao = scene.keep(
-        ctx.vertex_array(
-            scene.sphere_program,
-            [
-                (scene.keep(ctx.buffer(mesh.vertices.tobytes())), "3f", "in_vertex"),
-                (scene.keep(ctx.buffer(mesh.normals.tobytes())), "3f", "in_normal"),
-            ],
-            index_buffer=scene.keep(ctx.buffer(mesh.indices.tobytes())),
-            index_element_size=4,
-        )
-    )
-
-    if setup.scene_triangles > 0:
-        triangles = gl.load_triangles(setup.scene_triangles, setup.seed, setup.scene_load)
-        scene.load_vao = scene.keep(
-            ctx.vertex_array(
-                scene.keep(gl.load_program(ctx)),
-                [(scene.keep(ctx.buffer(triangles.tobytes())), "3f", "in_ndc")],
-            )
-        )
-        scene.load_triangle_count = len(triangles)
-
-
-def _draw(scene: _Scene, position: np.ndarray) -> np.ndarray:
-    """Draw the sphere at `position`, then the load behind it, and read the image back."""
-    scene.draw_fbo.use()
-    scene.draw_fbo.clear(0.0, 0.0, 0.0, 1.0, depth=1.0)
-    scene.ctx.enable(moderngl.DEPTH_TEST)
-    scene.sphere_program["centre"].value = tuple(np.asarray(position, dtype=np.float64))
-    scene.sphere_vao.render(moderngl.TRIANGLES)
-    if scene.load_vao is not None:
-        scene.load_vao.render(moderngl.TRIANGLES)
-    scene.ctx.copy_framebuffer(scene.image_fbo, scene.draw_fbo)
-    return gl.read_rgb(scene.image_fbo)

@@ -1,15 +1,16 @@
-"""OpenGL helpers shared by the rig's renderers: context, meshes, load geometry, shaders, readback.
+"""OpenGL helpers shared by the rig's renderers: context, GL objects, meshes, load geometry, readback.
 
 Depth is partitioned so that the tracked sphere is always in front of the load geometry: the
-sphere's vertex shader squeezes clip-space depth into the front half of the depth range
-(NDC z in [-1, 0]) and the load triangles live in the back half (NDC z in (0, 1)). The load
-therefore costs real rasterisation and depth testing but never occludes the sphere, whatever
+sphere's vertex shader (`rig.render.scene`) squeezes clip-space depth into the front half of the
+depth range (NDC z in [-1, 0]) and the load triangles live in the back half (NDC z in (0, 1)). The
+load therefore costs real rasterisation and depth testing but never occludes the sphere, whatever
 `world_to_clip` is.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 import moderngl
 import numpy as np
@@ -33,9 +34,6 @@ LOAD_MESH_DEPTH_RADIUS = 0.15
 
 LOAD_MAX_INTENSITY = 0.1
 """Brightest a load triangle gets (the farthest are darkest): dim beside the sphere's >= 0.6."""
-
-SPHERE_AMBIENT = 0.6
-SPHERE_DIFFUSE = 0.4
 
 FRONT_HALF_DEPTH = np.array(
     [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.5, -0.5], [0.0, 0.0, 0.0, 1.0]]
@@ -64,6 +62,61 @@ def create_context() -> moderngl.Context:
             "and libgl1-mesa-dri for software rendering) or set GLCONTEXT_DEVICE_INDEX to a working "
             "EGL device"
         ) from exc
+
+
+T = TypeVar("T")
+
+FULLSCREEN_VERTEX_SHADER = """
+#version 330
+// One triangle covering the viewport, from gl_VertexID 0, 1, 2.
+void main() {
+    vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+"""
+
+
+class GLObjects:
+    """The GL objects of one part of a renderer, made in one context and released together, newest first."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self._held: list[Any] = []
+
+    def keep(self, resource: T) -> T:
+        """Remember `resource` for release and return it."""
+        self._held.append(resource)
+        return resource
+
+    def texture(self, size: tuple[int, int], components: int, dtype: str = "f1") -> moderngl.Texture:
+        """A texture sampled nearest: its texels are read, never blended."""
+        texture = self.keep(self.ctx.texture(size, components, dtype=dtype))
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        return texture
+
+    def depth_texture(self, size: tuple[int, int]) -> moderngl.Texture:
+        """A depth texture sampled nearest, as depths (no comparison)."""
+        texture = self.keep(self.ctx.depth_texture(size))
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        texture.compare_func = ""
+        return texture
+
+    def program(self, vertex_shader: str, fragment_shader: str, **uniforms: Any) -> moderngl.Program:
+        """A shader program with `uniforms` set."""
+        program = self.keep(self.ctx.program(vertex_shader=vertex_shader, fragment_shader=fragment_shader))
+        for name, value in uniforms.items():
+            program[name].value = value
+        return program
+
+    def fullscreen(self, fragment_shader: str, **uniforms: Any) -> moderngl.VertexArray:
+        """A pass of `fragment_shader` over every pixel of the framebuffer in use, with `uniforms` set:
+        `render(moderngl.TRIANGLES, vertices=3)` draws one triangle covering the viewport."""
+        return self.keep(self.ctx.vertex_array(self.program(FULLSCREEN_VERTEX_SHADER, fragment_shader, **uniforms), []))
+
+    def release(self) -> None:
+        for resource in reversed(self._held):
+            resource.release()
+        self._held.clear()
 
 
 def check_setup(setup: RenderSetup, ctx: moderngl.Context) -> None:
@@ -191,97 +244,11 @@ def headlight_direction(world_to_clip: np.ndarray) -> np.ndarray:
     return toward_viewer * eye / np.linalg.norm(eye[:3])
 
 
-SPHERE_VERTEX_SHADER = """
-#version 330
-uniform mat4 world_to_clip;
-uniform vec3 centre;
-in vec3 in_vertex;
-in vec3 in_normal;
-out vec3 v_world;
-out vec3 v_normal;
-void main() {
-    v_world = centre + in_vertex;
-    v_normal = in_normal;
-    gl_Position = world_to_clip * vec4(v_world, 1.0);
-    // front half of the depth range: NDC z in [-1, 0] (near clipping unchanged; the far plane
-    // moves out, which a sphere inside the view never notices)
-    gl_Position.z = 0.5 * (gl_Position.z - gl_Position.w);
-}
-"""
-
-SPHERE_FRAGMENT_SHADER = """
-#version 330
-uniform vec4 eye;
-uniform float ambient;
-uniform float diffuse;
-in vec3 v_world;
-in vec3 v_normal;
-out vec4 f_colour;
-void main() {
-    vec3 to_eye = normalize(eye.xyz - eye.w * v_world);
-    float lit = ambient + diffuse * max(dot(normalize(v_normal), to_eye), 0.0);
-    f_colour = vec4(vec3(lit), 1.0);
-}
-"""
-
-LOAD_VERTEX_SHADER = """
-#version 330
-uniform float max_intensity;
-uniform vec2 depth_range;
-in vec3 in_ndc;
-out float v_intensity;
-void main() {
-    v_intensity = max_intensity * (depth_range.y - in_ndc.z) / (depth_range.y - depth_range.x);
-    gl_Position = vec4(in_ndc, 1.0);
-}
-"""
-
-LOAD_FRAGMENT_SHADER = """
-#version 330
-in float v_intensity;
-out vec4 f_colour;
-void main() {
-    f_colour = vec4(vec3(v_intensity), 1.0);
-}
-"""
-
-
 def write_matrix(program: moderngl.Program, name: str, matrix: np.ndarray) -> None:
-    """Set the mat4 uniform `name` of `program` to the 4x4 `matrix` (numpy, row-major)."""
+    """Set the mat4 uniform `name` of `program` to the 4x4 `matrix` (numpy, row-major), or the mat4
+    array uniform to the matrices (n, 4, 4)."""
     # moderngl takes matrices column-major; numpy holds them row-major.
-    program[name].write(np.asarray(matrix, dtype=np.float64).T.astype(np.float32).tobytes())
-
-
-def sphere_program(
-    ctx: moderngl.Context, world_to_clip: np.ndarray, fragment_shader: str = SPHERE_FRAGMENT_SHADER
-) -> moderngl.Program:
-    """The sphere's shader program, lit from the projection centre of `world_to_clip`.
-
-    A `fragment_shader` other than the default must declare the default's uniforms and inputs
-    (the warp client's adds an object-ID output).
-    """
-    program = ctx.program(vertex_shader=SPHERE_VERTEX_SHADER, fragment_shader=fragment_shader)
-    write_matrix(program, "world_to_clip", world_to_clip)
-    program["eye"].value = tuple(headlight_direction(world_to_clip))
-    program["ambient"].value = SPHERE_AMBIENT
-    program["diffuse"].value = SPHERE_DIFFUSE
-    return program
-
-
-def load_program(
-    ctx: moderngl.Context,
-    vertex_shader: str = LOAD_VERTEX_SHADER,
-    fragment_shader: str = LOAD_FRAGMENT_SHADER,
-) -> moderngl.Program:
-    """The load triangles' shader program: positions already in NDC, dimmer with depth.
-
-    Other shaders must declare the defaults' uniforms (the warp client's place the NDC-valued
-    positions with a matrix and add an object-ID output).
-    """
-    program = ctx.program(vertex_shader=vertex_shader, fragment_shader=fragment_shader)
-    program["max_intensity"].value = LOAD_MAX_INTENSITY
-    program["depth_range"].value = LOAD_DEPTH_RANGE
-    return program
+    program[name].write(np.asarray(matrix, dtype=np.float64).swapaxes(-1, -2).astype(np.float32).tobytes())
 
 
 def read_rgb(framebuffer: moderngl.Framebuffer) -> np.ndarray:

@@ -41,7 +41,8 @@ from predictors import Pose, quaternion
 from rig.errors import RigError
 from rig.render import gl
 from rig.render.protocol import AppFrameRequest, AppFrameResult, DisplayFrameRequest, DisplayFrameResult, RenderSetup
-from rig.render.warp_client import BACKGROUND_ID, LOAD_ID, OBJECT_COUNT, SPHERE_ID, ClientScene, ClientTarget, ClientView
+from rig.render.scene import BACKGROUND_ID, LOAD_ID, OBJECT_COUNT, SPHERE_ID, Scene
+from rig.render.warp_client import ClientTarget, surface_pass
 from rig.render.warp_holes import HoleFinder, build_leaves, hole_blocks, leaves_hit
 from rig.render.warp_matrices import UntrackedMotion, pose_matrix, translation, warp_matrix, widened_projection
 from rig.render.warp_options import WarpOptions
@@ -95,11 +96,9 @@ class WarpRenderer:
 
     def __init__(self, **options: Any) -> None:
         self.options = WarpOptions(**options)
-        self.views = self.options.views
-        self.reconstruction = self.options.recon
         self._ctx: moderngl.Context | None = None
         self._setup: RenderSetup | None = None
-        self._resources: list = []
+        self._objects: gl.GLObjects | None = None
         self._frames: dict[int, _ClientFrame] = {}
         self._free_targets: list[list[ClientTarget]] = []
         self._reference: dict[float | None, np.ndarray] = {}
@@ -113,6 +112,7 @@ class WarpRenderer:
             raise RigError("the warp renderer is already open; close() it before opening it again")
         ctx = gl.create_context()
         self._ctx = ctx
+        self._objects = gl.GLObjects(ctx)
         try:
             with ctx:
                 gl.check_setup(setup, ctx)
@@ -129,20 +129,22 @@ class WarpRenderer:
         border = tuple(int(math.ceil(options.border * s)) for s in self.server_size)
         self.client_size = (self.server_size[0] + 2 * border[0], self.server_size[1] + 2 * border[1])
         self._grid_motion_px = float(max(1, *border))  # the border: the largest image motion a client frame is drawn for
-        self._client_view = ClientView(widened_projection(world_to_clip, self.server_size, border))
+        self._client_world_to_clip = widened_projection(world_to_clip, self.server_size, border)
         self._world_to_clip = world_to_clip
         self._load_mesh_to_body = np.linalg.inv(world_to_clip)
         self._spin_centre, self._spin_axis = _view_axis(world_to_clip)
         triangles = gl.load_triangles(setup.scene_triangles, setup.seed, setup.scene_load)
         self._leaves = build_leaves(triangles) if options.holes >= 1 else None
-        self._scene = ClientScene(ctx, setup.sphere_radius_m, triangles, self._leaves.order if self._leaves else None)
-        self._resources.append(self._scene)
-        self._server = WarpServer(ctx, self.client_size, self.server_size, OBJECT_COUNT, options.recon, options.fill)
-        self._resources.append(self._server)
+        keep = self._objects.keep
+        leaf_order = self._leaves.order if self._leaves else None
+        self._scene = keep(Scene(ctx, setup.sphere_radius_m, triangles, leaf_order))
+        self._surface = surface_pass(self._objects)
+        self._server = keep(
+            WarpServer(ctx, self.client_size, self.server_size, OBJECT_COUNT, options.recon, options.fill)
+        )
         self._holes = None
         if self._leaves is not None:
-            self._holes = HoleFinder(ctx, self.server_size, OBJECT_COUNT)
-            self._resources.append(self._holes)
+            self._holes = keep(HoleFinder(ctx, self.server_size, OBJECT_COUNT))
             r = setup.sphere_radius_m
             leaves = self._leaves
             self._holes.set_boxes(
@@ -181,16 +183,17 @@ class WarpRenderer:
         if request.index in self._frames:
             raise RigError(f"application frame {request.index} was already rendered; indices must be new")
         pose = request.predict(request.t_start)
-        times = [request.t_start, 2.0 * request.t_photon - request.t_start][: self.views]
+        times = [request.t_start, 2.0 * request.t_photon - request.t_start][: self.options.views]
         views = [_ViewPoses(np.array(pose.position), self._load_pose(times[0]))]
-        if self.views == 2:
+        if self.options.views == 2:
             views.append(_ViewPoses(np.array(request.predict(times[1]).position), self._load_pose(times[1])))
         targets = self._free_targets.pop() if self._free_targets else [self._new_target() for _ in views]
         start = time.perf_counter()
         with self._ctx:
             for target, poses in zip(targets, views):
-                self._scene.draw(target, self._client_view, self._load_model(poses.load), poses.sphere)
-                self._scene.prepare_surface(target)
+                load_to_clip = self._client_world_to_clip @ self._load_model(poses.load)
+                self._scene.draw(target.framebuffer, self._client_world_to_clip, load_to_clip, poses.sphere)
+                target.prepare_surface(self._surface)
             if setup.wait_for_gpu:
                 self._ctx.finish()
         elapsed = time.perf_counter() - start
@@ -223,9 +226,9 @@ class WarpRenderer:
         with self._ctx:
             targets = [t for frame in self._frames.values() for t in frame.targets]
             targets += [t for free in self._free_targets for t in free]
-            for resource in [*targets, *reversed(self._resources)]:
-                resource.release()
-        self._resources.clear()
+            for target in targets:
+                target.release()
+            self._objects.release()
         self._frames = {}
         self._free_targets = []
         self._reference = {}
@@ -252,13 +255,13 @@ class WarpRenderer:
         (`rig.render.gl`).
         """
         self._check_open()
-        view = ClientView(self._world_to_clip)
+        view = self._world_to_clip
         key = float(t) if self.options.spin else None
         with self._ctx:
             target = ClientTarget(self._ctx, self.server_size)
             try:
                 if key not in self._reference:
-                    self._scene.draw(target, view, self._load_model(self._load_pose(t)), None)
+                    self._scene.draw(target.framebuffer, view, view @ self._load_model(self._load_pose(t)), None)
                     self._reference = {key: target.read()[0]}
                 target.framebuffer.use()
                 target.framebuffer.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
@@ -277,8 +280,9 @@ class WarpRenderer:
         return self._setup
 
     def _new_target(self) -> ClientTarget:
+        grid_motion_px = self._grid_motion_px if self.options.recon == "grid" else None
         with self._ctx:
-            return ClientTarget(self._ctx, self.client_size, self._grid_motion_px if self.reconstruction == "grid" else None)
+            return ClientTarget(self._ctx, self.client_size, grid_motion_px)
 
     def _switch_to(self, index: int) -> _ClientFrame:
         """The client frame `index`, releasing older ones the first time it is shown."""
@@ -312,7 +316,7 @@ class WarpRenderer:
         """(objects, 4, 4) warp matrices for objects where the client drew them: S_obj inverse(C_obj)
         cancels, leaving the cameras and each object's projection."""
         eye = np.eye(4)
-        view = self._client_view.world_to_clip
+        view = self._client_world_to_clip
         rows = np.empty((OBJECT_COUNT, 4, 4))
         rows[BACKGROUND_ID] = rows[LOAD_ID] = warp_matrix(self._world_to_clip, eye, eye, eye, eye, view)
         rows[SPHERE_ID] = warp_matrix(gl.FRONT_HALF_DEPTH @ self._world_to_clip, eye, eye, eye, eye, gl.FRONT_HALF_DEPTH @ view)
@@ -322,7 +326,7 @@ class WarpRenderer:
         """Per client view, the warp matrices to the newest poses: the sphere's from the tracker,
         the load's (`load`, None while it does not move) from its untracked motion."""
         eye = np.eye(4)
-        view = self._client_view.world_to_clip
+        view = self._client_world_to_clip
         result = []
         for poses in frame.views:
             rows = self._static_rows.copy()
@@ -344,15 +348,15 @@ class WarpRenderer:
             self._world_to_clip, gl.FRONT_HALF_DEPTH @ self._world_to_clip @ translation(sphere), self._world_to_clip @ load_model,
         ])  # fmt: skip
         server = self._server
-        levels, proxy = self._holes.find(object_to_clip, (server.warped, server.warped_id, server.warped_depth), self.options.holes, moved)
+        levels, proxy = self._holes.find(object_to_clip, server.warped, self.options.holes, moved)
         hit = leaves_hit(self._leaves, object_to_clip[LOAD_ID], hole_blocks(levels, proxy, LOAD_ID))
         ranges = [(int(self._leaves.first[i]), int(self._leaves.count[i])) for i in hit]
-        server.warped_fbo.use()
+        server.warped.framebuffer.use()
         if ranges:
-            self._scene.draw_load_leaves(self._world_to_clip, load_model, ranges)
+            self._scene.draw_load_leaves(object_to_clip[LOAD_ID], ranges)
         redraw_sphere = bool(np.any((levels > 0) & (proxy == SPHERE_ID)))
         if redraw_sphere:
-            self._scene.draw_sphere(ClientView(self._world_to_clip), sphere)
+            self._scene.draw_sphere(self._world_to_clip, sphere)
         self.last_holes = {
             **{f"level_{level}": int(np.sum(levels == level + 1)) for level in range(3)},
             "leaves": len(ranges), "triangles": sum(count for _, count in ranges), "sphere": int(redraw_sphere),

@@ -18,13 +18,13 @@ import moderngl
 import numpy as np
 
 from rig.errors import ConfigError
+from rig.render import gl
 from rig.render.fill_shaders import (
     NEAREST_FILL_FRAGMENT_SHADER,
     PYRAMID_BASE_FRAGMENT_SHADER,
     PYRAMID_REDUCE_FRAGMENT_SHADER,
     lowpass_fill_fragment_shader,
 )
-from rig.render.warp_shaders import FULLSCREEN_VERTEX_SHADER
 
 FILLS = ("nearest", "lowpass")
 FILL_SEARCH_FRACTION = 1.0 / 16.0
@@ -48,34 +48,20 @@ class HoleFill:
             raise ConfigError(f"the warp's hole fill must be one of {', '.join(FILLS)}, got {kind!r}")
         self.ctx = ctx
         self.kind = kind
-        self._resources: list = []
+        self._objects = objects = gl.GLObjects(ctx)
         self._levels: list[tuple[moderngl.Texture, moderngl.Framebuffer]] = []
+        final = {"warped": 0, "background": background}
         if kind == "nearest":
-            self._program = self._keep(ctx.program(vertex_shader=FULLSCREEN_VERTEX_SHADER, fragment_shader=NEAREST_FILL_FRAGMENT_SHADER))
-            self._program["warped_depth"].value = 1
-            self._program["max_steps"].value = int(np.ceil(FILL_SEARCH_FRACTION * max(size)))
+            steps = int(np.ceil(FILL_SEARCH_FRACTION * max(size)))
+            self._pass = objects.fullscreen(NEAREST_FILL_FRAGMENT_SHADER, warped_depth=1, max_steps=steps, **final)
         else:
             for level_size in pyramid_sizes(size):
-                texture = self._keep(ctx.texture(level_size, 4, dtype="f4"))
-                texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                self._levels.append((texture, self._keep(ctx.framebuffer(color_attachments=[texture]))))
-            self._base = self._keep(ctx.program(vertex_shader=FULLSCREEN_VERTEX_SHADER, fragment_shader=PYRAMID_BASE_FRAGMENT_SHADER))
-            self._base["warped_depth"].value = 1
-            self._reduce = self._keep(ctx.program(vertex_shader=FULLSCREEN_VERTEX_SHADER, fragment_shader=PYRAMID_REDUCE_FRAGMENT_SHADER))
-            self._program = self._keep(
-                ctx.program(vertex_shader=FULLSCREEN_VERTEX_SHADER, fragment_shader=lowpass_fill_fragment_shader(len(self._levels) - 1))
-            )
-            for level in range(1, len(self._levels)):
-                self._program[f"level_{level}"].value = level
-            self._base_vao = self._keep(ctx.vertex_array(self._base, []))
-            self._reduce_vao = self._keep(ctx.vertex_array(self._reduce, []))
-        self._program["warped"].value = 0
-        self._program["background"].value = background
-        self._vao = self._keep(ctx.vertex_array(self._program, []))
-
-    def _keep(self, resource):
-        self._resources.append(resource)
-        return resource
+                texture = objects.texture(level_size, 4, dtype="f4")
+                self._levels.append((texture, objects.keep(ctx.framebuffer(color_attachments=[texture]))))
+            self._base = objects.fullscreen(PYRAMID_BASE_FRAGMENT_SHADER, warped_depth=1)
+            self._reduce = objects.fullscreen(PYRAMID_REDUCE_FRAGMENT_SHADER)
+            levels = {f"level_{level}": level for level in range(1, len(self._levels))}
+            self._pass = objects.fullscreen(lowpass_fill_fragment_shader(len(self._levels) - 1), **levels, **final)
 
     def fill(self, warped: moderngl.Texture, warped_depth: moderngl.Texture, output: moderngl.Framebuffer) -> None:
         """Fill the holes (alpha 0) of `warped` into `output`."""
@@ -84,20 +70,18 @@ class HoleFill:
             self._levels[0][1].use()
             warped.use(0)
             warped_depth.use(1)
-            self._base_vao.render(moderngl.TRIANGLES, vertices=3)
+            self._base.render(moderngl.TRIANGLES, vertices=3)
             for (finer, _), (_, coarser) in zip(self._levels, self._levels[1:]):
                 coarser.use()
                 finer.use(0)
-                self._reduce_vao.render(moderngl.TRIANGLES, vertices=3)
+                self._reduce.render(moderngl.TRIANGLES, vertices=3)
             for level, (texture, _) in enumerate(self._levels[1:], start=1):
                 texture.use(level)
         output.use()
         warped.use(0)
         if self.kind == "nearest":
             warped_depth.use(1)
-        self._vao.render(moderngl.TRIANGLES, vertices=3)
+        self._pass.render(moderngl.TRIANGLES, vertices=3)
 
     def release(self) -> None:
-        for resource in reversed(self._resources):
-            resource.release()
-        self._resources.clear()
+        self._objects.release()

@@ -25,8 +25,10 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from rig.render import gl
 from rig.render.fill_shaders import HOLE_FRAGMENT_SHADER, PROXY_FRAGMENT_SHADER, proxy_vertex_shader
-from rig.render.warp_shaders import FULLSCREEN_VERTEX_SHADER, ID_SCALE
+from rig.render.warp_client import IdImage
+from rig.render.warp_shaders import ID_SCALE
 
 LEAF_TRIANGLES = 1024
 HOLE_BLOCK = 4
@@ -119,33 +121,25 @@ class HoleFinder:
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int], object_count: int) -> None:
         self.ctx = ctx
         self.size = size
-        self._resources: list = []
-        keep = self._keep
-        self.proxy_id = keep(ctx.texture(size, 1, dtype="nu2"))
-        self.proxy_depth = keep(ctx.depth_texture(size))
-        self.proxy_back_depth = keep(ctx.depth_texture(size))
-        self.holes = keep(ctx.texture(size, 4))
-        for texture in (self.proxy_id, self.proxy_depth, self.proxy_back_depth, self.holes):
-            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        for texture in (self.proxy_depth, self.proxy_back_depth):
-            texture.compare_func = ""
+        self._objects = objects = gl.GLObjects(ctx)
+        keep = objects.keep
+        self.proxy_id = objects.texture(size, 1, dtype="nu2")
+        self.proxy_depth = objects.depth_texture(size)
+        self.proxy_back_depth = objects.depth_texture(size)
+        self.holes = objects.texture(size, 4)
         self._front_fbo = keep(ctx.framebuffer(color_attachments=[self.proxy_id], depth_attachment=self.proxy_depth))
         self._back_fbo = keep(ctx.framebuffer(depth_attachment=self.proxy_back_depth))
         self._hole_fbo = keep(ctx.framebuffer(color_attachments=[self.holes]))
-        self._proxy_program = keep(ctx.program(vertex_shader=proxy_vertex_shader(object_count), fragment_shader=PROXY_FRAGMENT_SHADER))
-        self._proxy_program["id_scale"].value = ID_SCALE
+        self._proxy_program = objects.program(
+            proxy_vertex_shader(object_count), PROXY_FRAGMENT_SHADER, id_scale=ID_SCALE
+        )
         self._boxes = keep(ctx.buffer(reserve=28))
         self._box_count = 0
         self._proxy_vao: moderngl.VertexArray | None = None
-        self._hole_program = keep(ctx.program(vertex_shader=FULLSCREEN_VERTEX_SHADER, fragment_shader=HOLE_FRAGMENT_SHADER))
-        for unit, name in enumerate(("warped", "warped_id", "warped_depth", "proxy_id", "proxy_depth", "proxy_back_depth")):
-            self._hole_program[name].value = unit
-        self._hole_program["id_scale"].value = ID_SCALE
-        self._hole_vao = keep(ctx.vertex_array(self._hole_program, []))
-
-    def _keep(self, resource):
-        self._resources.append(resource)
-        return resource
+        units = ("warped", "warped_id", "warped_depth", "proxy_id", "proxy_depth", "proxy_back_depth")
+        self._hole_pass = objects.fullscreen(
+            HOLE_FRAGMENT_SHADER, id_scale=ID_SCALE, **{name: unit for unit, name in enumerate(units)}
+        )
 
     def set_boxes(self, box_min: np.ndarray, box_max: np.ndarray, object_ids: np.ndarray) -> None:
         """The proxy boxes (B, 3) in their objects' coordinates, and each box's object."""
@@ -160,7 +154,7 @@ class HoleFinder:
     def find(
         self,
         object_to_clip: np.ndarray,
-        warped: tuple[moderngl.Texture, moderngl.Texture, moderngl.Texture],
+        warped: IdImage,
         max_level: int,
         moved: set[int],
     ) -> tuple[np.ndarray, np.ndarray]:
@@ -168,8 +162,7 @@ class HoleFinder:
         (colour, id, depth) textures, given the objects that moved since the client drew them:
         (hole level + 1 or 0, proxy object) per pixel, OpenGL rows."""
         ctx = self.ctx
-        columns = np.ascontiguousarray(np.asarray(object_to_clip, dtype=np.float64).transpose(0, 2, 1), dtype=np.float32)
-        self._proxy_program["object_to_clip"].write(columns.tobytes())
+        gl.write_matrix(self._proxy_program, "object_to_clip", object_to_clip)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         self._front_fbo.use()
@@ -186,11 +179,12 @@ class HoleFinder:
         self._proxy_vao.render(moderngl.TRIANGLES, vertices=36, instances=self._box_count)
         ctx.disable(moderngl.CULL_FACE | moderngl.DEPTH_TEST)
         self._hole_fbo.use()
-        for unit, texture in enumerate((*warped, self.proxy_id, self.proxy_depth, self.proxy_back_depth)):
+        proxy_maps = (self.proxy_id, self.proxy_depth, self.proxy_back_depth)
+        for unit, texture in enumerate((warped.colour, warped.object_id, warped.depth, *proxy_maps)):
             texture.use(unit)
-        self._hole_program["max_level"].value = max_level
-        self._hole_program["moved"].value = sum(1 << i for i in moved)
-        self._hole_vao.render(moderngl.TRIANGLES, vertices=3)
+        self._hole_pass.program["max_level"].value = max_level
+        self._hole_pass.program["moved"].value = sum(1 << i for i in moved)
+        self._hole_pass.render(moderngl.TRIANGLES, vertices=3)
         w, h = self.size
         holes = np.frombuffer(self.holes.read(), dtype=np.uint8).reshape(h, w, 4)
         proxy = np.frombuffer(self.proxy_id.read(), dtype=np.uint16).reshape(h, w)
@@ -199,6 +193,4 @@ class HoleFinder:
     def release(self) -> None:
         if self._proxy_vao is not None:
             self._proxy_vao.release()
-        for resource in reversed(self._resources):
-            resource.release()
-        self._resources.clear()
+        self._objects.release()

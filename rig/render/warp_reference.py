@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rig.render.warp_client import BACKGROUND_ID
+from rig.render.scene import BACKGROUND_ID
 from rig.render.warp_matrices import jacobian, pixel_ndc, splat_size
 
 

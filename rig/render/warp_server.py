@@ -30,8 +30,8 @@ import moderngl
 import numpy as np
 
 from rig.errors import ConfigError
-from rig.render.gl import read_rgb
-from rig.render.warp_client import ClientTarget
+from rig.render import gl
+from rig.render.warp_client import ClientTarget, IdImage
 from rig.render.warp_fill import HoleFill
 from rig.render.warp_matrices import SPLAT_ROUNDING
 from rig.render.warp_shaders import (
@@ -87,8 +87,8 @@ class WarpServer:
         self.background = background
         self.primitives: list[int] = []
         """How many primitives the latest warp drew, per client view."""
-        self._resources: list = []
-        keep = self._keep
+        self._objects = objects = gl.GLObjects(ctx)
+        keep = objects.keep
         self.max_splat = float(min(MAX_SPLAT_PX, ctx.info["GL_POINT_SIZE_RANGE"][1]))
 
         geometry = {"quad": WARP_QUAD_GEOMETRY_SHADER, "mesh": mesh_geometry_shader(object_count)}.get(reconstruction)
@@ -111,28 +111,17 @@ class WarpServer:
         elif reconstruction != "grid":
             self._warp_vao = keep(ctx.vertex_array(program, []))
 
-        self.warped = keep(ctx.texture(server_size, 4))
-        self.warped_id = keep(ctx.texture(server_size, 1, dtype="nu2"))
-        self.warped_depth = keep(ctx.depth_texture(server_size))
-        self.coverage = keep(ctx.texture(server_size, 4))
-        for texture in (self.warped, self.warped_id, self.warped_depth, self.coverage):
-            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        self.warped_depth.compare_func = ""
-        self.warped_fbo = keep(ctx.framebuffer(color_attachments=[self.warped, self.warped_id], depth_attachment=self.warped_depth))
-        self._coverage_fbo = keep(ctx.framebuffer(color_attachments=[self.coverage]))
+        self.warped = IdImage(objects, server_size)
+        self.coverage = objects.texture(server_size, 4)
 
         self.output = keep(ctx.texture(server_size, 4))
         self.output_fbo = keep(ctx.framebuffer(color_attachments=[self.output]))
         self._fill = keep(HoleFill(ctx, server_size, fill, background))
 
-    def _keep(self, resource):
-        self._resources.append(resource)
-        return resource
-
     def begin(self) -> None:
         """Redraw the background: clear the warped image (alpha 0: nothing warped yet) and its depth."""
-        self.warped_fbo.use()
-        self.warped_fbo.clear(*self.background, 0.0, depth=1.0)
+        self.warped.framebuffer.use()
+        self.warped.framebuffer.clear(*self.background, 0.0, depth=1.0)
         self.primitives = []
 
     def warp(self, targets: Sequence[ClientTarget], matrices: Sequence[np.ndarray]) -> None:
@@ -142,13 +131,11 @@ class WarpServer:
         self.begin()
         for view, (target, view_matrices) in enumerate(zip(targets, matrices, strict=True)):
             if view == 1:
-                ctx.copy_framebuffer(self.coverage, self.warped_fbo)
-            self.warped_fbo.use()
+                ctx.copy_framebuffer(self.coverage, self.warped.framebuffer)
+            self.warped.framebuffer.use()
             ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
             ctx.depth_func = "<"
-            # moderngl takes matrices column-major; numpy holds them row-major
-            columns = np.asarray(view_matrices, dtype=np.float64).transpose(0, 2, 1)
-            self.warp_program["warp_matrices"].write(np.ascontiguousarray(columns, dtype=np.float32).tobytes())
+            gl.write_matrix(self.warp_program, "warp_matrices", view_matrices)
             if "motion_class" in self.warp_program:
                 self.warp_program["motion_class"].value = motion_classes(view_matrices)
             if "arbitrate" in self.warp_program:
@@ -163,7 +150,9 @@ class WarpServer:
         pixels = self.client_size[0] * self.client_size[1]
         if self.reconstruction == "grid":
             if target.grid_vao is None:
-                target.grid_vao = self.ctx.vertex_array(self.warp_program, [(target.grid_buffer, "3i/i", "cell")])
+                target.grid_vao = target.objects.keep(
+                    self.ctx.vertex_array(self.warp_program, [(target.grid_buffer, "3i/i", "cell")])
+                )
             target.grid_vao.render(moderngl.TRIANGLE_STRIP, vertices=4, instances=target.grid_count)
             return target.grid_count
         if self.reconstruction == "mesh":
@@ -174,11 +163,11 @@ class WarpServer:
 
     def fill(self) -> None:
         """Fill the level-0 holes of the warped image into the output image (alpha 0 marks them)."""
-        self._fill.fill(self.warped, self.warped_depth, self.output_fbo)
+        self._fill.fill(self.warped.colour, self.warped.depth, self.output_fbo)
 
     def read_rgb(self) -> np.ndarray:
         """The output image, RGB uint8 (h, w, 3), row 0 at the top."""
-        return read_rgb(self.output_fbo)
+        return gl.read_rgb(self.output_fbo)
 
     def hole_fraction(self) -> float:
         """Fraction of output pixels that were level-0 holes (nothing warped to them) before filling."""
@@ -186,15 +175,5 @@ class WarpServer:
         alpha = np.frombuffer(self.output.read(), dtype=np.uint8).reshape(h, w, 4)[:, :, 3]
         return float(np.mean(alpha < 128))
 
-    def read_warped(self) -> tuple[np.ndarray, np.ndarray]:
-        """Before filling: (colour (h, w, 4) uint8 with alpha 255 where covered, window depth (h, w)),
-        OpenGL rows (row 0 at the bottom), as `rig.render.warp_reference.reference_warp` returns."""
-        w, h = self.server_size
-        colour = np.frombuffer(self.warped.read(), dtype=np.uint8).reshape(h, w, 4).copy()
-        depth = np.frombuffer(self.warped_depth.read(), dtype=np.float32).reshape(h, w).copy()
-        return colour, depth
-
     def release(self) -> None:
-        for resource in reversed(self._resources):
-            resource.release()
-        self._resources.clear()
+        self._objects.release()

@@ -1,6 +1,6 @@
-"""GLSL (3.3 core) of the warp renderer's client (object-ID outputs, surface) and of the server's
-warps: point and quad splats, the pixel mesh, the adaptive grid. The hole and fill passes are in
-`rig.render.fill_shaders`.
+"""GLSL (3.3 core) of the warp renderer's client surface and of the server's warps: point and quad
+splats, the pixel mesh, the adaptive grid. The scene's own shaders are in `rig.render.scene`, the
+hole and fill passes in `rig.render.fill_shaders`.
 
 Object IDs are stored normalised in a 16-bit channel (R16), id / 65535, as the seeds store 16-bit
 IDs: a normalised format clears and renders like any colour, where an integer one would not. A warp
@@ -11,49 +11,6 @@ from __future__ import annotations
 
 ID_SCALE = 65535.0
 """Object ID i is stored as i / ID_SCALE in the client's R16 ID texture."""
-
-CLIENT_SPHERE_FRAGMENT_SHADER = """
-#version 330
-uniform vec4 eye;
-uniform float ambient;
-uniform float diffuse;
-uniform float object_id;
-in vec3 v_world;
-in vec3 v_normal;
-layout(location = 0) out vec4 f_colour;
-layout(location = 1) out float f_id;
-void main() {
-    vec3 to_eye = normalize(eye.xyz - eye.w * v_world);
-    float lit = ambient + diffuse * max(dot(normalize(v_normal), to_eye), 0.0);
-    f_colour = vec4(vec3(lit), 1.0);
-    f_id = object_id;
-}
-"""
-
-CLIENT_LOAD_VERTEX_SHADER = """
-#version 330
-uniform mat4 object_to_clip;
-uniform float max_intensity;
-uniform vec2 depth_range;
-in vec3 in_ndc;
-out float v_intensity;
-void main() {
-    v_intensity = max_intensity * (depth_range.y - in_ndc.z) / (depth_range.y - depth_range.x);
-    gl_Position = object_to_clip * vec4(in_ndc, 1.0);
-}
-"""
-
-CLIENT_LOAD_FRAGMENT_SHADER = """
-#version 330
-uniform float object_id;
-in float v_intensity;
-layout(location = 0) out vec4 f_colour;
-layout(location = 1) out float f_id;
-void main() {
-    f_colour = vec4(vec3(v_intensity), 1.0);
-    f_id = object_id;
-}
-"""
 
 SURFACE_FRAGMENT_SHADER = """
 #version 330
@@ -323,13 +280,3 @@ def warp_vertex_shader(reconstruction: str, object_count: int) -> str:
     of `object_count` objects (IDs 0 to object_count - 1)."""
     main = {"point": _SPLAT_VERTEX_MAIN, "quad": _SPLAT_VERTEX_MAIN, "mesh": _MESH_VERTEX_MAIN, "grid": _GRID_VERTEX_MAIN}[reconstruction]
     return _WARP_HEADER.replace("%OBJECTS%", str(int(object_count))) + main
-
-
-FULLSCREEN_VERTEX_SHADER = """
-#version 330
-// One triangle covering the viewport, from gl_VertexID 0, 1, 2.
-void main() {
-    vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
-}
-"""

@@ -83,11 +83,6 @@ class BenchLayout:
         sphere = self.panel_pixels(positions)[:, 1]
         return float(np.mean(led) - 0.5) / self.camera_height, float(np.mean(sphere) - 0.5) / self.camera_height
 
-    def display_row_fraction(self, position: np.ndarray) -> float:
-        """Row of the display (0 top, 1 bottom) where a world position is drawn."""
-        clip = self.world_to_clip @ np.append(position, 1.0)
-        return float(np.clip((1.0 - clip[1] / clip[3]) / 2.0, 0.0, 1.0))
-
     def panel_pixels(self, positions: np.ndarray) -> np.ndarray:
         """Camera pixel (x, y) where world positions (N, 3) appear on the display panel."""
         homogeneous = np.hstack([positions, np.ones((len(positions), 1))]) @ self.world_to_clip.T

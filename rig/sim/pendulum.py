@@ -66,11 +66,6 @@ class Pendulum:
         self._solution = self._integrate() if self.t_release < self.t_end else None
 
     @property
-    def small_angle_period_s(self) -> float:
-        """2 pi sqrt(L / g): the period of an infinitesimal, undamped swing."""
-        return self.config.small_angle_period_s
-
-    @property
     def period_s(self) -> float:
         """The exact undamped period at the release amplitude A: 4 sqrt(L / g) K(sin^2(A / 2))."""
         m = math.sin(self.amplitude_rad / 2.0) ** 2

@@ -110,12 +110,6 @@ def measure(motion: Motion, config: TrackerConfig, t_start: float, t_end: float,
     return TrackerSamples(np.arange(n), t_sensor, t_arrival, positions, orientations, lost)
 
 
-def simulate_tracker(motion: Motion, config: TrackerConfig, t_start: float, t_end: float, seed: int) -> list[PoseSample]:
-    """The samples a tracker on `motion` delivers for sensor times in [t_start, t_end), sorted by
-    t_arrival (which, as the transport keeps order, is also t_sensor order)."""
-    return measure(motion, config, t_start, t_end, seed).pose_samples()
-
-
 class SimTracker:
     """The simulated tracker of a run: samples for sensor times in [t_start, t_end), handed out as
     the clock passes their arrival. `faults` may only be faults in time: there are no bytes here."""

@@ -86,7 +86,7 @@ def test_the_gl_arbitration_of_two_views_agrees_with_the_numpy_reference():
                 reference_warp(*target.read(), m, (WIDTH, HEIGHT), renderer._server.max_splat, BACKGROUND_NDC_Z)
                 for target, m in zip(frame.targets, matrices)
             ]
-            warped, _ = renderer._server.read_warped()
+            warped, _, _ = renderer._server.warped.read()
     finally:
         renderer.close()
     expected, _ = arbitrate_views(*views)
@@ -121,10 +121,9 @@ def test_the_gl_hole_levels_agree_with_the_numpy_reference(max_level):
             ORTHOGRAPHIC @ renderer._load_model(load),
         ])  # fmt: skip
         with renderer._ctx:
-            levels, proxy = finder.find(object_to_clip, (server.warped, server.warped_id, server.warped_depth), max_level, {1, 2})
+            levels, proxy = finder.find(object_to_clip, server.warped, max_level, {1, 2})
             w, h = WIDTH, HEIGHT
-            colour, depth = server.read_warped()
-            ids = np.rint(np.frombuffer(server.warped_id.read(), dtype=np.uint16).reshape(h, w)).astype(np.int64)
+            colour, ids, depth = server.warped.read()
             front = np.frombuffer(finder.proxy_depth.read(), dtype=np.float32).reshape(h, w)
             back = np.frombuffer(finder.proxy_back_depth.read(), dtype=np.float32).reshape(h, w)
     finally:
@@ -142,7 +141,7 @@ def lowpass_filled() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     renderer, image, _ = warp_once(fill="lowpass")
     try:
         with renderer._ctx:
-            colour, depth = renderer._server.read_warped()
+            colour, _, depth = renderer._server.warped.read()
     finally:
         renderer.close()
     return image, colour, depth

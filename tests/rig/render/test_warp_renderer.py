@@ -114,7 +114,7 @@ def reference_of_display_frame(renderer: WarpRenderer, app_frame: int, position)
             reference_warp(*target.read(), view_matrices, (WIDTH, HEIGHT), renderer._server.max_splat, BACKGROUND_NDC_Z)
             for target, view_matrices in zip(frame.targets, matrices)
         ]
-        warped, _ = renderer._server.read_warped()
+        warped, _, _ = renderer._server.warped.read()
     colour, _ = views[0] if len(views) == 1 else arbitrate_views(*views)
     return warped, colour
 
@@ -195,7 +195,7 @@ def test_holes_are_marked_and_filled_from_behind_not_from_the_sphere(front):
     client_frame(front, 2, start)
     image = display(front, 2, moved, 2)
     with front._ctx:
-        warped, _ = front._server.read_warped()
+        warped, _, _ = front._server.warped.read()
     holes = front.hole_fraction()
     assert holes == pytest.approx(np.mean(warped[:, :, 3] == 0))
     # the sphere moved by more than its radius: most of where it was is a hole

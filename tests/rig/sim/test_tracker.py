@@ -9,7 +9,7 @@ from predictors import PoseSample
 from rig.clock import VirtualClock
 from rig.errors import ConfigError, RigError
 from rig.sim.pendulum import Pendulum, PendulumConfig
-from rig.sim.tracker import SimTracker, TrackerConfig, measure, simulate_tracker
+from rig.sim.tracker import SimTracker, TrackerConfig, measure
 from rig.sim.fault_plan import parse_faults
 
 QUIET = dict(position_noise_m=0.0, orientation_noise_deg=0.0, jitter_s=0.0)
@@ -42,9 +42,9 @@ def _body_frame_rotation_vector(truth: np.ndarray, measured: np.ndarray) -> np.n
 
 def test_same_seed_gives_the_same_samples_and_another_seed_does_not(pendulum):
     config = TrackerConfig(dropout=0.1)
-    first = _columns(simulate_tracker(pendulum, config, 0.0, 2.0, seed=7))
-    again = _columns(simulate_tracker(pendulum, config, 0.0, 2.0, seed=7))
-    other = _columns(simulate_tracker(pendulum, config, 0.0, 2.0, seed=8))
+    first = _columns(measure(pendulum, config, 0.0, 2.0, seed=7).pose_samples())
+    again = _columns(measure(pendulum, config, 0.0, 2.0, seed=7).pose_samples())
+    other = _columns(measure(pendulum, config, 0.0, 2.0, seed=8).pose_samples())
     for name in first:
         np.testing.assert_array_equal(first[name], again[name])
     assert not np.array_equal(first["position"], other["position"][: len(first["position"])])
@@ -53,20 +53,20 @@ def test_same_seed_gives_the_same_samples_and_another_seed_does_not(pendulum):
 
 def test_samples_come_at_the_configured_rate_and_phase(pendulum):
     config = TrackerConfig(rate_hz=100.0, phase_s=0.003, **QUIET)
-    t_sensor = _columns(simulate_tracker(pendulum, config, 1.0, 3.0, seed=0))["t_sensor"]
+    t_sensor = _columns(measure(pendulum, config, 1.0, 3.0, seed=0).pose_samples())["t_sensor"]
     assert t_sensor.size == 200
     np.testing.assert_allclose(t_sensor, 1.003 + np.arange(200) / 100.0, rtol=0, atol=1e-12)
 
 
 def test_last_sample_is_before_the_window_end(pendulum):
-    t_sensor = _columns(simulate_tracker(pendulum, TrackerConfig(rate_hz=10.0), 0.0, 1.0, seed=0))["t_sensor"]
+    t_sensor = _columns(measure(pendulum, TrackerConfig(rate_hz=10.0), 0.0, 1.0, seed=0).pose_samples())["t_sensor"]
     assert t_sensor.size == 10
     assert t_sensor[-1] < 1.0
 
 
 def test_noise_has_the_configured_spread(pendulum):
     config = TrackerConfig(position_noise_m=0.001, orientation_noise_deg=0.5, dropout=0.0)
-    columns = _columns(simulate_tracker(pendulum, config, 0.0, 25.0, seed=3))
+    columns = _columns(measure(pendulum, config, 0.0, 25.0, seed=3).pose_samples())
     n = columns["t_sensor"].size
     assert n == 3000
     true_positions, true_orientations = pendulum.sensor_pose(columns["t_sensor"])
@@ -83,7 +83,7 @@ def test_noise_has_the_configured_spread(pendulum):
 
 def test_arrival_is_late_by_the_delay_plus_the_mean_jitter(pendulum):
     config = TrackerConfig(transport_delay_s=0.004, jitter_s=0.0005)
-    columns = _columns(simulate_tracker(pendulum, config, 0.0, 25.0, seed=4))
+    columns = _columns(measure(pendulum, config, 0.0, 25.0, seed=4).pose_samples())
     lateness = columns["t_arrival"] - columns["t_sensor"]
     assert np.all(lateness >= 0.004 - 1e-12)
     n = lateness.size
@@ -94,7 +94,7 @@ def test_arrival_is_late_by_the_delay_plus_the_mean_jitter(pendulum):
 
 def test_transport_never_reorders_samples(pendulum):
     config = TrackerConfig(rate_hz=120.0, transport_delay_s=0.002, jitter_s=0.02)
-    columns = _columns(simulate_tracker(pendulum, config, 0.0, 5.0, seed=5))
+    columns = _columns(measure(pendulum, config, 0.0, 5.0, seed=5).pose_samples())
     steps = np.diff(columns["t_arrival"])
     assert np.all(steps >= 0.0)
     assert np.count_nonzero(steps == 0.0) > 10, "jitter this large must make samples queue behind late ones"
@@ -103,9 +103,9 @@ def test_transport_never_reorders_samples(pendulum):
 
 
 def test_dropout_removes_the_configured_fraction_and_keeps_the_rest_unchanged(pendulum):
-    full = _columns(simulate_tracker(pendulum, TrackerConfig(jitter_s=0.0), 0.0, 25.0, seed=6))
+    full = _columns(measure(pendulum, TrackerConfig(jitter_s=0.0), 0.0, 25.0, seed=6).pose_samples())
     thinned_config = TrackerConfig(jitter_s=0.0, dropout=0.3)
-    thinned = _columns(simulate_tracker(pendulum, thinned_config, 0.0, 25.0, seed=6))
+    thinned = _columns(measure(pendulum, thinned_config, 0.0, 25.0, seed=6).pose_samples())
     n = full["t_sensor"].size
     kept = thinned["t_sensor"].size / n
     assert kept == pytest.approx(0.7, abs=5 * math.sqrt(0.3 * 0.7 / n))
@@ -117,7 +117,7 @@ def test_dropout_removes_the_configured_fraction_and_keeps_the_rest_unchanged(pe
 
 def test_zero_noise_gives_the_exact_truth(pendulum):
     config = TrackerConfig(transport_delay_s=0.004, **QUIET)
-    columns = _columns(simulate_tracker(pendulum, config, 0.0, 3.0, seed=1))
+    columns = _columns(measure(pendulum, config, 0.0, 3.0, seed=1).pose_samples())
     positions, orientations = pendulum.sensor_pose(columns["t_sensor"])
     np.testing.assert_array_equal(columns["position"], positions)
     np.testing.assert_allclose(columns["orientation"], orientations, rtol=0, atol=1e-15)
@@ -125,18 +125,18 @@ def test_zero_noise_gives_the_exact_truth(pendulum):
 
 
 def test_a_window_too_short_for_one_sample_gives_none(pendulum):
-    assert simulate_tracker(pendulum, TrackerConfig(phase_s=0.005), 0.0, 0.004, seed=0) == []
+    assert measure(pendulum, TrackerConfig(phase_s=0.005), 0.0, 0.004, seed=0).pose_samples() == []
 
 
 @pytest.mark.parametrize("t_start, t_end", [(-0.1, 1.0), (0.0, 30.5)])
 def test_a_window_outside_the_pendulum_raises(pendulum, t_start, t_end):
     with pytest.raises(ConfigError, match="not inside the motion"):
-        simulate_tracker(pendulum, TrackerConfig(), t_start, t_end, seed=0)
+        measure(pendulum, TrackerConfig(), t_start, t_end, seed=0).pose_samples()
 
 
 def test_an_empty_window_raises(pendulum):
     with pytest.raises(ConfigError, match="t_end > t_start"):
-        simulate_tracker(pendulum, TrackerConfig(), 1.0, 1.0, seed=0)
+        measure(pendulum, TrackerConfig(), 1.0, 1.0, seed=0).pose_samples()
 
 
 @pytest.mark.parametrize(
@@ -161,7 +161,7 @@ def test_config_rejects_bad_values(kwargs, message):
 
 def test_the_simulated_tracker_hands_out_each_sample_once_its_arrival_has_passed(pendulum):
     tracker = SimTracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=4)
-    expected = simulate_tracker(pendulum, TrackerConfig(), 0.0, 1.0, seed=4)
+    expected = measure(pendulum, TrackerConfig(), 0.0, 1.0, seed=4).pose_samples()
     clock = VirtualClock(-0.5)
     tracker.connect(clock)
     first = tracker.wait(timeout_s=1.0)
