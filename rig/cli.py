@@ -3,7 +3,7 @@
 This module imports only the standard library, the rig's error types and its interrupt handling
 (`rig.interrupts`), so that an interrupt or a signal at any moment, imports included, ends in the
 rig's own message and exit status: the command modules are imported once the handlers are in place.
-`rig --help` lists the commands from SUMMARIES and imports none of them; `rig COMMAND` imports that
+`rig --help` lists the commands from COMMANDS and imports none of them; `rig COMMAND` imports that
 command's module alone, whose parser is made from light declarations (settings dataclasses, the
 help's listings): numpy, OpenCV, JAX, SciPy, matplotlib and the analysis load only once the command
 runs, so that any help answers at once. `rig --version` is the installed package's.
@@ -38,25 +38,6 @@ from rig.errors import RigError
 from rig.interrupts import Terminated
 
 COMMANDS = {
-    "demo": "demo",
-    "simulate": "simulate",
-    "analyse": "analyse",
-    "calibrate-camera": "calibrate_camera",
-    "plan": "plan",
-    "sweep": "sweep",
-    "report": "report",
-    "bench": "bench",
-    "tune": "tune",
-    "board": "board",
-    "record-tracker": "record_tracker",
-    "devices": "devices",
-    "emulate-tracker": "emulate",
-    "record": "record",
-    "measure": "measure",
-    "check": "check",
-}
-"""Each command and its module in rig.commands, in the order `rig --help` lists them."""
-SUMMARIES = {
     "demo": "simulate the rig end to end and check the analyser against the known latency",
     "simulate": "simulate the rig and write a video with known latency",
     "analyse": "measure latency from a video of the LED and the sphere",
@@ -74,7 +55,10 @@ SUMMARIES = {
     "measure": "measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
     "check": "check the devices a run would use (display refresh and pacing, camera rate and exposure, tracker, disk) in about 10 s",
 }
-"""Each command's line in `rig --help`, kept here so that listing the commands imports none of them."""
+"""Each command and its line in `rig --help`, in the order it lists them, kept here so that listing the
+commands imports none of them; its module in rig.commands is named after it (`command_module`)."""
+OTHER_MODULE_NAMES = {"emulate-tracker": "emulate"}
+"""The commands whose module is not their name with underscores."""
 PACKAGE = "latency-rig"
 """The distribution whose installed metadata `rig --version` reads."""
 EXIT_FAULT = 1
@@ -161,9 +145,14 @@ def installed_version() -> str:
         return "(version unknown: not installed; run `pip install -e .` in the rig's folder)"
 
 
+def command_module(name: str) -> str:
+    """The module of the command `name`: its parser and what it runs."""
+    return "rig.commands." + OTHER_MODULE_NAMES.get(name, name.replace("-", "_"))
+
+
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The command line. When `argv` names a command, that command's parser alone is built from
-    its module; otherwise every command is listed by its summary (SUMMARIES) and no command module
+    its module; otherwise every command is listed by its summary (COMMANDS) and no command module
     is imported, so `rig --help` answers at once."""
     parser = OneLineParser(
         prog="rig",
@@ -173,10 +162,10 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     named = next((word for word in argv or () if not word.startswith("-")), None)
     if named in COMMANDS:
-        importlib.import_module(f"rig.commands.{COMMANDS[named]}").add_parser(subparsers)
+        importlib.import_module(command_module(named)).add_parser(subparsers)
     else:
-        for name in COMMANDS:
-            subparsers.add_parser(name, help=SUMMARIES[name])
+        for name, summary in COMMANDS.items():
+            subparsers.add_parser(name, help=summary)
     return parser
 
 
