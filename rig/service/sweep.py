@@ -56,7 +56,7 @@ from rig.service.simulate import SimulationResult, simulate
 from rig.sim.config import SimulationConfig
 from rig.sim.placement import placement
 from rig.sim.truth import Truth
-from rig.toml_file import read_toml
+from rig.toml_file import dotted, read_toml
 
 SIMULATED_ROIS = "simulated_rois"
 SIMULATED_BENCH = "simulated_bench"
@@ -104,7 +104,7 @@ class Sweep:
         chosen = [(dict(zip(names, values)), None) for values in combinations]
         chosen += [({k: v for k, v in point.items() if k != "labels"}, point.get("labels")) for point in self.explicit]
         return [
-            (_merged(self.base, overrides), {str(k): str(v) for k, v in (labels if labels is not None else _dotted(overrides)).items()})
+            (_merged(self.base, overrides), {str(k): str(v) for k, v in (labels if labels is not None else dotted(overrides)).items()})
             for overrides, labels in chosen
         ]
 
@@ -144,19 +144,8 @@ def analysis_options(table: Mapping[str, Any]) -> AnalysisOptions:
     return with_profile(options, read_profile(path), path)
 
 
-def _dotted(mapping: Mapping[str, Any]) -> dict[str, Any]:
-    """{"camera": {"fps": 1}} and {"camera.fps": 1} alike, as dotted keys."""
-    flat: dict[str, Any] = {}
-    for key, value in mapping.items():
-        if isinstance(value, Mapping):
-            flat.update({f"{key}.{k}": v for k, v in _dotted(value).items()})
-        else:
-            flat[key] = value
-    return flat
-
-
 def _merged(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:
-    return {**_dotted(base), **_dotted(overrides)}
+    return {**dotted(base), **dotted(overrides)}
 
 
 def build(kind: type, settings: Mapping[str, Any]) -> Any:
@@ -238,7 +227,7 @@ def read_sweep(path: Path) -> Sweep:
     for table in ("base", "grid", "analysis"):
         if not isinstance(spec.get(table, {}), dict):
             raise ConfigError(f"{path}: {table} must be a table ([{table}]) of settings, not {spec[table]!r}")
-    grid = _dotted(spec.get("grid", {}))
+    grid = dotted(spec.get("grid", {}))
     explicit = spec.get("points", [])
     if not grid and not explicit:
         raise ConfigError(f"{path} has no [grid] and no [[points]]: name at least one setting and the values to sweep it over")
