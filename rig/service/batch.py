@@ -175,6 +175,27 @@ class BatchRun:
             self._record.close()
             self._record = None
 
+    def run(
+        self,
+        job: Callable[[Any], dict[str, Any]],
+        items: Sequence[Any],
+        workers: int | None,
+        scheduler: str | None,
+        progress: Callable[[float, float], object] | None,
+    ) -> list[dict[str, Any]]:
+        """Each item's row by `job`, serially, on `workers` local Dask processes or on `scheduler`,
+        added as it comes; the rows in input order."""
+        self.open()
+        try:
+            with executor(workers, scheduler) as jobs:
+                for _, row in jobs(job, items):
+                    self.add(row)
+                    if progress is not None:
+                        progress(len(self.rows), len(items))
+            return self.finish()
+        finally:
+            self.close()
+
 
 def _indexed(pair: tuple[int, BatchItem]) -> dict[str, Any]:
     index, item = pair
@@ -193,19 +214,10 @@ def run_batch(
     labels = list(dict.fromkeys(key for item in items for key in item.labels))
     run = BatchRun(summary, (*SUMMARY_COLUMNS, *labels))
     outputs = () if summary is None else (summary, summary.with_suffix(".json"))
+    if progress is not None:
+        progress(0, len(items))
     with removed_unless_recorded(*outputs):
-        run.open()
-        try:
-            with executor(workers, scheduler) as jobs:
-                if progress is not None:
-                    progress(0, len(items))
-                for _, row in jobs(_indexed, list(enumerate(items))):
-                    run.add(row)
-                    if progress is not None:
-                        progress(len(run.rows), len(items))
-            return run.finish()
-        finally:
-            run.close()
+        return run.run(_indexed, list(enumerate(items)), workers, scheduler, progress)
 
 
 def requests_for(videos: Sequence[Path], template: AnalysisRequest) -> list[AnalysisRequest]:

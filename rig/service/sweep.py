@@ -47,7 +47,6 @@ from analysis.video.native_path import shown_path
 from declared import from_table, setting_of
 from rig.errors import ConfigError
 from rig.film_file import video_file_name
-from rig.executor import executor
 from rig.fresh_outputs import removed_unless_recorded
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import SUMMARY_COLUMNS, USER_ERRORS, BatchItem, BatchRun, analysed_row
@@ -351,13 +350,4 @@ def run_sweep(
     run = BatchRun(summary, (*SUMMARY_COLUMNS, "truth_ms", "error_ms", *sweep.labels))
     with removed_unless_recorded(Path(out)):
         Path(out).mkdir(parents=True, exist_ok=True)
-        run.open()
-        try:
-            with executor(workers, scheduler) as jobs:
-                for _, row in jobs(job, points):
-                    run.add(row)
-                    if progress is not None:
-                        progress(len(run.rows), len(points))
-            return run.finish(), summary
-        finally:
-            run.close()
+        return run.run(job, points, workers, scheduler, progress), summary
