@@ -15,7 +15,7 @@ import json
 import os
 import time
 import traceback
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
@@ -80,13 +80,9 @@ def labels_from(path: Path | None, videos: Sequence[Path]) -> dict[Path, dict[st
     return {video: by_name.get(str(video), by_name.get(video.name, {})) for video in videos}
 
 
-def summary_row(item: BatchItem) -> dict[str, Any]:
-    """Analyse one video into its summary row; a failure is a row too, never an exception."""
-    return analysed_row(item)[0]
-
-
 def analysed_row(item: BatchItem) -> tuple[dict[str, Any], LatencyResult | None]:
-    """`summary_row`, and the analyser's whole result (None where the row failed)."""
+    """Analyse one video into its summary row (a failure is a row too, never an exception), and the
+    analyser's whole result (None where the row failed)."""
     started = time.perf_counter()
     row: dict[str, Any] = dict.fromkeys(SUMMARY_COLUMNS)
     row["video"] = shown_path(item.request.video)
@@ -199,7 +195,7 @@ class BatchRun:
 
 def _indexed(pair: tuple[int, BatchItem]) -> dict[str, Any]:
     index, item = pair
-    return summary_row(item) | {"index": index}
+    return analysed_row(item)[0] | {"index": index}
 
 
 def run_batch(
@@ -218,11 +214,6 @@ def run_batch(
         progress(0, len(items))
     with removed_unless_recorded(*outputs):
         return run.run(_indexed, list(enumerate(items)), workers, scheduler, progress)
-
-
-def requests_for(videos: Sequence[Path], template: AnalysisRequest) -> list[AnalysisRequest]:
-    """One request per video, each as the template asks (ROIs, method, range...)."""
-    return [replace(template, video=video) for video in videos]
 
 
 def write_summary_plot(rows: Sequence[dict[str, Any]], path: Path, group: str | None) -> None:
