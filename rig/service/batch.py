@@ -118,16 +118,6 @@ def analysed_row(item: BatchItem) -> tuple[dict[str, Any], LatencyResult | None]
     return row | item.labels, result
 
 
-def check_summary_path(summary: Path, overwrite: bool) -> None:
-    """Refuse a summary path that cannot be written, or that would replace one unless asked."""
-    if summary.suffix.lower() != ".csv":
-        raise ConfigError(f"--summary must name a .csv file (the JSON goes beside it), got {summary}")
-    if not summary.parent.is_dir():
-        raise ConfigError(f"cannot write the summary {summary}: folder {summary.parent} does not exist")
-    if summary.exists() and not overwrite:
-        raise ConfigError(f"{summary} already exists; choose another file or pass --overwrite")
-
-
 def _write_json(path: Path, rows: list[dict[str, Any]], partial: bool) -> None:
     temporary = path.with_name(path.name + ".tmp")
     temporary.write_text(json.dumps({"partial": partial, "rows": rows}, indent=1) + "\n", encoding="utf-8")
