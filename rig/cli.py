@@ -34,7 +34,7 @@ from typing import Callable, NoReturn, Sequence
 
 from rig import interrupts
 from rig.compile_cache import keep_compiled_fits
-from rig.errors import RigError
+from rig.errors import user_errors
 from rig.interrupts import Terminated
 
 COMMANDS = {
@@ -114,14 +114,6 @@ class OneLineParser(argparse.ArgumentParser):
         if option is not None:
             message += f" (write a value that starts with '-' as {option[1]}=VALUE)"
         self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message}; see {self.prog} --help\n")
-
-
-def user_errors() -> tuple[type[Exception], ...]:
-    """The error types a user can cause: the rig's and its two libraries'."""
-    from analysis.errors import AnalysisError
-    from predictors import PredictorError
-
-    return (RigError, PredictorError, AnalysisError)
 
 
 class VersionAction(argparse.Action):

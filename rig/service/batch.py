@@ -20,10 +20,8 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from analysis import LatencyResult
-from analysis.errors import AnalysisError
 from analysis.video.native_path import shown_path
-from predictors import PredictorError
-from rig.errors import ConfigError, RigError
+from rig.errors import ConfigError, user_errors
 from rig.executor import executor
 from rig.fresh_outputs import removed_unless_recorded
 from rig.writers import CsvRecord
@@ -35,7 +33,7 @@ SUMMARY_COLUMNS = (
     "index", "video", "status", "latency_ms", "ci95_low_ms", "ci95_high_ms", "method", "model", "period_s",
     "frequency_hz", "frames", "frames_used", "ambiguous", "warnings", "error", "seconds",
 )  # fmt: skip
-USER_ERRORS = (RigError, AnalysisError, PredictorError)
+USER_ERRORS = user_errors()
 RESULT_COLUMNS = frozenset((*SUMMARY_COLUMNS, "truth_ms", "error_ms"))
 """Every column a summary row may hold that is not a label (a sweep adds the truth and the error)."""
 
