@@ -51,17 +51,17 @@ from rig.fresh_outputs import removed_unless_recorded
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import SUMMARY_COLUMNS, USER_ERRORS, BatchItem, BatchRun, analysed_row
 from rig.service.bench_profile import BenchProfile, CameraProfile, DisplayProfile, LayoutProfile, read_profile, with_profile
-from rig.service.simulate import SimulationResult, simulate
+from rig.service.simulate import TRUTH_FILE, SimulationResult, simulate
 from rig.sim.config import SimulationConfig
 from rig.sim.placement import placement
 from rig.sim.truth import Truth
 from rig.toml_file import dotted, read_toml
 
 SIMULATED_ROIS = "simulated_rois"
+"""The [analysis] option that analyses each video within its simulation's regions."""
 SIMULATED_BENCH = "simulated_bench"
 """The [analysis] option that gives each video its own simulation's bench as hints."""
 FLAGS = (SIMULATED_ROIS, SIMULATED_BENCH)
-"""The [analysis] option that analyses each video within its simulation's regions."""
 MAX_POINTS = 10_000
 """The most points a sweep runs: more is a grid written by mistake (each point is a film simulated
 and analysed, seconds to minutes each), counted before any point is made."""
@@ -280,7 +280,7 @@ def told_options(point: SweepPoint, truth: Truth) -> AnalysisOptions:
     if point.simulated_rois:
         options = dataclasses.replace(options, led_roi=tuple(truth.led_roi), sphere_roi=tuple(truth.sphere_roi))
     if point.simulated_bench:
-        options = with_profile(options, simulated_bench(point.config), point.out_dir / "truth.json")
+        options = with_profile(options, simulated_bench(point.config), point.out_dir / TRUTH_FILE)
     return options
 
 
