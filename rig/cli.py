@@ -172,16 +172,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_USER_ERROR
     except KeyboardInterrupt as interrupt:
         interrupts.handled()
-        print(f"\nrig {args.command}: {_stopped(type(interrupt))}; everything recorded so far is on disk", file=sys.stderr)
-        return _interrupted_status(type(interrupt))
+        return _stopped(type(interrupt), f"rig {args.command}", "; everything recorded so far is on disk")
 
 
-def _stopped(kind: type[KeyboardInterrupt]) -> str:
-    return "terminated" if issubclass(kind, Terminated) else "interrupted"
-
-
-def _interrupted_status(kind: type[KeyboardInterrupt]) -> int:
-    return EXIT_TERMINATED if issubclass(kind, Terminated) else EXIT_INTERRUPTED
+def _stopped(kind: type[KeyboardInterrupt], who: str, then: str) -> int:
+    """Say on stderr that `who` was terminated or interrupted (`kind`), and what `then` holds; the exit status."""
+    terminated = issubclass(kind, Terminated)
+    print(f"\n{who}: {'terminated' if terminated else 'interrupted'}{then}", file=sys.stderr)
+    return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
 
 
 def run() -> None:
@@ -198,11 +196,9 @@ def run() -> None:
         late = interrupts.pending()
         if late is not None:
             # Swallowed where it landed and never raised again: the work ran to its end.
-            print(f"\nrig: {_stopped(late)} as it finished; its results are complete", file=sys.stderr)
-            code = _interrupted_status(late)
+            code = _stopped(late, "rig", " as it finished; its results are complete")
     except KeyboardInterrupt as interrupt:
-        print(f"\nrig: {_stopped(type(interrupt))} while starting; nothing was done", file=sys.stderr)
-        code = _interrupted_status(type(interrupt))
+        code = _stopped(type(interrupt), "rig", " while starting; nothing was done")
     except SystemExit as exit_:
         code = exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else EXIT_USER_ERROR)
         if exit_.code is not None and not isinstance(exit_.code, int):
@@ -211,8 +207,7 @@ def run() -> None:
         late = interrupts.pending()
         if late is not None:
             # A library that turned the interrupt into an error of its own (an extension's import does).
-            print(f"\nrig: {_stopped(late)}; everything recorded so far is on disk", file=sys.stderr)
-            code = _interrupted_status(late)
+            code = _stopped(late, "rig", "; everything recorded so far is on disk")
         else:
             traceback.print_exc()
             print(f"rig: {REPORT_A_FAULT}", file=sys.stderr)
