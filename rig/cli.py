@@ -3,7 +3,7 @@
 This module imports only the standard library, the rig's error types and its interrupt handling
 (`rig.interrupts`), so that an interrupt or a signal at any moment, imports included, ends in the
 rig's own message and exit status: the command modules are imported once the handlers are in place.
-`rig --help` lists the commands from SUMMARIES and imports none of them; `rig COMMAND` imports that
+`rig --help` lists the commands from COMMANDS and imports none of them; `rig COMMAND` imports that
 command's module alone, whose parser is made from light declarations (settings dataclasses, the
 help's listings): numpy, OpenCV, JAX, SciPy, matplotlib and the analysis load only once the command
 runs, so that any help answers at once. `rig --version` is the installed package's.
@@ -34,29 +34,10 @@ from typing import Callable, NoReturn, Sequence
 
 from rig import interrupts
 from rig.compile_cache import keep_compiled_fits
-from rig.errors import RigError
+from rig.errors import user_errors
 from rig.interrupts import Terminated
 
 COMMANDS = {
-    "demo": "demo",
-    "simulate": "simulate",
-    "analyse": "analyse",
-    "calibrate-camera": "calibrate_camera",
-    "plan": "plan",
-    "sweep": "sweep",
-    "report": "report",
-    "bench": "bench",
-    "tune": "tune",
-    "board": "board",
-    "record-tracker": "record_tracker",
-    "devices": "devices",
-    "emulate-tracker": "emulate",
-    "record": "record",
-    "measure": "measure",
-    "check": "check",
-}
-"""Each command and its module in rig.commands, in the order `rig --help` lists them."""
-SUMMARIES = {
     "demo": "simulate the rig end to end and check the analyser against the known latency",
     "simulate": "simulate the rig and write a video with known latency",
     "analyse": "measure latency from a video of the LED and the sphere",
@@ -74,7 +55,10 @@ SUMMARIES = {
     "measure": "measure a real system: the live rig and a camera together, then the latency from the video beside the rig's log",
     "check": "check the devices a run would use (display refresh and pacing, camera rate and exposure, tracker, disk) in about 10 s",
 }
-"""Each command's line in `rig --help`, kept here so that listing the commands imports none of them."""
+"""Each command and its line in `rig --help`, in the order it lists them, kept here so that listing the
+commands imports none of them; its module in rig.commands is named after it (`command_module`)."""
+OTHER_MODULE_NAMES = {"emulate-tracker": "emulate"}
+"""The commands whose module is not their name with underscores."""
 PACKAGE = "latency-rig"
 """The distribution whose installed metadata `rig --version` reads."""
 EXIT_FAULT = 1
@@ -132,14 +116,6 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message}; see {self.prog} --help\n")
 
 
-def user_errors() -> tuple[type[Exception], ...]:
-    """The error types a user can cause: the rig's and its two libraries'."""
-    from analysis.errors import AnalysisError
-    from predictors import PredictorError
-
-    return (RigError, PredictorError, AnalysisError)
-
-
 class VersionAction(argparse.Action):
     """`--version`: the installed package's version, read from its metadata only when asked."""
 
@@ -161,9 +137,14 @@ def installed_version() -> str:
         return "(version unknown: not installed; run `pip install -e .` in the rig's folder)"
 
 
+def command_module(name: str) -> str:
+    """The module of the command `name`: its parser and what it runs."""
+    return "rig.commands." + OTHER_MODULE_NAMES.get(name, name.replace("-", "_"))
+
+
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The command line. When `argv` names a command, that command's parser alone is built from
-    its module; otherwise every command is listed by its summary (SUMMARIES) and no command module
+    its module; otherwise every command is listed by its summary (COMMANDS) and no command module
     is imported, so `rig --help` answers at once."""
     parser = OneLineParser(
         prog="rig",
@@ -173,10 +154,10 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     named = next((word for word in argv or () if not word.startswith("-")), None)
     if named in COMMANDS:
-        importlib.import_module(f"rig.commands.{COMMANDS[named]}").add_parser(subparsers)
+        importlib.import_module(command_module(named)).add_parser(subparsers)
     else:
-        for name in COMMANDS:
-            subparsers.add_parser(name, help=SUMMARIES[name])
+        for name, summary in COMMANDS.items():
+            subparsers.add_parser(name, help=summary)
     return parser
 
 
@@ -191,16 +172,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_USER_ERROR
     except KeyboardInterrupt as interrupt:
         interrupts.handled()
-        print(f"\nrig {args.command}: {_stopped(type(interrupt))}; everything recorded so far is on disk", file=sys.stderr)
-        return _interrupted_status(type(interrupt))
+        return _stopped(type(interrupt), f"rig {args.command}", "; everything recorded so far is on disk")
 
 
-def _stopped(kind: type[KeyboardInterrupt]) -> str:
-    return "terminated" if issubclass(kind, Terminated) else "interrupted"
-
-
-def _interrupted_status(kind: type[KeyboardInterrupt]) -> int:
-    return EXIT_TERMINATED if issubclass(kind, Terminated) else EXIT_INTERRUPTED
+def _stopped(kind: type[KeyboardInterrupt], who: str, then: str) -> int:
+    """Say on stderr that `who` was terminated or interrupted (`kind`), and what `then` holds; the exit status."""
+    terminated = issubclass(kind, Terminated)
+    print(f"\n{who}: {'terminated' if terminated else 'interrupted'}{then}", file=sys.stderr)
+    return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
 
 
 def run() -> None:
@@ -217,11 +196,9 @@ def run() -> None:
         late = interrupts.pending()
         if late is not None:
             # Swallowed where it landed and never raised again: the work ran to its end.
-            print(f"\nrig: {_stopped(late)} as it finished; its results are complete", file=sys.stderr)
-            code = _interrupted_status(late)
+            code = _stopped(late, "rig", " as it finished; its results are complete")
     except KeyboardInterrupt as interrupt:
-        print(f"\nrig: {_stopped(type(interrupt))} while starting; nothing was done", file=sys.stderr)
-        code = _interrupted_status(type(interrupt))
+        code = _stopped(type(interrupt), "rig", " while starting; nothing was done")
     except SystemExit as exit_:
         code = exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else EXIT_USER_ERROR)
         if exit_.code is not None and not isinstance(exit_.code, int):
@@ -230,8 +207,7 @@ def run() -> None:
         late = interrupts.pending()
         if late is not None:
             # A library that turned the interrupt into an error of its own (an extension's import does).
-            print(f"\nrig: {_stopped(late)}; everything recorded so far is on disk", file=sys.stderr)
-            code = _interrupted_status(late)
+            code = _stopped(late, "rig", "; everything recorded so far is on disk")
         else:
             traceback.print_exc()
             print(f"rig: {REPORT_A_FAULT}", file=sys.stderr)

@@ -7,3 +7,12 @@ class RigError(Exception):
 
 class ConfigError(RigError, ValueError):
     """An option or configuration value outside its allowed range."""
+
+
+def user_errors() -> tuple[type[Exception], ...]:
+    """The error types a user can cause: the rig's and its two libraries' (imported when asked, so
+    that the command line starts light)."""
+    from analysis.errors import AnalysisError
+    from predictors import PredictorError
+
+    return (RigError, PredictorError, AnalysisError)

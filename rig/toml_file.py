@@ -1,10 +1,10 @@
-"""A TOML file's tables, read in one place: a sweep, a bench's spec, a bench profile."""
+"""A TOML file's tables, read in one place (a sweep, a bench's spec, a bench profile), and their keys dotted."""
 
 from __future__ import annotations
 
 import tomllib
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 from rig.errors import ConfigError
 
@@ -17,3 +17,14 @@ def read_toml(path: Path, what: str) -> dict[str, Any]:
         raise ConfigError(f"cannot read the {what} {path}: {error.strerror}") from None
     except tomllib.TOMLDecodeError as error:
         raise ConfigError(f"{path} is not valid TOML: {error}") from None
+
+
+def dotted(table: Mapping[str, Any]) -> dict[str, Any]:
+    """{"camera": {"fps": 1}} and {"camera.fps": 1} alike, as dotted keys."""
+    flat: dict[str, Any] = {}
+    for key, value in table.items():
+        if isinstance(value, Mapping):
+            flat.update({f"{key}.{k}": v for k, v in dotted(value).items()})
+        else:
+            flat[key] = value
+    return flat

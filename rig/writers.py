@@ -20,7 +20,6 @@ from __future__ import annotations
 import csv
 import os
 from pathlib import Path
-from types import TracebackType
 from typing import Any, Sequence
 
 import numpy as np
@@ -99,12 +98,7 @@ class CsvRecord:
     def __enter__(self) -> CsvRecord:
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
 

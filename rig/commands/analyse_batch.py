@@ -16,7 +16,7 @@ from rig.commands import outputs
 from rig.errors import ConfigError
 from rig.progress import ProgressBar
 from rig.service import AnalysisRequest
-from rig.service.batch import BatchItem, check_summary_path, labels_from, run_batch, write_summary_plot
+from rig.service.batch import BatchItem, labels_from, run_batch, write_summary_plot
 
 
 def is_batch(args: argparse.Namespace, videos: list[Path]) -> bool:
@@ -29,8 +29,8 @@ def check_batch_options(args: argparse.Namespace) -> None:
     for option, value in (("--csv", args.csv), ("--board", args.board)):
         if value is not None:
             raise ConfigError(f"{option} is for one video; a batch writes its rows with --summary FILE.csv")
-    if args.summary is not None:
-        check_summary_path(args.summary, args.overwrite)
+    if args.summary is not None and args.summary.exists() and not args.overwrite:
+        raise ConfigError(f"{args.summary} already exists; choose another file or pass --overwrite")
     if args.plot is not None and args.summary is None:
         raise ConfigError("--plot of a batch needs --summary FILE.csv (the plot shows the summary's rows)")
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from datetime import date
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -30,10 +29,6 @@ EXIT_UNREACHABLE = 1
 def _numbers(text: str) -> tuple[float, ...]:
     """A comma-separated list of positive numbers."""
     return tuple(options.positive_float(part) for part in text.split(","))
-
-
-def _log(message: str) -> None:
-    print(message, file=sys.stderr, flush=True)
 
 
 def _print(result: Plan) -> None:
@@ -67,6 +62,7 @@ def _print(result: Plan) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rig.bench.contract import log_to_stderr
     from rig.service import PlanRequest, plan
     from rig.service.bench_profile import BenchProfile, read_profile, write_profile
 
@@ -79,7 +75,7 @@ def _run(args: argparse.Namespace) -> int:
         accuracy_ms=args.accuracy_ms,
     )
     current = read_profile(args.bench) if args.bench is not None and args.bench.exists() else BenchProfile()
-    result = plan(request, _log, args.runs)
+    result = plan(request, log_to_stderr, args.runs)
     if args.json:
         print(json.dumps(result.to_dict()))
     else:
@@ -87,7 +83,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.bench is not None:
         changes = result.bench_changes(current.camera, date.today().isoformat())
         write_profile(args.bench, changes)
-        (_log if args.json else print)(profile_line(args.bench, changes))
+        (log_to_stderr if args.json else print)(profile_line(args.bench, changes))
     return 0 if result.recommended is not None else EXIT_UNREACHABLE
 
 

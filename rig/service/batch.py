@@ -15,15 +15,13 @@ import json
 import os
 import time
 import traceback
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from analysis import LatencyResult
-from analysis.errors import AnalysisError
 from analysis.video.native_path import shown_path
-from predictors import PredictorError
-from rig.errors import ConfigError, RigError
+from rig.errors import ConfigError, user_errors
 from rig.executor import executor
 from rig.fresh_outputs import removed_unless_recorded
 from rig.writers import CsvRecord
@@ -35,7 +33,7 @@ SUMMARY_COLUMNS = (
     "index", "video", "status", "latency_ms", "ci95_low_ms", "ci95_high_ms", "method", "model", "period_s",
     "frequency_hz", "frames", "frames_used", "ambiguous", "warnings", "error", "seconds",
 )  # fmt: skip
-USER_ERRORS = (RigError, AnalysisError, PredictorError)
+USER_ERRORS = user_errors()
 RESULT_COLUMNS = frozenset((*SUMMARY_COLUMNS, "truth_ms", "error_ms"))
 """Every column a summary row may hold that is not a label (a sweep adds the truth and the error)."""
 
@@ -80,13 +78,9 @@ def labels_from(path: Path | None, videos: Sequence[Path]) -> dict[Path, dict[st
     return {video: by_name.get(str(video), by_name.get(video.name, {})) for video in videos}
 
 
-def summary_row(item: BatchItem) -> dict[str, Any]:
-    """Analyse one video into its summary row; a failure is a row too, never an exception."""
-    return analysed_row(item)[0]
-
-
 def analysed_row(item: BatchItem) -> tuple[dict[str, Any], LatencyResult | None]:
-    """`summary_row`, and the analyser's whole result (None where the row failed)."""
+    """Analyse one video into its summary row (a failure is a row too, never an exception), and the
+    analyser's whole result (None where the row failed)."""
     started = time.perf_counter()
     row: dict[str, Any] = dict.fromkeys(SUMMARY_COLUMNS)
     row["video"] = shown_path(item.request.video)
@@ -120,16 +114,6 @@ def analysed_row(item: BatchItem) -> tuple[dict[str, Any], LatencyResult | None]
         )
     row["seconds"] = time.perf_counter() - started
     return row | item.labels, result
-
-
-def check_summary_path(summary: Path, overwrite: bool) -> None:
-    """Refuse a summary path that cannot be written, or that would replace one unless asked."""
-    if summary.suffix.lower() != ".csv":
-        raise ConfigError(f"--summary must name a .csv file (the JSON goes beside it), got {summary}")
-    if not summary.parent.is_dir():
-        raise ConfigError(f"cannot write the summary {summary}: folder {summary.parent} does not exist")
-    if summary.exists() and not overwrite:
-        raise ConfigError(f"{summary} already exists; choose another file or pass --overwrite")
 
 
 def _write_json(path: Path, rows: list[dict[str, Any]], partial: bool) -> None:
@@ -175,10 +159,31 @@ class BatchRun:
             self._record.close()
             self._record = None
 
+    def run(
+        self,
+        job: Callable[[Any], dict[str, Any]],
+        items: Sequence[Any],
+        workers: int | None,
+        scheduler: str | None,
+        progress: Callable[[float, float], object] | None,
+    ) -> list[dict[str, Any]]:
+        """Each item's row by `job`, serially, on `workers` local Dask processes or on `scheduler`,
+        added as it comes; the rows in input order."""
+        self.open()
+        try:
+            with executor(workers, scheduler) as jobs:
+                for _, row in jobs(job, items):
+                    self.add(row)
+                    if progress is not None:
+                        progress(len(self.rows), len(items))
+            return self.finish()
+        finally:
+            self.close()
+
 
 def _indexed(pair: tuple[int, BatchItem]) -> dict[str, Any]:
     index, item = pair
-    return summary_row(item) | {"index": index}
+    return analysed_row(item)[0] | {"index": index}
 
 
 def run_batch(
@@ -193,24 +198,10 @@ def run_batch(
     labels = list(dict.fromkeys(key for item in items for key in item.labels))
     run = BatchRun(summary, (*SUMMARY_COLUMNS, *labels))
     outputs = () if summary is None else (summary, summary.with_suffix(".json"))
+    if progress is not None:
+        progress(0, len(items))
     with removed_unless_recorded(*outputs):
-        run.open()
-        try:
-            with executor(workers, scheduler) as jobs:
-                if progress is not None:
-                    progress(0, len(items))
-                for _, row in jobs(_indexed, list(enumerate(items))):
-                    run.add(row)
-                    if progress is not None:
-                        progress(len(run.rows), len(items))
-            return run.finish()
-        finally:
-            run.close()
-
-
-def requests_for(videos: Sequence[Path], template: AnalysisRequest) -> list[AnalysisRequest]:
-    """One request per video, each as the template asks (ROIs, method, range...)."""
-    return [replace(template, video=video) for video in videos]
+        return run.run(_indexed, list(enumerate(items)), workers, scheduler, progress)
 
 
 def write_summary_plot(rows: Sequence[dict[str, Any]], path: Path, group: str | None) -> None:

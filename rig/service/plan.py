@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
@@ -171,14 +171,7 @@ class Plan:
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "request": {
-                "display_hz": self.request.display_hz,
-                "camera_fps": list(self.request.camera_fps),
-                "exposures": list(self.request.exposures),
-                "period_s": self.request.period_s,
-                "amplitude_deg": self.request.amplitude_deg,
-                "accuracy_ms": self.request.accuracy_ms,
-            },
+            "request": asdict(self.request),
             "settings": [setting.to_dict() for setting in self.settings],
             "recommended": None if self.recommended is None else self.recommended.to_dict(),
             "checked": self.checked,

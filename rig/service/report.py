@@ -28,6 +28,7 @@ from rig.service.analyse import AnalysisRequest, Measurement, analyse
 from rig.service.batch import RESULT_COLUMNS
 from rig.service.compare import Z95, differences, group_latencies
 from rig.session.run_files import BOARD_FOLDER
+from rig.toml_file import dotted
 
 PACKAGES = ("latency-rig", "numpy", "scipy", "opencv-contrib-python-headless", "jax", "jaxopt", "emcee", "matplotlib", "moderngl")
 RUN_VIDEO = "video.avi"
@@ -60,16 +61,6 @@ def software() -> list[tuple[str, str]]:
     except (OSError, subprocess.TimeoutExpired):
         state = "git not available"
     return rows + [("project commit", state)]
-
-
-def _flatten(values: dict[str, Any], prefix: str = "") -> list[tuple[str, Any]]:
-    items: list[tuple[str, Any]] = []
-    for key, value in values.items():
-        if isinstance(value, dict):
-            items += _flatten(value, f"{prefix}{key}.")
-        else:
-            items.append((f"{prefix}{key}", value))
-    return items
 
 
 def _verdict(name: str, value: Any) -> str:
@@ -131,16 +122,17 @@ def run_report(path: Path, progress: Callable[[int, int], object] | None = None)
                                                 ("residual", residuals_figure(result))]))  # fmt: skip
     methods = [(name, m.latency_ms, *(m.ci95_ms or (None, None)), m.model) for name, m in result.methods.items()]
     report.sections.append(Section("Methods", [(("method", "latency (ms)", "95 % low", "95 % high", "model"), methods)]))
-    diagnostics = [(name, value, _verdict(name, value)) for name, value in _flatten(result.diagnostics)]
+    diagnostics = [(name, value, _verdict(name, value)) for name, value in dotted(result.diagnostics).items()]
     rows = [("period (s)", result.period_s, "-"), ("frames used", f"{result.frames_used}/{result.frames}", "-"),
             ("ROIs", f"LED {result.led_roi.as_list()}, sphere {result.sphere_roi.as_list()} ({result.roi_source})", "-"),
             ("LED told apart by", result.led_rule, "-"), *diagnostics]  # fmt: skip
     report.sections.append(Section("Diagnostics", [(("diagnostic", "value", "verdict"), rows)]))
     if measurement.board is not None:
-        report.sections.append(Section("Board", [(("field", "value"), _flatten(measurement.board.to_dict()))]))
+        board_rows = list(dotted(measurement.board.to_dict()).items())
+        report.sections.append(Section("Board", [(("field", "value"), board_rows)]))
     configuration = [("video", str(video)), ("method", request.options.method), ("latency range (ms)", request.options.latency_range_ms)]
     if truth is not None:
-        configuration += [(f"simulation.{k}", v) for k, v in _flatten(truth["config"])]
+        configuration += [(f"simulation.{k}", v) for k, v in dotted(truth["config"]).items()]
     report.sections.append(Section("Configuration and devices", [(("setting", "value"), configuration)]))
     report.sections.append(Section("Software", [(("software", "version"), software())]))
     return report, measurement

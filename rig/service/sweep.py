@@ -47,22 +47,21 @@ from analysis.video.native_path import shown_path
 from declared import from_table, setting_of
 from rig.errors import ConfigError
 from rig.film_file import video_file_name
-from rig.executor import executor
 from rig.fresh_outputs import removed_unless_recorded
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import SUMMARY_COLUMNS, USER_ERRORS, BatchItem, BatchRun, analysed_row
 from rig.service.bench_profile import BenchProfile, CameraProfile, DisplayProfile, LayoutProfile, read_profile, with_profile
-from rig.service.simulate import SimulationResult, simulate
+from rig.service.simulate import TRUTH_FILE, SimulationResult, simulate
 from rig.sim.config import SimulationConfig
 from rig.sim.placement import placement
 from rig.sim.truth import Truth
-from rig.toml_file import read_toml
+from rig.toml_file import dotted, read_toml
 
 SIMULATED_ROIS = "simulated_rois"
+"""The [analysis] option that analyses each video within its simulation's regions."""
 SIMULATED_BENCH = "simulated_bench"
 """The [analysis] option that gives each video its own simulation's bench as hints."""
 FLAGS = (SIMULATED_ROIS, SIMULATED_BENCH)
-"""The [analysis] option that analyses each video within its simulation's regions."""
 MAX_POINTS = 10_000
 """The most points a sweep runs: more is a grid written by mistake (each point is a film simulated
 and analysed, seconds to minutes each), counted before any point is made."""
@@ -104,7 +103,7 @@ class Sweep:
         chosen = [(dict(zip(names, values)), None) for values in combinations]
         chosen += [({k: v for k, v in point.items() if k != "labels"}, point.get("labels")) for point in self.explicit]
         return [
-            (_merged(self.base, overrides), {str(k): str(v) for k, v in (labels if labels is not None else _dotted(overrides)).items()})
+            (_merged(self.base, overrides), {str(k): str(v) for k, v in (labels if labels is not None else dotted(overrides)).items()})
             for overrides, labels in chosen
         ]
 
@@ -144,19 +143,8 @@ def analysis_options(table: Mapping[str, Any]) -> AnalysisOptions:
     return with_profile(options, read_profile(path), path)
 
 
-def _dotted(mapping: Mapping[str, Any]) -> dict[str, Any]:
-    """{"camera": {"fps": 1}} and {"camera.fps": 1} alike, as dotted keys."""
-    flat: dict[str, Any] = {}
-    for key, value in mapping.items():
-        if isinstance(value, Mapping):
-            flat.update({f"{key}.{k}": v for k, v in _dotted(value).items()})
-        else:
-            flat[key] = value
-    return flat
-
-
 def _merged(base: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:
-    return {**_dotted(base), **_dotted(overrides)}
+    return {**dotted(base), **dotted(overrides)}
 
 
 def build(kind: type, settings: Mapping[str, Any]) -> Any:
@@ -238,7 +226,7 @@ def read_sweep(path: Path) -> Sweep:
     for table in ("base", "grid", "analysis"):
         if not isinstance(spec.get(table, {}), dict):
             raise ConfigError(f"{path}: {table} must be a table ([{table}]) of settings, not {spec[table]!r}")
-    grid = _dotted(spec.get("grid", {}))
+    grid = dotted(spec.get("grid", {}))
     explicit = spec.get("points", [])
     if not grid and not explicit:
         raise ConfigError(f"{path} has no [grid] and no [[points]]: name at least one setting and the values to sweep it over")
@@ -292,7 +280,7 @@ def told_options(point: SweepPoint, truth: Truth) -> AnalysisOptions:
     if point.simulated_rois:
         options = dataclasses.replace(options, led_roi=tuple(truth.led_roi), sphere_roi=tuple(truth.sphere_roi))
     if point.simulated_bench:
-        options = with_profile(options, simulated_bench(point.config), point.out_dir / "truth.json")
+        options = with_profile(options, simulated_bench(point.config), point.out_dir / TRUTH_FILE)
     return options
 
 
@@ -362,13 +350,4 @@ def run_sweep(
     run = BatchRun(summary, (*SUMMARY_COLUMNS, "truth_ms", "error_ms", *sweep.labels))
     with removed_unless_recorded(Path(out)):
         Path(out).mkdir(parents=True, exist_ok=True)
-        run.open()
-        try:
-            with executor(workers, scheduler) as jobs:
-                for _, row in jobs(job, points):
-                    run.add(row)
-                    if progress is not None:
-                        progress(len(run.rows), len(points))
-            return run.finish(), summary
-        finally:
-            run.close()
+        return run.run(job, points, workers, scheduler, progress), summary

@@ -259,8 +259,10 @@ def test_bench_stopped_while_benchmarking(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 def test_record_tracker_stopped_while_recording(tmp_path: Path) -> None:
-    emulator = subprocess.Popen([str(RIG), "emulate-tracker", "serial", "--pty", str(tmp_path / "tty"), "--rate", "500"],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    emulator = subprocess.Popen(
+        [str(RIG), "emulate-tracker", "serial", "--pty", str(tmp_path / "tty"), "--rate", "500", "--profile", "binary-pose"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
     try:
         deadline = time.monotonic() + START_LIMIT_S
         while not (tmp_path / "tty").exists():
