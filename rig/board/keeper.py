@@ -8,6 +8,7 @@ import threading
 from typing import Callable
 
 from rig.board.events import LinkChange
+from rig.board.link import SerialLink
 from rig.errors import RigError
 
 # After a reconnection, setting the board up again is tried this often, this far apart.
@@ -18,8 +19,8 @@ LONGEST_SLEEP_S = 1.0
 
 
 class Keeper:
-    """Runs `sync` every `resync_every_s` (None: never) and `restore` after `request_restore()`,
-    until `stop` is set.
+    """Runs `sync` every `resync_every_s` (None: never) and `restore` after `request_restore()`, on
+    the link's clock, until the link's `stop` is set.
 
     report: receives a LinkChange for each failed try at setting the board up again.
     fail: receives the error when every try failed; the connection is then unusable.
@@ -27,20 +28,18 @@ class Keeper:
 
     def __init__(
         self,
+        link: SerialLink,
         *,
-        url: str,
-        clock: Callable[[], float],
         resync_every_s: float | None,
-        stop: threading.Event,
         sync: Callable[[], object],
         restore: Callable[[], None],
         report: Callable[[LinkChange], None],
         fail: Callable[[RigError], None],
     ) -> None:
-        self._url = url
-        self._clock = clock
+        self._url = link.url
+        self._clock = link.clock
+        self._stop = link.stop
         self._resync_every = resync_every_s
-        self._stop = stop
         self._sync = sync
         self._restore = restore
         self._report = report

@@ -98,14 +98,7 @@ class Microcontroller:
             on_frames=self._on_frames,
             on_change=self._on_link_change,
         )
-        self._requests = Requests(
-            self._link,
-            reply_timeout_s=reply_timeout_s,
-            reconnect_timeout_s=reconnect_timeout_s,
-            clock=clock,
-            stop=self._stop,
-            check=self.check,
-        )
+        self._requests = Requests(self._link, reply_timeout_s=reply_timeout_s, check=self.check)
         self._messages = MessageReader(self.to_rig_time)
         self._keeper: Keeper | None = None
 
@@ -118,10 +111,8 @@ class Microcontroller:
         self._stop.clear()
         self._failure = None
         self._keeper = Keeper(
-            url=self.url,
-            clock=self._clock,
+            self._link,
             resync_every_s=self._resync_every,
-            stop=self._stop,
             sync=self.sync,
             restore=self._restore,
             report=self._emit,
@@ -206,10 +197,6 @@ class Microcontroller:
     def add_listener(self, listener: BoardListener) -> None:
         with self._listener_lock:
             self._listeners.append(listener)
-
-    def remove_listener(self, listener: BoardListener) -> None:
-        with self._listener_lock:
-            self._listeners.remove(listener)
 
     # ---- commands ----
 
