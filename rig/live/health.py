@@ -25,14 +25,13 @@ caveats), `valid` otherwise. Times are seconds into the run.
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from rig.live.files import MARKERS_FILE, PUBLISHED_FILE, SWAPS_FILE
+from rig.live.files import MARKERS_FILE, PUBLISHED_FILE, SWAPS_FILE, read_columns, with_poses
 from rig.session.run_record import FRAMES_FILE, TRACKER_FILE
 
 STALL_S = 0.25
@@ -75,24 +74,6 @@ class Verdict:
         return self.status if not self.reasons else f"{self.status}: {'; '.join(self.reasons)}"
 
 
-def _table(path: Path) -> dict[str, np.ndarray] | None:
-    """A CSV run file's numeric columns (empty cells NaN); None where the run did not write it."""
-    if not path.is_file():
-        return None
-    with path.open(encoding="utf-8", newline="") as stream:
-        reader = csv.DictReader(stream)
-        rows = list(reader)
-        names = reader.fieldnames or []
-
-    def number(cell: str | None) -> float:
-        try:
-            return float(cell) if cell not in ("", None) else np.nan
-        except ValueError:
-            return np.nan
-
-    return {name: np.array([number(row.get(name)) for row in rows], dtype=np.float64) for name in names}
-
-
 def pauses(times: np.ndarray, t_begin: float, t_end: float) -> dict[str, float]:
     """When the first of `times` in the span came (s into it; the span's length if none did), and
     the longest pause (ms) from it to the span's end, the end included, with when it began."""
@@ -125,10 +106,10 @@ def swaps_of(out_dir: Path) -> dict[str, np.ndarray] | None:
     """Each new image's swap: `t` (rig clock), `image` (its published frame) and `late` (NaN where
     not known: an external renderer's markers do not say), from the window's swap log or an external
     renderer's markers; None where the run kept neither."""
-    swaps = _table(out_dir / SWAPS_FILE)
+    swaps = read_columns(out_dir / SWAPS_FILE)
     if swaps is not None:
         return {"t": swaps["t_swap"], "image": swaps["image"], "late": swaps["late"]}
-    markers = _table(out_dir / MARKERS_FILE)
+    markers = read_columns(out_dir / MARKERS_FILE)
     if markers is None:
         return None
     frames = markers["frame"]
@@ -157,11 +138,10 @@ def pose_age(swaps: dict[str, np.ndarray], poses: dict[str, np.ndarray] | None) 
     """The pose's age (ms) at each swap: the swap's time minus its image's newest sample's sensor time."""
     if poses is None or not len(poses.get("frame", ())):
         return None
-    index = {int(frame): i for i, frame in enumerate(poses["frame"])}
-    pairs = [(t, poses["t_sensor"][index[int(image)]]) for t, image in zip(swaps["t"], swaps["image"]) if int(image) in index]
-    if not pairs:
+    at, pose_at = with_poses(swaps["image"], np.ones(len(swaps["image"]), dtype=bool), poses)
+    if not len(at):
         return None
-    age_ms = np.array([t - sensor for t, sensor in pairs]) * 1e3
+    age_ms = (swaps["t"][at] - poses["t_sensor"][pose_at]) * 1e3
     return {"median_ms": float(np.median(age_ms)), "p95_ms": float(np.percentile(age_ms, 95)), "max_ms": float(age_ms.max())}
 
 
@@ -250,9 +230,9 @@ def run_health(out_dir: Path, refresh_hz: float, t_begin: float, t_end: float, f
     health: dict[str, Any] = {
         "span_s": t_end - t_begin,
         "display": display_health(swaps, refresh_hz, t_begin, t_end) if swaps is not None else None,
-        "pose_age": pose_age(swaps, _table(out_dir / PUBLISHED_FILE)) if swaps is not None else None,
-        "tracker": tracker_health(_table(out_dir / TRACKER_FILE), t_begin, t_end),
-        "camera": camera_health(_table(out_dir / FRAMES_FILE), film, t_begin),
+        "pose_age": pose_age(swaps, read_columns(out_dir / PUBLISHED_FILE)) if swaps is not None else None,
+        "tracker": tracker_health(read_columns(out_dir / TRACKER_FILE), t_begin, t_end),
+        "camera": camera_health(read_columns(out_dir / FRAMES_FILE), film, t_begin),
     }
     verdict = judge(health)
     return {**health, "status": verdict.status, "reasons": list(verdict.reasons), "verdict": str(verdict)}

@@ -15,7 +15,6 @@ not analysed, since its video would not show the system's latency; its report ho
 
 from __future__ import annotations
 
-import csv
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -29,6 +28,7 @@ from rig.board.instrument import BoardInstrument
 from rig.devices.camera.opencv_camera import opencv_camera
 from rig.errors import RigError
 from rig.fresh_outputs import removed_unless_recorded
+from rig.live.files import camera_instants
 from rig.live.health import INVALID, VALID
 from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
 from rig.live.run import EXTERNAL, LiveConfig, run_live, write_summary
@@ -36,7 +36,7 @@ from rig.live.video_vs_log import video_against_log
 from rig.live.view import View
 from rig.render.protocol import RenderSetup
 from rig.service.analyse import AnalysisRequest, analyse
-from rig.session.run_files import BOARD_FOLDER, FRAMES_FILE
+from rig.session.run_files import BOARD_FOLDER
 
 MEASURE_FILE = "measure.json"
 PLOT_FILE = "measure.png"
@@ -75,12 +75,6 @@ class MeasureReport:
         }
 
 
-def filmed_instants(out_dir: Path) -> np.ndarray:
-    """When the camera took each frame it delivered (not the stand-ins for dropped ones)."""
-    with (out_dir / FRAMES_FILE).open(encoding="utf-8", newline="") as stream:
-        return np.array([float(row["t_capture"]) for row in csv.DictReader(stream) if row["filled"] == "0"])
-
-
 def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[str, Any]:
     """The log's answer for a run folder (`rig.live.log_latency`) at the instants the camera filmed,
     which weights the run as the video does, and over the whole run beside it."""
@@ -93,7 +87,7 @@ def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[s
         scanout = rows * display["scanout_fraction"] / display["refresh_hz"]
     else:
         shown = shown_by_window(out_dir)
-    filmed = log_latency(out_dir, shown, scanout, filmed_instants(out_dir)).to_dict()
+    filmed = log_latency(out_dir, shown, scanout, camera_instants(out_dir, dropped=False)).to_dict()
     return {**filmed, "whole_run_latency_ms": log_latency(out_dir, shown, scanout).latency_ms}
 
 
