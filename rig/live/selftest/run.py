@@ -21,7 +21,7 @@ from typing import Any, Callable
 from analysis import AnalysisOptions
 from rig.clock import MonotonicClock
 from rig.devices.protocols import Display
-from rig.devices.window import WindowSettings
+from rig.devices.window import WindowDisplay, WindowSettings
 from rig.errors import RigError
 from rig.live.measure import MeasureReport, analyse_run, write_report
 from rig.live.run import EXTERNAL, LiveConfig, run_live
@@ -79,9 +79,8 @@ def self_test(
     window_rect: list[tuple[int, int, int, int]] = [(*WINDOW_POSITION, *DISPLAY_SIZE)]
 
     def connected(display: Display) -> None:
-        window = getattr(display, "window", None)
-        if window is not None:
-            window_rect[0] = window.rect
+        if isinstance(display, WindowDisplay) and display.window is not None:  # the rig's renderer draws in it
+            window_rect[0] = display.window.rect
 
     emulator = EmulatedPendulum(name, duration_s + EMULATOR_MARGIN_S, clock)
     out_dir.mkdir(parents=True, exist_ok=True)
