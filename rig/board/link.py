@@ -158,7 +158,8 @@ class SerialLink:
             except RigError as error:
                 if self.clock() >= deadline:
                     self.failure = RigError(
-                        f"lost the board at {self.url} and could not reopen it within {self.reconnect_timeout_s} s: {error}"
+                        f"lost the board at {self.url} and could not reopen it within {self.reconnect_timeout_s} s: "
+                        f"{error}"
                     )
                     self._on_change(LinkChange(self.clock(), "failed", str(error)))
                     return False
