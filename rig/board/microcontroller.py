@@ -25,7 +25,7 @@ from rig.board.framing import Frame, encode_frame
 from rig.board.keeper import Keeper
 from rig.board.link import SerialLink, SerialPort, open_serial_url
 from rig.board.messages import MessageReader, status_event
-from rig.board.protocol import ProtocolSpec, protocol
+from rig.board.protocol import protocol
 from rig.board.requests import Answer, Requests
 from rig.errors import ConfigError, RigError
 
@@ -155,10 +155,6 @@ class Microcontroller:
     # ---- state ----
 
     @property
-    def spec(self) -> ProtocolSpec:
-        return protocol()
-
-    @property
     def identity(self) -> BoardIdentity | None:
         return self._identity
 
@@ -203,7 +199,7 @@ class Microcontroller:
     def identify(self, tries: int | None = None) -> BoardIdentity:
         answer = self._request("RIG_CMD_IDENTIFY", expects=("RIG_MSG_IDENTITY",), tries=tries)
         fields = answer.answer("RIG_MSG_IDENTITY")
-        spec = self.spec
+        spec = protocol()
         identity = BoardIdentity(
             name=fields["name"].rstrip(b"\0").decode("ascii", "replace"),
             protocol=fields["protocol"],
@@ -240,7 +236,7 @@ class Microcontroller:
 
     def sync(self, round_trips: int | None = None) -> OffsetInterval:
         """Measures the clock offset: intersects the intervals of `round_trips` round trips."""
-        spec = self.spec
+        spec = protocol()
         count = self._sync_round_trips if round_trips is None else round_trips
         if count < 1:
             raise ConfigError(f"round_trips must be >= 1, got {count}")
@@ -281,7 +277,7 @@ class Microcontroller:
 
     def blink(self, *, bits: int, bit_s: float, seed: int, level: int = 255, start_in_s: float = 0.2) -> BlinkSchedule:
         """Plays `bits` bits of the blink code, starting `start_in_s` from now; returns the schedule."""
-        spec = self.spec
+        spec = protocol()
         hz = spec["RIG_TICK_HZ"]
         bit_ticks = round(bit_s * hz)
         if not 1 <= bits <= spec["RIG_BLINK_MAX_BITS"]:
@@ -299,7 +295,7 @@ class Microcontroller:
 
     def configure_encoder(self, report_hz: float = 0.0) -> None:
         """One report per edge (report_hz 0), or at most report_hz reports per second."""
-        spec = self.spec
+        spec = protocol()
         hz = spec["RIG_TICK_HZ"]
         highest = hz / spec["RIG_ENCODER_MIN_REPORT_TICKS"]
         if report_hz != 0 and not 0 < report_hz <= highest:
@@ -309,7 +305,7 @@ class Microcontroller:
     def configure_photodiode(self, rise: int, fall: int, raw_every: int = 0) -> None:
         """Crossings up through `rise` and down through `fall` (ADC counts, fall < rise), and every
         raw_every-th ADC sample (0: none)."""
-        spec = self.spec
+        spec = protocol()
         top = spec["RIG_ADC_MAX"]
         if not 0 <= fall < rise <= top:
             raise ConfigError(f"photodiode thresholds need 0 <= fall < rise <= {top}, got rise {rise}, fall {fall}")
@@ -320,7 +316,7 @@ class Microcontroller:
     def stream(self, *, encoder: bool = False, photodiode: bool = False, samples: bool = False) -> None:
         """Which event streams the board sends: encoder edges, photodiode crossings and passages,
         raw photodiode samples (LED changes always come)."""
-        spec = self.spec
+        spec = protocol()
         mask = (
             (spec["RIG_STREAM_ENCODER"] if encoder else 0)
             | (spec["RIG_STREAM_PHOTODIODE"] if photodiode else 0)
@@ -351,7 +347,7 @@ class Microcontroller:
     # ---- what the reader thread reports ----
 
     def _on_frames(self, frames: list[Frame], received: float) -> None:
-        spec = self.spec
+        spec = protocol()
         for frame in frames:
             fields = spec.layout(frame.type).unpack(frame.payload)
             if "reply_to" in fields and not fields.get("unsolicited"):
