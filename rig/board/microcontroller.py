@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+from dataclasses import asdict
 from typing import Callable, Protocol
 
 from analysis.board.blink_code import BlinkSchedule
@@ -161,7 +162,7 @@ class Microcontroller:
     @property
     def counters(self) -> dict[str, int]:
         """The host's link counters (see LinkCounters) and the number of reconnections."""
-        return self._link.counters.as_dict() | {"reconnects": self._link.reconnects}
+        return asdict(self._link.counters) | {"reconnects": self._link.reconnects}
 
     @property
     def clock_model(self) -> ClockModel:

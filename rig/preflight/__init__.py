@@ -10,7 +10,7 @@ still checked. A malformed spec is the user's error (ConfigError), raised before
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -50,7 +50,7 @@ class CheckReport:
         return worst(self.rows)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"status": self.status, "seconds": self.seconds, "checks": [row.to_dict() for row in self.rows]}
+        return {"status": self.status, "seconds": self.seconds, "checks": [asdict(row) for row in self.rows]}
 
 
 def run_checks(plan: CheckPlan, *, frame_clock: FrameClock | None = None, clock: MonotonicClock | None = None) -> CheckReport:
