@@ -22,7 +22,8 @@ from scipy.optimize import minimize_scalar
 
 from predictors import read_samples
 from rig.errors import RigError
-from rig.live.files import read_columns, with_poses
+from rig.live.files import MARKERS_FILE, PUBLISHED_FILE, read_columns, with_poses
+from rig.session.run_files import DISPLAY_FRAMES_FILE, TRACKER_FILE
 from rig.sim.truth import SCAN_STEP_S, effective_latency, shown_signal
 
 # Left out at each end of the run: the predictor and the display settle, the last frames may be cut.
@@ -75,7 +76,7 @@ def log_latency(
     leave its row at t + scanout_s) and its pose's `px py pz` and `t_sensor`. With `instants` (the
     times a camera filmed), over those instants only: what that camera would have measured of the
     logged display, whatever it missed."""
-    samples = read_samples(out_dir / "tracker.csv")
+    samples = read_samples(out_dir / TRACKER_FILE)
     if len(samples) < 10 or len(shown.get("t", ())) < 10:
         raise RigError(f"{out_dir} holds too few tracker samples or shown frames to work out the logged latency")
     t_sensor = np.array([s.t_sensor for s in samples])
@@ -112,7 +113,7 @@ def log_latency(
 
 def shown_by_window(out_dir: Path) -> dict[str, np.ndarray]:
     """What the rig's own renderer showed: display_frames.csv joined with published_poses.csv."""
-    frames, poses = read_columns(out_dir / "display_frames.csv"), read_columns(out_dir / "published_poses.csv")
+    frames, poses = read_columns(out_dir / DISPLAY_FRAMES_FILE), read_columns(out_dir / PUBLISHED_FILE)
     if not frames or not poses:
         return {}
     at, pose_at = with_poses(frames["image"], np.concatenate([[True], np.diff(frames["image"]) != 0]), poses)
@@ -122,7 +123,7 @@ def shown_by_window(out_dir: Path) -> dict[str, np.ndarray]:
 
 def shown_by_markers(out_dir: Path) -> dict[str, np.ndarray]:
     """What an external renderer showed: its swap markers joined with the poses the rig published."""
-    markers, poses = read_columns(out_dir / "renderer_markers.csv"), read_columns(out_dir / "published_poses.csv")
+    markers, poses = read_columns(out_dir / MARKERS_FILE), read_columns(out_dir / PUBLISHED_FILE)
     if not markers or not poses:
         return {}
     at, pose_at = with_poses(markers["frame"], np.concatenate([[True], np.diff(markers["frame"]) != 0]), poses)

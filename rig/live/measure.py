@@ -36,7 +36,7 @@ from rig.live.video_vs_log import video_against_log
 from rig.live.view import View
 from rig.render.protocol import RenderSetup
 from rig.service.analyse import AnalysisRequest, analyse
-from rig.session.run_files import BOARD_FOLDER
+from rig.session.run_files import BOARD_FOLDER, VIDEO_FILE
 
 MEASURE_FILE = "measure.json"
 PLOT_FILE = "measure.png"
@@ -100,7 +100,7 @@ def analyse_run(out_dir: Path, fps: float | None, options: AnalysisOptions, boar
         report = MeasureReport(out_dir, None, None, None, run)
         write_report(report)
         return report
-    request = AnalysisRequest(out_dir / "video.avi", replace(options, fps=fps), tracks_csv=out_dir / "tracks.csv")
+    request = AnalysisRequest(out_dir / VIDEO_FILE, replace(options, fps=fps), tracks_csv=out_dir / "tracks.csv")
     try:
         video = analyse(request, progress).to_dict()
     except AnalysisError as error:
