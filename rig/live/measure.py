@@ -175,10 +175,10 @@ def measure(
     camera = opencv_camera(camera_spec, accept_refused=accept_camera_settings)
     board = [BoardInstrument(board_port, out_dir / BOARD_FOLDER)] if board_port else []
     with removed_unless_recorded(out_dir):
-        result = run_live(config, out_dir, view=view, camera=camera, instruments=board, overwrite=overwrite, progress=progress)
-        film = result.summary["film"]
-        if result.summary["health"]["status"] == INVALID:
-            return analyse_run(out_dir, None, options, None, result.summary)
+        run = run_live(config, out_dir, view=view, camera=camera, instruments=board, overwrite=overwrite, progress=progress)
+        film = run["film"]
+        if run["health"]["status"] == INVALID:
+            return analyse_run(out_dir, None, options, None, run)
         if film is None or film["frames"] < 2:
             raise RigError(f"the camera {camera_spec} recorded no video; check it films while the run goes")
-    return analyse_run(out_dir, film["measured_fps"], options, out_dir / BOARD_FOLDER if board else None, result.summary)
+    return analyse_run(out_dir, film["measured_fps"], options, out_dir / BOARD_FOLDER if board else None, run)

@@ -88,17 +88,17 @@ def self_test(
     try:
         twin = TwinSetup(camera_config, layout, PendulumConfig(), pendulum_end, 1.0 / REFRESH_HZ, out_dir, seed=1)
         camera = ScreenCamera(twin, lambda: emulator.start, lambda: window_rect[0])
-        result = run_live(config, out_dir, view=View(layout.world_to_clip, layout.sphere_radius_m),
-                          frame_clock=FixedRateFrameClock(REFRESH_HZ), camera=camera, clock=clock, overwrite=overwrite,
-                          progress=progress, on_connected=connected)  # fmt: skip
+        run = run_live(config, out_dir, view=View(layout.world_to_clip, layout.sphere_radius_m),
+                       frame_clock=FixedRateFrameClock(REFRESH_HZ), camera=camera, clock=clock, overwrite=overwrite,
+                       progress=progress, on_connected=connected)  # fmt: skip
     finally:
         if renderer is not None:
             renderer.terminate()
             renderer.wait(timeout=10)
         emulator.close()
-    film = result.summary["film"]
+    film = run["film"]
     options = AnalysisOptions(led_roi=layout.led_roi, sphere_roi=layout.sphere_roi)
-    report = analyse_run(out_dir, film["measured_fps"] if film else None, options, None, result.summary)
+    report = analyse_run(out_dir, film["measured_fps"] if film else None, options, None, run)
     if not report.invalid:
         report.run["self_test"] = _agreement(report)
         write_report(report)
