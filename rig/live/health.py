@@ -17,15 +17,14 @@ connected to when it ended):
   and sent them late in a burst left the rig extrapolating as surely as one that measured nothing);
 * the camera: frames dropped, with when (runs of consecutive drops), and its stalls.
 
-`judge` turns those into a `Verdict` against the thresholds below: `invalid` when the rig or its
-tracker stalled (its number would not be the system's latency), `degraded` when it hitched, repeated
-images at most refreshes, swapped late or dropped camera frames often (the number stands, with its
-caveats), `valid` otherwise. Times are seconds into the run.
+`judge` turns those into a verdict (a status and its reasons) against the thresholds below:
+`invalid` when the rig or its tracker stalled (its number would not be the system's latency),
+`degraded` when it hitched, repeated images at most refreshes, swapped late or dropped camera frames
+often (the number stands, with its caveats), `valid` otherwise. Times are seconds into the run.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -63,15 +62,6 @@ slow; camera drops within `SLOW_MARGIN_S` of one are counted as drops while the 
 SLOW_MARGIN_S = 0.1
 
 VALID, DEGRADED, INVALID = "valid", "degraded", "invalid"
-
-
-@dataclass(frozen=True)
-class Verdict:
-    status: str
-    reasons: tuple[str, ...] = ()
-
-    def __str__(self) -> str:
-        return self.status if not self.reasons else f"{self.status}: {'; '.join(self.reasons)}"
 
 
 def pauses(times: np.ndarray, t_begin: float, t_end: float) -> dict[str, float]:
@@ -194,7 +184,7 @@ def _pauses(stream: dict[str, Any], stalled: str, hitched: str, first: str, sile
     return invalid, degraded
 
 
-def judge(health: dict[str, Any]) -> Verdict:
+def judge(health: dict[str, Any]) -> tuple[str, list[str]]:
     """The verdict on a run's health (see the module docstring and the thresholds)."""
     invalid, degraded = [], []
     display, tracker, camera = health.get("display"), health["tracker"], health.get("camera")
@@ -218,8 +208,8 @@ def judge(health: dict[str, Any]) -> Verdict:
         degraded.append(f"the camera dropped {camera['dropped']} frames ({camera['dropped_share']:.1%}), "
                         f"{worst['frames']} in a row at {worst['at_s']:.1f} s")  # fmt: skip
     if invalid:
-        return Verdict(INVALID, tuple(invalid))
-    return Verdict(DEGRADED, tuple(degraded)) if degraded else Verdict(VALID)
+        return INVALID, invalid
+    return (DEGRADED, degraded) if degraded else (VALID, [])
 
 
 def run_health(out_dir: Path, refresh_hz: float, t_begin: float, t_end: float, film: dict[str, Any] | None) -> dict[str, Any]:
@@ -234,5 +224,6 @@ def run_health(out_dir: Path, refresh_hz: float, t_begin: float, t_end: float, f
         "tracker": tracker_health(read_columns(out_dir / TRACKER_FILE), t_begin, t_end),
         "camera": camera_health(read_columns(out_dir / FRAMES_FILE), film, t_begin),
     }
-    verdict = judge(health)
-    return {**health, "status": verdict.status, "reasons": list(verdict.reasons), "verdict": str(verdict)}
+    status, reasons = judge(health)
+    verdict = f"{status}: {'; '.join(reasons)}" if reasons else status
+    return {**health, "status": status, "reasons": reasons, "verdict": verdict}
