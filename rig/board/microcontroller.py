@@ -84,8 +84,8 @@ class Microcontroller:
         self._stop = threading.Event()
         self._failure: RigError | None = None
         self._config: dict[str, dict[str, int]] = {}
-        self._identity: BoardIdentity | None = None
-        self._clock_model = ClockModel()
+        self.identity: BoardIdentity | None = None
+        self.clock_model = ClockModel()
         self._clock_lock = threading.Lock()
         self._listeners: list[BoardListener] = []
         self._listener_lock = threading.RLock()
@@ -156,33 +156,25 @@ class Microcontroller:
     # ---- state ----
 
     @property
-    def identity(self) -> BoardIdentity | None:
-        return self._identity
-
-    @property
     def counters(self) -> dict[str, int]:
         """The host's link counters (see LinkCounters) and the number of reconnections."""
         return asdict(self._link.counters) | {"reconnects": self._link.reconnects}
 
-    @property
-    def clock_model(self) -> ClockModel:
-        return self._clock_model
-
     def to_rig_time(self, board_time: float) -> float:
         """The rig time of a board time (NaN before the first clock synchronisation)."""
         with self._clock_lock:
-            if self._clock_model.latest is None:
+            if self.clock_model.latest is None:
                 return math.nan
-            return self._clock_model.to_rig_time(board_time)
+            return self.clock_model.to_rig_time(board_time)
 
     def board_time_now(self) -> float:
         """The board's time now, from the rig clock and the latest offset."""
         with self._clock_lock:
-            latest = self._clock_model.latest
+            latest = self.clock_model.latest
             if latest is None:
                 raise RigError("the board clock is not synchronised yet")
             now = self._clock()
-            return now + self._clock_model.offset_at(now)
+            return now + self.clock_model.offset_at(now)
 
     def check(self) -> None:
         """Raises the error that stopped the link (the port could not be reopened, or a listener
@@ -214,7 +206,7 @@ class Microcontroller:
                 f"protocol {spec['RIG_PROTOCOL_VERSION']} at {spec['RIG_TICK_HZ']} Hz: "
                 "flash the firmware of this checkout (make -C firmware flash)"
             )
-        self._identity = identity
+        self.identity = identity
         return identity
 
     def status(self) -> BoardStatus:
@@ -266,7 +258,7 @@ class Microcontroller:
                 f"{spec['RIG_BAUD']} baud; is it running the rig firmware at that rate?"
             ) from None
         with self._clock_lock:
-            self._clock_model.add(interval)
+            self.clock_model.add(interval)
         self._emit(ClockSynced(self._clock(), interval.low, interval.high, interval.round_trips, left_out))
         return interval
 
