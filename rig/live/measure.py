@@ -133,10 +133,7 @@ def write_report(report: MeasureReport) -> Path:
 def plot_measurement(report: MeasureReport, path: Path) -> Path:
     """The answers side by side: each latency with its interval (the log's: the frame-by-frame
     sensor-to-photon spread)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     rows = [("video", report.video["latency_ms"], report.video["ci95_ms"])]
     spread = report.log["sensor_to_photon_ms"]["sd"]
@@ -144,7 +141,8 @@ def plot_measurement(report: MeasureReport, path: Path) -> Path:
     if report.board:
         value, sd = report.board["latency_ms"], report.board["sd_ms"]
         rows.append(("photodiode", value, [value - 1.96 * sd, value + 1.96 * sd]))
-    figure, axes = plt.subplots(figsize=(6.0, 0.8 + 0.6 * len(rows)))
+    figure = Figure(figsize=(6.0, 0.8 + 0.6 * len(rows)))
+    axes = figure.subplots()
     for i, (name, value, interval) in enumerate(rows):
         low, high = interval if interval else (value, value)
         axes.errorbar([value], [i], xerr=[[value - low], [high - value]], fmt="o", capsize=4)
@@ -154,7 +152,6 @@ def plot_measurement(report: MeasureReport, path: Path) -> Path:
     axes.set_xlabel("latency (ms): video 95 % interval, log +- 1 sd of frame delays, photodiode 95 %")
     figure.tight_layout()
     figure.savefig(path, dpi=120)
-    plt.close(figure)
     return path
 
 
