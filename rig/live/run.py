@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import json
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
@@ -150,10 +150,11 @@ def run_live(
     progress: Progress | None = None,
     on_connected: Callable[[Display], None] = lambda display: None,
 ) -> dict[str, Any]:
-    """Run `config` live into `out_dir`; its summary (live.json's content). `frame_clock` paces the window instead of the monitor (the
-    self-test's, under a virtual X server); `camera` films the run into its record and is watched;
-    `instruments` record beside it (the rig board); `view` frames the renderer (None: framed from
-    the tracker first); `on_connected(display)` is called once everything is open."""
+    """Run `config` live into `out_dir` and return its summary (live.json's content). `frame_clock`
+    paces the window instead of the monitor (the self-test's, under a virtual X server); `camera`
+    films the run into its record and is watched; `instruments` record beside it (the rig board);
+    `view` frames the renderer (None: framed from the tracker first); `on_connected(display)` is
+    called once everything is open."""
     clock = clock or MonotonicClock()
     out_dir = Path(out_dir)
     try:
@@ -212,8 +213,7 @@ def run_live(
                 "duration_s": config.duration_s, "ended": ended, "display": display.report(),
                 "tracker_report": tracker.report(), "camera": camera.report() if camera is not None else None,
                 "film": record.film.report() if record.film is not None else None,
-                "lsl": {"pose": config.streams.pose, "tracker": config.streams.tracker, "markers": config.streams.markers}
-                if config.streams else None,
+                "lsl": asdict(config.streams) if config.streams else None,
                 "view": {"world_to_clip": view.world_to_clip.tolist(), "sphere_radius_m": view.sphere_radius_m},
             }  # fmt: skip
             summary["health"] = run_health(out_dir, display.refresh_hz, session.t_begin,
