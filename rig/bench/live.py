@@ -109,11 +109,11 @@ def live_run(out_dir: Path, duration_s: float, context: Context) -> dict[str, An
     try:
         config = LiveConfig(tracker=f"lsl:{name}", renderer="direct", duration_s=duration_s, window=WindowSettings(size=SIZE),
                             streams=None)  # fmt: skip
-        result = run_live(config, out_dir / "run", view=View(layout.world_to_clip, layout.sphere_radius_m),
-                          frame_clock=FixedRateFrameClock(REFRESH_HZ), clock=clock, overwrite=True)  # fmt: skip
+        summary = run_live(config, out_dir / "run", view=View(layout.world_to_clip, layout.sphere_radius_m),
+                           frame_clock=FixedRateFrameClock(REFRESH_HZ), clock=clock, overwrite=True)  # fmt: skip
     finally:
         emulator.close()
-    return {**arrival_to_pose(out_dir / "run"), "run_health": result.summary["health"]["verdict"]}
+    return {**arrival_to_pose(out_dir / "run"), "run_health": summary["health"]["verdict"]}
 
 
 def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:

@@ -5,37 +5,20 @@ writes them as a board recording (the format is analysis.board.recording's)."""
 
 from declared.lazy import lazy_exports
 
-__getattr__, __dir__ = lazy_exports(
-    __name__,
-    {
-        "ClockModel": "rig.board.clock_sync",
-        "OffsetInterval": "rig.board.clock_sync",
-        "BoardIdentity": "rig.board.events",
-        "BoardStatus": "rig.board.events",
-        "ClockSynced": "rig.board.events",
-        "EncoderEdge": "rig.board.events",
-        "LedChange": "rig.board.events",
-        "LinkChange": "rig.board.events",
-        "PhotodiodeCrossing": "rig.board.events",
-        "PhotodiodePassage": "rig.board.events",
-        "PhotodiodeSample": "rig.board.events",
-        "Microcontroller": "rig.board.microcontroller",
-        "BoardRecorder": "rig.board.recorder",
-    },
-)
-
-__all__ = [
-    "BoardIdentity",
-    "BoardRecorder",
-    "BoardStatus",
-    "ClockModel",
-    "ClockSynced",
-    "EncoderEdge",
-    "LedChange",
-    "LinkChange",
-    "Microcontroller",
-    "OffsetInterval",
-    "PhotodiodeCrossing",
-    "PhotodiodePassage",
-    "PhotodiodeSample",
-]
+_EXPORTS = {
+    "ClockModel": "rig.board.clock_sync",
+    "OffsetInterval": "rig.board.clock_sync",
+    "BoardIdentity": "rig.board.events",
+    "BoardStatus": "rig.board.events",
+    "ClockSynced": "rig.board.events",
+    "EncoderEdge": "rig.board.events",
+    "LedChange": "rig.board.events",
+    "LinkChange": "rig.board.events",
+    "PhotodiodeCrossing": "rig.board.events",
+    "PhotodiodePassage": "rig.board.events",
+    "PhotodiodeSample": "rig.board.events",
+    "Microcontroller": "rig.board.microcontroller",
+    "BoardRecorder": "rig.board.recorder",
+}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__all__ = sorted(_EXPORTS)

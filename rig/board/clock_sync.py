@@ -46,13 +46,6 @@ class OffsetInterval:
     def midpoint(self) -> float:
         return 0.5 * (self.low + self.high)
 
-    def intersect(self, other: OffsetInterval) -> OffsetInterval | None:
-        low = max(self.low, other.low)
-        high = min(self.high, other.high)
-        if low > high:
-            return None
-        return OffsetInterval(low, high, max(self.at, other.at), self.round_trips + other.round_trips)
-
 
 @dataclass(frozen=True)
 class RoundTrip:

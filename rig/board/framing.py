@@ -90,9 +90,6 @@ class LinkCounters:
     unknown: int = 0
     lost: int = 0
 
-    def as_dict(self) -> dict[str, int]:
-        return dict(vars(self))
-
 
 @dataclass
 class FrameDecoder:

@@ -71,9 +71,9 @@ class SerialLink:
     ) -> None:
         self.url = url
         self._open_port = open_port
-        self._clock = clock
-        self._reconnect_timeout = reconnect_timeout_s
-        self._stop = stop
+        self.clock = clock
+        self.reconnect_timeout_s = reconnect_timeout_s
+        self.stop = stop
         self._on_frames = on_frames
         self._on_change = on_change
         self._port: SerialPort | None = None
@@ -108,7 +108,7 @@ class SerialLink:
         with self._port_lock:
             if self._port is None:
                 raise LinkDown()
-            sent = self._clock()
+            sent = self.clock()
             try:
                 self._port.write(frame)
             except (serial.SerialException, OSError) as error:
@@ -125,7 +125,7 @@ class SerialLink:
 
     def read_loop(self) -> None:
         """The reader thread: reads, decodes and hands on frames; reopens a dropped port."""
-        while not self._stop.is_set():
+        while not self.stop.is_set():
             port = self._port
             if port is None:
                 if not self._reconnect():
@@ -136,43 +136,44 @@ class SerialLink:
             except (serial.SerialException, OSError, TypeError, AttributeError) as error:
                 # pyserial raises TypeError (AttributeError for socket://) when close() takes the port
                 # away in the middle of a read.
-                if not self._stop.is_set():
+                if not self.stop.is_set():
                     self._lost(str(error))
                 continue
             if data:
-                received = self._clock()
+                received = self.clock()
                 self._on_frames(self._decoder.feed(data), received)
 
     def _lost(self, detail: str) -> None:
         self.close()
         self._decoder.reset()
-        self._on_change(LinkChange(self._clock(), "lost", detail))
+        self._on_change(LinkChange(self.clock(), "lost", detail))
 
     def _reconnect(self) -> bool:
         """Reopens the port until it works (True), or until stop or the reconnect timeout (False)."""
-        deadline = self._clock() + self._reconnect_timeout
+        deadline = self.clock() + self.reconnect_timeout_s
         wait = RECONNECT_FIRST_WAIT_S
-        while not self._stop.is_set():
+        while not self.stop.is_set():
             try:
                 port = self._open()
             except RigError as error:
-                if self._clock() >= deadline:
+                if self.clock() >= deadline:
                     self.failure = RigError(
-                        f"lost the board at {self.url} and could not reopen it within {self._reconnect_timeout} s: {error}"
+                        f"lost the board at {self.url} and could not reopen it within {self.reconnect_timeout_s} s: "
+                        f"{error}"
                     )
-                    self._on_change(LinkChange(self._clock(), "failed", str(error)))
+                    self._on_change(LinkChange(self.clock(), "failed", str(error)))
                     return False
-                self._stop.wait(wait)
+                self.stop.wait(wait)
                 wait = min(2 * wait, RECONNECT_LONGEST_WAIT_S)
                 continue
             with self._port_lock:
-                if self._stop.is_set():
+                if self.stop.is_set():
                     _close_quietly(port)
                     return False
                 self._port = port
                 self.up.set()
             self.reconnects += 1
-            self._on_change(LinkChange(self._clock(), "restored", self.url))
+            self._on_change(LinkChange(self.clock(), "restored", self.url))
             return True
         return False
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+from dataclasses import asdict
 from typing import Callable, Protocol
 
 from analysis.board.blink_code import BlinkSchedule
@@ -25,7 +26,7 @@ from rig.board.framing import Frame, encode_frame
 from rig.board.keeper import Keeper
 from rig.board.link import SerialLink, SerialPort, open_serial_url
 from rig.board.messages import MessageReader, status_event
-from rig.board.protocol import ProtocolSpec, protocol
+from rig.board.protocol import protocol
 from rig.board.requests import Answer, Requests
 from rig.errors import ConfigError, RigError
 
@@ -83,8 +84,8 @@ class Microcontroller:
         self._stop = threading.Event()
         self._failure: RigError | None = None
         self._config: dict[str, dict[str, int]] = {}
-        self._identity: BoardIdentity | None = None
-        self._clock_model = ClockModel()
+        self.identity: BoardIdentity | None = None
+        self.clock_model = ClockModel()
         self._clock_lock = threading.Lock()
         self._listeners: list[BoardListener] = []
         self._listener_lock = threading.RLock()
@@ -98,14 +99,7 @@ class Microcontroller:
             on_frames=self._on_frames,
             on_change=self._on_link_change,
         )
-        self._requests = Requests(
-            self._link,
-            reply_timeout_s=reply_timeout_s,
-            reconnect_timeout_s=reconnect_timeout_s,
-            clock=clock,
-            stop=self._stop,
-            check=self.check,
-        )
+        self._requests = Requests(self._link, reply_timeout_s=reply_timeout_s, check=self.check)
         self._messages = MessageReader(self.to_rig_time)
         self._keeper: Keeper | None = None
 
@@ -118,10 +112,8 @@ class Microcontroller:
         self._stop.clear()
         self._failure = None
         self._keeper = Keeper(
-            url=self.url,
-            clock=self._clock,
+            self._link,
             resync_every_s=self._resync_every,
-            stop=self._stop,
             sync=self.sync,
             restore=self._restore,
             report=self._emit,
@@ -164,37 +156,25 @@ class Microcontroller:
     # ---- state ----
 
     @property
-    def spec(self) -> ProtocolSpec:
-        return protocol()
-
-    @property
-    def identity(self) -> BoardIdentity | None:
-        return self._identity
-
-    @property
     def counters(self) -> dict[str, int]:
         """The host's link counters (see LinkCounters) and the number of reconnections."""
-        return self._link.counters.as_dict() | {"reconnects": self._link.reconnects}
-
-    @property
-    def clock_model(self) -> ClockModel:
-        return self._clock_model
+        return asdict(self._link.counters) | {"reconnects": self._link.reconnects}
 
     def to_rig_time(self, board_time: float) -> float:
         """The rig time of a board time (NaN before the first clock synchronisation)."""
         with self._clock_lock:
-            if self._clock_model.latest is None:
+            if self.clock_model.latest is None:
                 return math.nan
-            return self._clock_model.to_rig_time(board_time)
+            return self.clock_model.to_rig_time(board_time)
 
     def board_time_now(self) -> float:
         """The board's time now, from the rig clock and the latest offset."""
         with self._clock_lock:
-            latest = self._clock_model.latest
+            latest = self.clock_model.latest
             if latest is None:
                 raise RigError("the board clock is not synchronised yet")
             now = self._clock()
-            return now + self._clock_model.offset_at(now)
+            return now + self.clock_model.offset_at(now)
 
     def check(self) -> None:
         """Raises the error that stopped the link (the port could not be reopened, or a listener
@@ -207,16 +187,12 @@ class Microcontroller:
         with self._listener_lock:
             self._listeners.append(listener)
 
-    def remove_listener(self, listener: BoardListener) -> None:
-        with self._listener_lock:
-            self._listeners.remove(listener)
-
     # ---- commands ----
 
     def identify(self, tries: int | None = None) -> BoardIdentity:
         answer = self._request("RIG_CMD_IDENTIFY", expects=("RIG_MSG_IDENTITY",), tries=tries)
         fields = answer.answer("RIG_MSG_IDENTITY")
-        spec = self.spec
+        spec = protocol()
         identity = BoardIdentity(
             name=fields["name"].rstrip(b"\0").decode("ascii", "replace"),
             protocol=fields["protocol"],
@@ -230,7 +206,7 @@ class Microcontroller:
                 f"protocol {spec['RIG_PROTOCOL_VERSION']} at {spec['RIG_TICK_HZ']} Hz: "
                 "flash the firmware of this checkout (make -C firmware flash)"
             )
-        self._identity = identity
+        self.identity = identity
         return identity
 
     def status(self) -> BoardStatus:
@@ -253,7 +229,7 @@ class Microcontroller:
 
     def sync(self, round_trips: int | None = None) -> OffsetInterval:
         """Measures the clock offset: intersects the intervals of `round_trips` round trips."""
-        spec = self.spec
+        spec = protocol()
         count = self._sync_round_trips if round_trips is None else round_trips
         if count < 1:
             raise ConfigError(f"round_trips must be >= 1, got {count}")
@@ -282,7 +258,7 @@ class Microcontroller:
                 f"{spec['RIG_BAUD']} baud; is it running the rig firmware at that rate?"
             ) from None
         with self._clock_lock:
-            self._clock_model.add(interval)
+            self.clock_model.add(interval)
         self._emit(ClockSynced(self._clock(), interval.low, interval.high, interval.round_trips, left_out))
         return interval
 
@@ -294,7 +270,7 @@ class Microcontroller:
 
     def blink(self, *, bits: int, bit_s: float, seed: int, level: int = 255, start_in_s: float = 0.2) -> BlinkSchedule:
         """Plays `bits` bits of the blink code, starting `start_in_s` from now; returns the schedule."""
-        spec = self.spec
+        spec = protocol()
         hz = spec["RIG_TICK_HZ"]
         bit_ticks = round(bit_s * hz)
         if not 1 <= bits <= spec["RIG_BLINK_MAX_BITS"]:
@@ -312,7 +288,7 @@ class Microcontroller:
 
     def configure_encoder(self, report_hz: float = 0.0) -> None:
         """One report per edge (report_hz 0), or at most report_hz reports per second."""
-        spec = self.spec
+        spec = protocol()
         hz = spec["RIG_TICK_HZ"]
         highest = hz / spec["RIG_ENCODER_MIN_REPORT_TICKS"]
         if report_hz != 0 and not 0 < report_hz <= highest:
@@ -322,7 +298,7 @@ class Microcontroller:
     def configure_photodiode(self, rise: int, fall: int, raw_every: int = 0) -> None:
         """Crossings up through `rise` and down through `fall` (ADC counts, fall < rise), and every
         raw_every-th ADC sample (0: none)."""
-        spec = self.spec
+        spec = protocol()
         top = spec["RIG_ADC_MAX"]
         if not 0 <= fall < rise <= top:
             raise ConfigError(f"photodiode thresholds need 0 <= fall < rise <= {top}, got rise {rise}, fall {fall}")
@@ -333,7 +309,7 @@ class Microcontroller:
     def stream(self, *, encoder: bool = False, photodiode: bool = False, samples: bool = False) -> None:
         """Which event streams the board sends: encoder edges, photodiode crossings and passages,
         raw photodiode samples (LED changes always come)."""
-        spec = self.spec
+        spec = protocol()
         mask = (
             (spec["RIG_STREAM_ENCODER"] if encoder else 0)
             | (spec["RIG_STREAM_PHOTODIODE"] if photodiode else 0)
@@ -364,7 +340,7 @@ class Microcontroller:
     # ---- what the reader thread reports ----
 
     def _on_frames(self, frames: list[Frame], received: float) -> None:
-        spec = self.spec
+        spec = protocol()
         for frame in frames:
             fields = spec.layout(frame.type).unpack(frame.payload)
             if "reply_to" in fields and not fields.get("unsolicited"):

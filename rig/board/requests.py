@@ -44,29 +44,16 @@ class _Pending:
 
 
 class Requests:
-    """The commands in flight on a link.
+    """The commands in flight on a link, on the link's clock; a command waits the link's
+    reconnect_timeout_s for a dropped link to come back, and fails at once once its `stop` is set.
 
     reply_timeout_s: how long to wait for the answers to each try.
-    reconnect_timeout_s: how long a command waits for a dropped link to come back.
-    stop: set when the connection closes; commands then fail at once.
     check: raises the error that stopped the connection, if any.
     """
 
-    def __init__(
-        self,
-        link: SerialLink,
-        *,
-        reply_timeout_s: float,
-        reconnect_timeout_s: float,
-        clock: Callable[[], float],
-        stop: threading.Event,
-        check: Callable[[], None],
-    ) -> None:
+    def __init__(self, link: SerialLink, *, reply_timeout_s: float, check: Callable[[], None]) -> None:
         self._link = link
         self._reply_timeout = reply_timeout_s
-        self._reconnect_timeout = reconnect_timeout_s
-        self._clock = clock
-        self._stop = stop
         self._check = check
         self._seq = itertools.count(1)
         self._pending: dict[int, _Pending] = {}
@@ -103,15 +90,16 @@ class Requests:
 
     def _wait_for_link(self) -> None:
         """Returns once the port is open; raises if the link failed, closed or stayed down."""
-        deadline = self._clock() + self._reconnect_timeout
-        while not self._link.up.wait(READ_TIMEOUT_S):
+        link = self._link
+        deadline = link.clock() + link.reconnect_timeout_s
+        while not link.up.wait(READ_TIMEOUT_S):
             self._check()
-            if self._stop.is_set():
-                raise RigError(f"the connection to the board at {self._link.url} is closed")
-            if self._clock() > deadline:
-                raise RigError(f"the link to the board at {self._link.url} stayed down for {self._reconnect_timeout} s")
+            if link.stop.is_set():
+                raise RigError(f"the connection to the board at {link.url} is closed")
+            if link.clock() > deadline:
+                raise RigError(f"the link to the board at {link.url} stayed down for {link.reconnect_timeout_s} s")
         self._check()
-        if self._stop.is_set():
+        if link.stop.is_set():
             raise RigError(f"the connection to the board at {self._link.url} is closed")
 
     def resolve(self, reply_to: int, message_type: int, fields: dict[str, Any], received: float) -> None:

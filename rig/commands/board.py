@@ -74,12 +74,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help="play the blink code at the start, then leave the LED lit: film it, release the pendulum after it, "
         "and `rig analyse VIDEO --board DIR` aligns the video to this recording",
     )
-    _add_blink_options(record)
+    add_declared_options(record, BlinkOptions)
     record.set_defaults(func=run_record)
 
     blink = commands.add_parser("blink", help="play the LED blink code, to align a camera's video to the board's clock")
     _add_port(blink)
-    _add_blink_options(blink)
+    add_declared_options(blink, BlinkOptions)
     blink.add_argument("--out", type=outputs.output_folder, help="also record the LED changes (led.csv) and the schedule (blink.json) here")
     blink.add_argument("--json", action="store_true", help="print the schedule as one JSON object")
     blink.set_defaults(func=run_blink)
@@ -109,10 +109,6 @@ class BlinkOptions:
     bit_ms: float = setting(50.0, "ms", "duration of one bit", Range(1.0, 10000.0, True, True), flag="--bit-ms")
     seed: int = setting(0xACE1, "", "code seed", Range(1.0, 65535.0, True, True), flag="--seed")
     level: int = setting(255, "", "LED level of a 1 bit (and after a recording's blink)", Range(1.0, 255.0, True, True), flag="--level")
-
-
-def _add_blink_options(parser: argparse.ArgumentParser) -> None:
-    add_declared_options(parser, BlinkOptions)
 
 
 def _add_port(parser: argparse.ArgumentParser) -> None:

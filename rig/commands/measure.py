@@ -126,6 +126,7 @@ def _self_test(args: argparse.Namespace) -> int:
 
 def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:
     from rig.live.camera_recording import check_first_seconds, record_camera
+    from rig.session.run_files import VIDEO_FILE
 
     for step in GUIDE:
         print(step, file=sys.stderr)
@@ -133,7 +134,7 @@ def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:
         folder = args.out / "check"
         record_camera(args.camera.removeprefix("camera:"), CHECK_SECONDS, folder, overwrite=True,
                       accept_refused=args.accept_camera_settings)  # fmt: skip
-        problems = check_first_seconds(folder / "video.avi", led_side)
+        problems = check_first_seconds(folder / VIDEO_FILE, led_side)
         if not problems:
             print(f"the first {CHECK_SECONDS:g} s look right: both blobs found, exposure not saturated", file=sys.stderr)
             return

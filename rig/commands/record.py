@@ -38,14 +38,14 @@ def _run(args: argparse.Namespace) -> int:
     from rig.live.camera_recording import record_camera
 
     rois = (list(args.led_roi), list(args.sphere_roi)) if args.led_roi and args.sphere_roi else None
-    recording = record_camera(
+    report = record_camera(
         args.camera.removeprefix("camera:"), args.duration, args.out, preview=args.preview, rois=rois,
         accept_refused=args.accept_camera_settings, overwrite=args.overwrite, progress=ProgressBar("recording"),
     )  # fmt: skip
     if args.json:
-        print(json.dumps(recording.report))
+        print(json.dumps(report))
     else:
-        print(_summary(recording.report))
+        print(_summary(report))
         print(f"wrote {args.out}")
     return 0
 

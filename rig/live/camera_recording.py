@@ -14,7 +14,6 @@ asks whether both blobs are found and whether the exposure leaves them unsaturat
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
@@ -40,12 +39,6 @@ SATURATED = 255
 SATURATED_SHARE = 0.002
 """More of the image than this at full scale is an exposure too long (the LED's core aside)."""
 LED_COLOUR, SPHERE_COLOUR = (255, 200, 0), (0, 200, 255)
-
-
-@dataclass(frozen=True)
-class CameraRecording:
-    out_dir: Path
-    report: dict[str, Any]
 
 
 class Preview:
@@ -95,8 +88,8 @@ def record_camera(
     accept_refused: bool = False,
     overwrite: bool = False,
     progress: Callable[[float, float], None] = lambda done, total: None,
-) -> CameraRecording:
-    """Film `spec` for `duration_s` into `out_dir` (see the module docstring)."""
+) -> dict[str, Any]:
+    """Film `spec` for `duration_s` into `out_dir` (see the module docstring); camera.json's content."""
     camera = opencv_camera(spec, accept_refused=accept_refused)
     window = Preview(rois) if preview else None
     clock = MonotonicClock()
@@ -126,7 +119,7 @@ def record_camera(
         if (fault := camera.fault()) is not None:
             kept = f"everything captured before is in {out_dir}" if film is not None and film.frames else "nothing was captured"
             raise RigError(f"{fault.reason} at {fault.since:.3f} s; {kept}")
-    return CameraRecording(out_dir, report)
+    return report
 
 
 def _film(frames: list[CameraFrame], film: FilmRecord, window: Preview | None) -> None:

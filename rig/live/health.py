@@ -17,22 +17,20 @@ connected to when it ended):
   and sent them late in a burst left the rig extrapolating as surely as one that measured nothing);
 * the camera: frames dropped, with when (runs of consecutive drops), and its stalls.
 
-`judge` turns those into a `Verdict` against the thresholds below: `invalid` when the rig or its
-tracker stalled (its number would not be the system's latency), `degraded` when it hitched, repeated
-images at most refreshes, swapped late or dropped camera frames often (the number stands, with its
-caveats), `valid` otherwise. Times are seconds into the run.
+`judge` turns those into a verdict (a status and its reasons) against the thresholds below:
+`invalid` when the rig or its tracker stalled (its number would not be the system's latency),
+`degraded` when it hitched, repeated images at most refreshes, swapped late or dropped camera frames
+often (the number stands, with its caveats), `valid` otherwise. Times are seconds into the run.
 """
 
 from __future__ import annotations
 
-import csv
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from rig.live.files import MARKERS_FILE, PUBLISHED_FILE, SWAPS_FILE
+from rig.live.files import MARKERS_FILE, PUBLISHED_FILE, SWAPS_FILE, read_columns, with_poses
 from rig.session.run_record import FRAMES_FILE, TRACKER_FILE
 
 STALL_S = 0.25
@@ -64,33 +62,6 @@ slow; camera drops within `SLOW_MARGIN_S` of one are counted as drops while the 
 SLOW_MARGIN_S = 0.1
 
 VALID, DEGRADED, INVALID = "valid", "degraded", "invalid"
-
-
-@dataclass(frozen=True)
-class Verdict:
-    status: str
-    reasons: tuple[str, ...] = ()
-
-    def __str__(self) -> str:
-        return self.status if not self.reasons else f"{self.status}: {'; '.join(self.reasons)}"
-
-
-def _table(path: Path) -> dict[str, np.ndarray] | None:
-    """A CSV run file's numeric columns (empty cells NaN); None where the run did not write it."""
-    if not path.is_file():
-        return None
-    with path.open(encoding="utf-8", newline="") as stream:
-        reader = csv.DictReader(stream)
-        rows = list(reader)
-        names = reader.fieldnames or []
-
-    def number(cell: str | None) -> float:
-        try:
-            return float(cell) if cell not in ("", None) else np.nan
-        except ValueError:
-            return np.nan
-
-    return {name: np.array([number(row.get(name)) for row in rows], dtype=np.float64) for name in names}
 
 
 def pauses(times: np.ndarray, t_begin: float, t_end: float) -> dict[str, float]:
@@ -125,10 +96,10 @@ def swaps_of(out_dir: Path) -> dict[str, np.ndarray] | None:
     """Each new image's swap: `t` (rig clock), `image` (its published frame) and `late` (NaN where
     not known: an external renderer's markers do not say), from the window's swap log or an external
     renderer's markers; None where the run kept neither."""
-    swaps = _table(out_dir / SWAPS_FILE)
+    swaps = read_columns(out_dir / SWAPS_FILE)
     if swaps is not None:
         return {"t": swaps["t_swap"], "image": swaps["image"], "late": swaps["late"]}
-    markers = _table(out_dir / MARKERS_FILE)
+    markers = read_columns(out_dir / MARKERS_FILE)
     if markers is None:
         return None
     frames = markers["frame"]
@@ -157,11 +128,10 @@ def pose_age(swaps: dict[str, np.ndarray], poses: dict[str, np.ndarray] | None) 
     """The pose's age (ms) at each swap: the swap's time minus its image's newest sample's sensor time."""
     if poses is None or not len(poses.get("frame", ())):
         return None
-    index = {int(frame): i for i, frame in enumerate(poses["frame"])}
-    pairs = [(t, poses["t_sensor"][index[int(image)]]) for t, image in zip(swaps["t"], swaps["image"]) if int(image) in index]
-    if not pairs:
+    at, pose_at = with_poses(swaps["image"], np.ones(len(swaps["image"]), dtype=bool), poses)
+    if not len(at):
         return None
-    age_ms = np.array([t - sensor for t, sensor in pairs]) * 1e3
+    age_ms = (swaps["t"][at] - poses["t_sensor"][pose_at]) * 1e3
     return {"median_ms": float(np.median(age_ms)), "p95_ms": float(np.percentile(age_ms, 95)), "max_ms": float(age_ms.max())}
 
 
@@ -214,7 +184,7 @@ def _pauses(stream: dict[str, Any], stalled: str, hitched: str, first: str, sile
     return invalid, degraded
 
 
-def judge(health: dict[str, Any]) -> Verdict:
+def judge(health: dict[str, Any]) -> tuple[str, list[str]]:
     """The verdict on a run's health (see the module docstring and the thresholds)."""
     invalid, degraded = [], []
     display, tracker, camera = health.get("display"), health["tracker"], health.get("camera")
@@ -238,8 +208,8 @@ def judge(health: dict[str, Any]) -> Verdict:
         degraded.append(f"the camera dropped {camera['dropped']} frames ({camera['dropped_share']:.1%}), "
                         f"{worst['frames']} in a row at {worst['at_s']:.1f} s")  # fmt: skip
     if invalid:
-        return Verdict(INVALID, tuple(invalid))
-    return Verdict(DEGRADED, tuple(degraded)) if degraded else Verdict(VALID)
+        return INVALID, invalid
+    return (DEGRADED, degraded) if degraded else (VALID, [])
 
 
 def run_health(out_dir: Path, refresh_hz: float, t_begin: float, t_end: float, film: dict[str, Any] | None) -> dict[str, Any]:
@@ -250,9 +220,10 @@ def run_health(out_dir: Path, refresh_hz: float, t_begin: float, t_end: float, f
     health: dict[str, Any] = {
         "span_s": t_end - t_begin,
         "display": display_health(swaps, refresh_hz, t_begin, t_end) if swaps is not None else None,
-        "pose_age": pose_age(swaps, _table(out_dir / PUBLISHED_FILE)) if swaps is not None else None,
-        "tracker": tracker_health(_table(out_dir / TRACKER_FILE), t_begin, t_end),
-        "camera": camera_health(_table(out_dir / FRAMES_FILE), film, t_begin),
+        "pose_age": pose_age(swaps, read_columns(out_dir / PUBLISHED_FILE)) if swaps is not None else None,
+        "tracker": tracker_health(read_columns(out_dir / TRACKER_FILE), t_begin, t_end),
+        "camera": camera_health(read_columns(out_dir / FRAMES_FILE), film, t_begin),
     }
-    verdict = judge(health)
-    return {**health, "status": verdict.status, "reasons": list(verdict.reasons), "verdict": str(verdict)}
+    status, reasons = judge(health)
+    verdict = f"{status}: {'; '.join(reasons)}" if reasons else status
+    return {**health, "status": status, "reasons": reasons, "verdict": verdict}

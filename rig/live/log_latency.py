@@ -13,7 +13,6 @@ both). Beside it, the mean and spread of the frame-by-frame sensor-to-photon del
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
@@ -23,6 +22,8 @@ from scipy.optimize import minimize_scalar
 
 from predictors import read_samples
 from rig.errors import RigError
+from rig.live.files import MARKERS_FILE, PUBLISHED_FILE, read_columns, with_poses
+from rig.session.run_files import DISPLAY_FRAMES_FILE, TRACKER_FILE
 from rig.sim.truth import SCAN_STEP_S, effective_latency, shown_signal
 
 # Left out at each end of the run: the predictor and the display settle, the last frames may be cut.
@@ -40,15 +41,6 @@ class LogLatency:
     def to_dict(self) -> dict[str, Any]:
         return {"latency_ms": self.latency_ms, "sensor_to_photon_ms": {"mean": self.delay_mean_ms, "sd": self.delay_sd_ms},
                 "frames": self.frames, "period_s": self.period_s}  # fmt: skip
-
-
-def _table(path: Path) -> dict[str, np.ndarray]:
-    with path.open(encoding="utf-8", newline="") as stream:
-        rows = list(csv.DictReader(stream))
-    if not rows:
-        return {}
-    return {key: np.array([float(row[key]) if row[key] not in ("", None) else np.nan for row in rows]) for key in rows[0]
-            if key != "cost_source"}  # fmt: skip
 
 
 def swing_period(t: np.ndarray, x: np.ndarray) -> float:
@@ -84,7 +76,7 @@ def log_latency(
     leave its row at t + scanout_s) and its pose's `px py pz` and `t_sensor`. With `instants` (the
     times a camera filmed), over those instants only: what that camera would have measured of the
     logged display, whatever it missed."""
-    samples = read_samples(out_dir / "tracker.csv")
+    samples = read_samples(out_dir / TRACKER_FILE)
     if len(samples) < 10 or len(shown.get("t", ())) < 10:
         raise RigError(f"{out_dir} holds too few tracker samples or shown frames to work out the logged latency")
     t_sensor = np.array([s.t_sensor for s in samples])
@@ -121,29 +113,19 @@ def log_latency(
 
 def shown_by_window(out_dir: Path) -> dict[str, np.ndarray]:
     """What the rig's own renderer showed: display_frames.csv joined with published_poses.csv."""
-    frames, poses = _table(out_dir / "display_frames.csv"), _table(out_dir / "published_poses.csv")
+    frames, poses = read_columns(out_dir / DISPLAY_FRAMES_FILE), read_columns(out_dir / PUBLISHED_FILE)
     if not frames or not poses:
         return {}
-    new = np.concatenate([[True], np.diff(frames["image"]) != 0])
-    index = {int(frame): i for i, frame in enumerate(poses["frame"])}
-    rows = [(i, index[int(image)]) for i, image in enumerate(frames["image"]) if new[i] and int(image) in index]
-    at, pose_at = np.array([r[0] for r in rows], dtype=int), np.array([r[1] for r in rows], dtype=int)
+    at, pose_at = with_poses(frames["image"], np.concatenate([[True], np.diff(frames["image"]) != 0]), poses)
     return {"t": frames["t_photon"][at], "t_sensor": frames["t_sensor_newest"][at],
             **{key: poses[key][pose_at] for key in ("px", "py", "pz")}}  # fmt: skip
 
 
 def shown_by_markers(out_dir: Path) -> dict[str, np.ndarray]:
     """What an external renderer showed: its swap markers joined with the poses the rig published."""
-    markers, poses = _table(out_dir / "renderer_markers.csv"), _table(out_dir / "published_poses.csv")
+    markers, poses = read_columns(out_dir / MARKERS_FILE), read_columns(out_dir / PUBLISHED_FILE)
     if not markers or not poses:
         return {}
-    index = {int(frame): i for i, frame in enumerate(poses["frame"])}
-    previous = None
-    rows = []
-    for i, frame in enumerate(markers["frame"]):
-        if int(frame) in index and frame != previous:
-            rows.append((i, index[int(frame)]))
-        previous = frame
-    at, pose_at = np.array([r[0] for r in rows], dtype=int), np.array([r[1] for r in rows], dtype=int)
+    at, pose_at = with_poses(markers["frame"], np.concatenate([[True], np.diff(markers["frame"]) != 0]), poses)
     return {"t": markers["t_swap"][at], "t_sensor": poses["t_sensor"][pose_at],
             **{key: poses[key][pose_at] for key in ("px", "py", "pz")}}  # fmt: skip

@@ -15,7 +15,6 @@ not analysed, since its video would not show the system's latency; its report ho
 
 from __future__ import annotations
 
-import csv
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -29,6 +28,7 @@ from rig.board.instrument import BoardInstrument
 from rig.devices.camera.opencv_camera import opencv_camera
 from rig.errors import RigError
 from rig.fresh_outputs import removed_unless_recorded
+from rig.live.files import camera_instants
 from rig.live.health import INVALID, VALID
 from rig.live.log_latency import log_latency, shown_by_markers, shown_by_window
 from rig.live.run import EXTERNAL, LiveConfig, run_live, write_summary
@@ -36,7 +36,7 @@ from rig.live.video_vs_log import video_against_log
 from rig.live.view import View
 from rig.render.protocol import RenderSetup
 from rig.service.analyse import AnalysisRequest, analyse
-from rig.session.run_files import BOARD_FOLDER, FRAMES_FILE
+from rig.session.run_files import BOARD_FOLDER, VIDEO_FILE
 
 MEASURE_FILE = "measure.json"
 PLOT_FILE = "measure.png"
@@ -75,12 +75,6 @@ class MeasureReport:
         }
 
 
-def filmed_instants(out_dir: Path) -> np.ndarray:
-    """When the camera took each frame it delivered (not the stand-ins for dropped ones)."""
-    with (out_dir / FRAMES_FILE).open(encoding="utf-8", newline="") as stream:
-        return np.array([float(row["t_capture"]) for row in csv.DictReader(stream) if row["filled"] == "0"])
-
-
 def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[str, Any]:
     """The log's answer for a run folder (`rig.live.log_latency`) at the instants the camera filmed,
     which weights the run as the video does, and over the whole run beside it."""
@@ -93,7 +87,7 @@ def logged_latency(out_dir: Path, external: bool, run: dict[str, Any]) -> dict[s
         scanout = rows * display["scanout_fraction"] / display["refresh_hz"]
     else:
         shown = shown_by_window(out_dir)
-    filmed = log_latency(out_dir, shown, scanout, filmed_instants(out_dir)).to_dict()
+    filmed = log_latency(out_dir, shown, scanout, camera_instants(out_dir, dropped=False)).to_dict()
     return {**filmed, "whole_run_latency_ms": log_latency(out_dir, shown, scanout).latency_ms}
 
 
@@ -106,7 +100,7 @@ def analyse_run(out_dir: Path, fps: float | None, options: AnalysisOptions, boar
         report = MeasureReport(out_dir, None, None, None, run)
         write_report(report)
         return report
-    request = AnalysisRequest(out_dir / "video.avi", replace(options, fps=fps), tracks_csv=out_dir / "tracks.csv")
+    request = AnalysisRequest(out_dir / VIDEO_FILE, replace(options, fps=fps), tracks_csv=out_dir / "tracks.csv")
     try:
         video = analyse(request, progress).to_dict()
     except AnalysisError as error:
@@ -139,10 +133,7 @@ def write_report(report: MeasureReport) -> Path:
 def plot_measurement(report: MeasureReport, path: Path) -> Path:
     """The answers side by side: each latency with its interval (the log's: the frame-by-frame
     sensor-to-photon spread)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     rows = [("video", report.video["latency_ms"], report.video["ci95_ms"])]
     spread = report.log["sensor_to_photon_ms"]["sd"]
@@ -150,7 +141,8 @@ def plot_measurement(report: MeasureReport, path: Path) -> Path:
     if report.board:
         value, sd = report.board["latency_ms"], report.board["sd_ms"]
         rows.append(("photodiode", value, [value - 1.96 * sd, value + 1.96 * sd]))
-    figure, axes = plt.subplots(figsize=(6.0, 0.8 + 0.6 * len(rows)))
+    figure = Figure(figsize=(6.0, 0.8 + 0.6 * len(rows)))
+    axes = figure.subplots()
     for i, (name, value, interval) in enumerate(rows):
         low, high = interval if interval else (value, value)
         axes.errorbar([value], [i], xerr=[[value - low], [high - value]], fmt="o", capsize=4)
@@ -160,7 +152,6 @@ def plot_measurement(report: MeasureReport, path: Path) -> Path:
     axes.set_xlabel("latency (ms): video 95 % interval, log +- 1 sd of frame delays, photodiode 95 %")
     figure.tight_layout()
     figure.savefig(path, dpi=120)
-    plt.close(figure)
     return path
 
 
@@ -181,10 +172,10 @@ def measure(
     camera = opencv_camera(camera_spec, accept_refused=accept_camera_settings)
     board = [BoardInstrument(board_port, out_dir / BOARD_FOLDER)] if board_port else []
     with removed_unless_recorded(out_dir):
-        result = run_live(config, out_dir, view=view, camera=camera, instruments=board, overwrite=overwrite, progress=progress)
-        film = result.summary["film"]
-        if result.summary["health"]["status"] == INVALID:
-            return analyse_run(out_dir, None, options, None, result.summary)
+        run = run_live(config, out_dir, view=view, camera=camera, instruments=board, overwrite=overwrite, progress=progress)
+        film = run["film"]
+        if run["health"]["status"] == INVALID:
+            return analyse_run(out_dir, None, options, None, run)
         if film is None or film["frames"] < 2:
             raise RigError(f"the camera {camera_spec} recorded no video; check it films while the run goes")
-    return analyse_run(out_dir, film["measured_fps"], options, out_dir / BOARD_FOLDER if board else None, result.summary)
+    return analyse_run(out_dir, film["measured_fps"], options, out_dir / BOARD_FOLDER if board else None, run)

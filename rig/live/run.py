@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import json
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
@@ -77,12 +77,6 @@ class LiveConfig:
         check(self, ConfigError)
         if self.renderer == EXTERNAL and self.streams is None:
             raise ConfigError("an external renderer is reached through LSL: the run needs its streams")
-
-
-@dataclass
-class LiveResult:
-    out_dir: Path
-    summary: dict[str, Any] = field(default_factory=dict)
 
 
 class Watchdog:
@@ -155,11 +149,12 @@ def run_live(
     overwrite: bool = False,
     progress: Progress | None = None,
     on_connected: Callable[[Display], None] = lambda display: None,
-) -> LiveResult:
-    """Run `config` live into `out_dir`. `frame_clock` paces the window instead of the monitor (the
-    self-test's, under a virtual X server); `camera` films the run into its record and is watched;
-    `instruments` record beside it (the rig board); `view` frames the renderer (None: framed from
-    the tracker first); `on_connected(display)` is called once everything is open."""
+) -> dict[str, Any]:
+    """Run `config` live into `out_dir` and return its summary (live.json's content). `frame_clock`
+    paces the window instead of the monitor (the self-test's, under a virtual X server); `camera`
+    films the run into its record and is watched; `instruments` record beside it (the rig board);
+    `view` frames the renderer (None: framed from the tracker first); `on_connected(display)` is
+    called once everything is open."""
     clock = clock or MonotonicClock()
     out_dir = Path(out_dir)
     try:
@@ -172,7 +167,6 @@ def run_live(
     width, height = (640, 480) if external else config.window.size
     if view is None:
         view = frame_view(config.tracker, clock, width, height, config.mirror)
-    result = LiveResult(out_dir)
     ended = "interrupted"
     with contextlib.ExitStack() as files:
         published = files.enter_context(CsvRecord(out_dir / PUBLISHED_FILE, PUBLISHED_COLUMNS, overwrite=overwrite))
@@ -214,16 +208,15 @@ def run_live(
             raise
         finally:
             record.close()
-            result.summary = {
+            summary = {
                 "tracker": config.tracker, "renderer": config.renderer, "predictor": config.predictor,
                 "duration_s": config.duration_s, "ended": ended, "display": display.report(),
                 "tracker_report": tracker.report(), "camera": camera.report() if camera is not None else None,
                 "film": record.film.report() if record.film is not None else None,
-                "lsl": {"pose": config.streams.pose, "tracker": config.streams.tracker, "markers": config.streams.markers}
-                if config.streams else None,
+                "lsl": asdict(config.streams) if config.streams else None,
                 "view": {"world_to_clip": view.world_to_clip.tolist(), "sphere_radius_m": view.sphere_radius_m},
             }  # fmt: skip
-            result.summary["health"] = run_health(out_dir, display.refresh_hz, session.t_begin,
-                                                  min(session.t_end, clock.now()), result.summary["film"])  # fmt: skip
-            write_summary(out_dir, result.summary)
-    return result
+            summary["health"] = run_health(out_dir, display.refresh_hz, session.t_begin,
+                                           min(session.t_end, clock.now()), summary["film"])  # fmt: skip
+            write_summary(out_dir, summary)
+    return summary

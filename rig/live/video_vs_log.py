@@ -11,23 +11,13 @@ of remedy.
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from rig.live.files import camera_instants
 from rig.live.health import during, slow_spans, swaps_of
-from rig.session.run_record import FRAMES_FILE
-
-
-def dropped_instants(out_dir: Path) -> np.ndarray:
-    """When the camera should have taken each frame it dropped (the film's stand-ins' times)."""
-    path = Path(out_dir) / FRAMES_FILE
-    if not path.is_file():
-        return np.array([])
-    with path.open(encoding="utf-8", newline="") as stream:
-        return np.array([float(row["t_capture"]) for row in csv.DictReader(stream) if row["filled"] == "1"])
 
 
 def compare(video: dict[str, Any], log: dict[str, Any], dropped: np.ndarray, slow: list[tuple[float, float]]) -> dict[str, Any]:
@@ -62,4 +52,4 @@ def video_against_log(out_dir: Path, video: dict[str, Any], log: dict[str, Any])
     """`compare` for a run folder: its camera's drops and its rig's slow moments from its logs."""
     swaps = swaps_of(Path(out_dir))
     slow = slow_spans(swaps["t"]) if swaps is not None else []
-    return compare(video, log, dropped_instants(Path(out_dir)), slow)
+    return compare(video, log, camera_instants(out_dir, dropped=True), slow)

@@ -10,11 +10,11 @@ still checked. A malformed spec is the user's error (ConfigError), raised before
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from rig.clock import Clock, MonotonicClock
+from rig.clock import MonotonicClock
 from rig.devices.window import FrameClock
 from rig.preflight.camera import CameraProbe
 from rig.preflight.display import check_display
@@ -50,22 +50,7 @@ class CheckReport:
         return worst(self.rows)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"status": self.status, "seconds": self.seconds, "checks": [row.to_dict() for row in self.rows]}
-
-
-class _Listening:
-    """A probe's `run(clock, until)` on a thread of its own, for LISTEN_S after its device opens."""
-
-    def __init__(self, probe: TrackerProbe | CameraProbe, clock: Clock) -> None:
-        self.probe = probe
-        self._thread = threading.Thread(target=self._run, args=(clock,), name=f"rig check {type(probe).__name__}", daemon=True)
-        self._thread.start()
-
-    def _run(self, clock: Clock) -> None:
-        self.probe.run(clock, LISTEN_S)
-
-    def join(self) -> None:
-        self._thread.join()
+        return {"status": self.status, "seconds": self.seconds, "checks": [asdict(row) for row in self.rows]}
 
 
 def run_checks(plan: CheckPlan, *, frame_clock: FrameClock | None = None, clock: MonotonicClock | None = None) -> CheckReport:
@@ -75,12 +60,20 @@ def run_checks(plan: CheckPlan, *, frame_clock: FrameClock | None = None, clock:
     started = clock.now()
     tracker = TrackerProbe(plan.tracker) if plan.tracker else None
     camera = CameraProbe(plan.camera.removeprefix("camera:"), plan.accept_camera_settings) if plan.camera else None
-    listening = [_Listening(probe, clock) for probe in (tracker, camera) if probe is not None]
+    listening = [
+        threading.Thread(
+            target=probe.run, args=(clock, LISTEN_S), name=f"rig check {type(probe).__name__}", daemon=True
+        )
+        for probe in (tracker, camera)
+        if probe is not None
+    ]
+    for thread in listening:
+        thread.start()
     try:
         rows = check_display(plan.display, clock, frame_clock) if plan.display is not None else []
     finally:
-        for listener in listening:
-            listener.join()
+        for thread in listening:
+            thread.join()
     if tracker is not None:
         rows += tracker.rows(LISTEN_S)
     if camera is not None:

@@ -3,7 +3,7 @@ and, where it is not a pass, what to fix."""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 PASS, WARN, FAIL = "pass", "warn", "fail"
@@ -26,9 +26,6 @@ class CheckRow:
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
             raise ValueError(f"a check's status is one of {', '.join(STATUSES)}, got {self.status!r}")
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
 
 def worst(rows: list[CheckRow]) -> str:

@@ -21,7 +21,7 @@ from typing import Any, Callable
 from analysis import AnalysisOptions
 from rig.clock import MonotonicClock
 from rig.devices.protocols import Display
-from rig.devices.window import WindowSettings
+from rig.devices.window import WindowDisplay, WindowSettings
 from rig.errors import RigError
 from rig.live.measure import MeasureReport, analyse_run, write_report
 from rig.live.run import EXTERNAL, LiveConfig, run_live
@@ -79,9 +79,8 @@ def self_test(
     window_rect: list[tuple[int, int, int, int]] = [(*WINDOW_POSITION, *DISPLAY_SIZE)]
 
     def connected(display: Display) -> None:
-        window = getattr(display, "window", None)
-        if window is not None:
-            window_rect[0] = window.rect
+        if isinstance(display, WindowDisplay) and display.window is not None:  # the rig's renderer draws in it
+            window_rect[0] = display.window.rect
 
     emulator = EmulatedPendulum(name, duration_s + EMULATOR_MARGIN_S, clock)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -89,17 +88,17 @@ def self_test(
     try:
         twin = TwinSetup(camera_config, layout, PendulumConfig(), pendulum_end, 1.0 / REFRESH_HZ, out_dir, seed=1)
         camera = ScreenCamera(twin, lambda: emulator.start, lambda: window_rect[0])
-        result = run_live(config, out_dir, view=View(layout.world_to_clip, layout.sphere_radius_m),
-                          frame_clock=FixedRateFrameClock(REFRESH_HZ), camera=camera, clock=clock, overwrite=overwrite,
-                          progress=progress, on_connected=connected)  # fmt: skip
+        run = run_live(config, out_dir, view=View(layout.world_to_clip, layout.sphere_radius_m),
+                       frame_clock=FixedRateFrameClock(REFRESH_HZ), camera=camera, clock=clock, overwrite=overwrite,
+                       progress=progress, on_connected=connected)  # fmt: skip
     finally:
         if renderer is not None:
             renderer.terminate()
             renderer.wait(timeout=10)
         emulator.close()
-    film = result.summary["film"]
+    film = run["film"]
     options = AnalysisOptions(led_roi=layout.led_roi, sphere_roi=layout.sphere_roi)
-    report = analyse_run(out_dir, film["measured_fps"] if film else None, options, None, result.summary)
+    report = analyse_run(out_dir, film["measured_fps"] if film else None, options, None, run)
     if not report.invalid:
         report.run["self_test"] = _agreement(report)
         write_report(report)
