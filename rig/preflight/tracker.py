@@ -11,7 +11,7 @@ import numpy as np
 from rig.clock import Clock
 from rig.devices.protocols import TrackerSource
 from rig.devices.registry import make_tracker
-from rig.devices.trackers.stream import TrackerRecord, TrackerStream
+from rig.devices.trackers.stream import RecordSource, TrackerRecord
 from rig.errors import RigError
 from rig.preflight.rows import PASS, WARN, CheckRow, failed
 
@@ -55,7 +55,7 @@ class TrackerProbe:
 
     def _wait(self, timeout_s: float) -> list[TrackerRecord]:
         """The records that came within `timeout_s`, with the device's own time where the source has it."""
-        if isinstance(self._tracker, TrackerStream):
+        if isinstance(self._tracker, RecordSource):
             return self._tracker.wait_records(timeout_s)
         return [TrackerRecord.of_sample(sample) for sample in self._tracker.wait(timeout_s)]
 

@@ -23,7 +23,7 @@ from typing import Any, Callable
 from predictors import SAMPLE_COLUMNS
 from rig.clock import MonotonicClock
 from rig.devices.registry import make_tracker
-from rig.devices.trackers.stream import TrackerRecord, TrackerStream
+from rig.devices.trackers.stream import RecordSource, TrackerRecord
 from rig.errors import RigError
 from rig.writers import CsvRecord
 
@@ -44,7 +44,7 @@ class TrackerRecording:
 
 
 def _queued(tracker: Any) -> list[TrackerRecord]:
-    if isinstance(tracker, TrackerStream):
+    if isinstance(tracker, RecordSource):
         return tracker.poll_records()
     return [TrackerRecord.of_sample(sample) for sample in tracker.poll()]
 
@@ -101,7 +101,7 @@ def record_tracker(
             interrupted = False
         finally:
             tracker.close()
-            left = tracker.take_queued() if isinstance(tracker, TrackerStream) else []
+            left = tracker.take_queued() if isinstance(tracker, RecordSource) else []
             write(left)
             samples += len(left)
             sidecar = {

@@ -30,7 +30,7 @@ from dataclasses import asdict, dataclass
 from functools import partial
 from itertools import repeat
 from operator import sub
-from typing import Any, Callable, NamedTuple
+from typing import Any, Callable, NamedTuple, Protocol, runtime_checkable
 
 from predictors import PoseSample
 from rig.clock import Clock
@@ -87,6 +87,19 @@ class TrackerRecord(NamedTuple):
     def sample_row(self) -> tuple[float, ...]:
         """The sample's values in the trace format's order (`predictors.SAMPLE_COLUMNS`)."""
         return (self.t_sensor, self.t_arrival, *self.position, *self.orientation)
+
+
+@runtime_checkable
+class RecordSource(Protocol):
+    """A tracker source whose records hold what the device said beside the pose (`TrackerRecord`):
+    a recording writes them whole, and `rig check` reads the device's own clock from them. A
+    `TrackerStream` is one; any other source is recorded from its samples alone."""
+
+    def poll_records(self) -> list[TrackerRecord]: ...
+
+    def wait_records(self, timeout_s: float) -> list[TrackerRecord]: ...
+
+    def take_queued(self) -> list[TrackerRecord]: ...
 
 
 _record = partial(tuple.__new__, TrackerRecord)
