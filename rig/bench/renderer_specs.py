@@ -9,13 +9,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from declared import Range, check, like, setting
+from declared import Range, check, from_table, like, setting
 from rig.bench.renderer_estimate import estimated_hours
-from rig.bench.spec_reader import read_spec
 from rig.errors import ConfigError
 from rig.sim.camera_config import CameraConfig
 from rig.sim.config import MAX_HOURS
 from rig.sim.display_config import DisplayConfig
+from rig.toml_file import read_toml
 
 if TYPE_CHECKING:
     from rig.bench.renderer_latency import LatencyRun
@@ -95,9 +95,10 @@ class BenchGrid:
 
 
 def read_grid(path: Path | None) -> BenchGrid:
-    """The grid a TOML spec sets (`rig.bench.spec_reader`: every key and value checked), the
-    defaults where it is silent; with no spec, the defaults."""
-    return read_spec(BenchGrid, path) if path is not None else BenchGrid()
+    """The grid a TOML spec sets (`declared.from_table`: every key and value checked, a typo or a
+    wrong type one line naming the file and the key), the defaults where it is silent; with no
+    spec, the defaults."""
+    return from_table(BenchGrid, read_toml(path, "spec"), ConfigError, str(path)) if path is not None else BenchGrid()
 
 
 @dataclass(frozen=True)

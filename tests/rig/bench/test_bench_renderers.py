@@ -17,13 +17,12 @@ from rig.bench.renderer_setup import scene_setup
 from rig.bench.renderer_specs import QUICK_SPEC, BenchGrid, read_grid
 from rig.bench.renderers import LATENCY_FIELDS, ROW_FIELDS
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
-from rig.bench.spec_reader import read_spec
 from rig.cli import EXIT_USER_ERROR, main
 from rig.commands import bench
 from rig.service.sweep import read_sweep
 from rig.sim.camera import CameraConfig
 
-QUICK_GRID = read_spec(BenchGrid, QUICK_SPEC)
+QUICK_GRID = read_grid(QUICK_SPEC)
 
 
 def _grid(args: argparse.Namespace) -> BenchGrid:
