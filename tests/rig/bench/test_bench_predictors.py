@@ -56,24 +56,27 @@ def test_ratios_are_errors_over_constant_velocity_and_their_geometric_mean():
     traces = [head_motion(3.0, 60.0, seed=s).with_noise(0.001, math.radians(0.2), seed=s) for s in (1, 2)]
     traces = [Trace.from_samples(f"head{k}", tr.t, tr.position, tr.orientation) for k, tr in enumerate(traces)]
     results = bench.evaluate_all(traces, [("slerp", {}), ("hold", {})], [20.0, 50.0], timing_repeats=1)
-    ratios = {entry.predictor: entry for entry in predictor_scores.ratios(results, [20.0, 50.0])}
+    record = predictor_scores.ratios_record(predictor_scores.scores_of(results, [20.0, 50.0]))
+    ratios = {entry["predictor"]: entry for entry in record}
     by = {(r.trace, r.predictor): r for r in results}
     for trace in ("head0", "head1"):
         expected = by[(trace, "hold")].at(50.0).angular_rms_deg / by[(trace, "slerp")].at(50.0).angular_rms_deg
-        assert ratios["hold"].angular[trace][50.0] == pytest.approx(expected)
-        assert ratios["slerp"].angular[trace][50.0] == 1.0
-    hold = ratios["hold"]
-    assert hold.geometric_mean("angular", 50.0) == pytest.approx(math.sqrt(hold.angular["head0"][50.0] * hold.angular["head1"][50.0]))
-    assert hold.worst("angular", 50.0) == max(hold.angular["head0"][50.0], hold.angular["head1"][50.0])
+        assert ratios["hold"]["angular"][trace]["50"] == pytest.approx(expected)
+        assert ratios["slerp"]["angular"][trace]["50"] == 1.0
+        assert ratios["hold"]["us_per_update"][trace] == by[(trace, "hold")].us_per_update
+    hold = ratios["hold"]["angular"]
+    geometric_mean = math.sqrt(hold["head0"]["50"] * hold["head1"]["50"])
+    assert ratios["hold"]["geometric_mean"]["angular"]["50"] == pytest.approx(geometric_mean)
+    assert ratios["hold"]["worst"]["angular"]["50"] == max(hold["head0"]["50"], hold["head1"]["50"])
 
 
 def test_a_trace_without_position_has_no_position_ratio():
     trace = head_motion(2.0, 60.0, seed=3)
     still = Trace.from_samples("still", trace.t, np.zeros((len(trace), 3)), trace.orientation)
     results = bench.evaluate_all([still], [("slerp", {}), ("adaptive", {})], [50.0], timing_repeats=0)
-    entry = predictor_scores.ratios(results, [50.0])[1]
-    assert math.isnan(entry.position["still"][50.0]) and math.isnan(entry.geometric_mean("position", 50.0))
-    assert entry.to_dict([50.0])["position"]["still"]["50"] is None
+    entry = predictor_scores.ratios_record(predictor_scores.scores_of(results, [50.0]))[1]
+    assert entry["position"]["still"]["50"] is None and entry["geometric_mean"]["position"]["50"] is None
+    assert entry["angular"]["still"]["50"] > 0.0
 
 
 @pytest.mark.slow
