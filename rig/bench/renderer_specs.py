@@ -7,23 +7,30 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from declared import Range, check, from_table, like, setting
 from rig.bench.renderer_estimate import estimated_hours
 from rig.errors import ConfigError
 from rig.sim.camera_config import CameraConfig
-from rig.sim.config import MAX_HOURS
+from rig.sim.config import MAX_HOURS, SimulationConfig
 from rig.sim.display_config import DisplayConfig
 from rig.toml_file import read_toml
-
-if TYPE_CHECKING:
-    from rig.bench.renderer_latency import LatencyRun
 
 QUICK_SPEC = Path(__file__).parent / "specs" / "renderers-quick.toml"
 
 TRIANGLES = Range(0.0, 1e8, True, True)
 """A load's triangles: a heavy VR scene draws a few million a frame, 100 million is past any GPU's budget."""
+
+
+@dataclass(frozen=True)
+class LatencyRun:
+    """One filmed run: what it is, as a simulation (`config`: renderer, load, display, predictor,
+    photon target, camera, and the costs modelled, None where measured), its shortest film and its
+    longest pendulum period (how it is filmed is `rig.bench.renderer_latency.film_config`'s)."""
+
+    config: SimulationConfig
+    min_duration_s: float = 6.0
+    max_period_s: float = 8.0
 
 
 @dataclass(frozen=True)
@@ -85,13 +92,13 @@ class BenchGrid:
     ) -> LatencyRun:
         """The filmed run of `renderer` on `triangles` (shaped as `load` says) at the first
         resolution, costs measured (the server's modelled if `server_ms` says)."""
-        from rig.bench.renderer_latency import LatencyRun  # the simulation's libraries: only when a bench runs
-
-        return LatencyRun(
-            renderer, triangles, self.resolutions[0], predictor, server_ms=self.server_ms, photon_target=photon_target,
-            refresh_hz=self.refresh_hz, camera=self.latency_camera, min_duration_s=self.latency_duration_s,
-            max_period_s=self.max_period_s, load=load,
+        width, height = self.resolutions[0]
+        config = SimulationConfig(
+            display=DisplayConfig(refresh_hz=self.refresh_hz, width=width, height=height), renderer=renderer, predictor=predictor,
+            scene_triangles=triangles, scene_load=load, app_frame_ms=None, warp_ms=self.server_ms, photon_target=photon_target,
+            camera=self.latency_camera,
         )  # fmt: skip
+        return LatencyRun(config, self.latency_duration_s, self.max_period_s)
 
 
 def read_grid(path: Path | None) -> BenchGrid:

@@ -329,7 +329,7 @@ def test_a_warp_variant_that_cannot_be_opened_is_a_failed_row_beside_the_others(
         return opened(variant, *args)
 
     monkeypatch.setattr(warp_variants, "open_warp", two_views_refused)
-    monkeypatch.setattr(warp_variants, "film_latency", lambda run, *_: renderer_latency.failed_figures(renderer_latency.run_config(run), "not filmed here"))
+    monkeypatch.setattr(warp_variants, "film_latency", lambda run, *_: renderer_latency.failed_figures(run.config, "not filmed here"))
     out, plot = tmp_path / "variants.json", tmp_path / "variants.png"
     code, printed, err = run_rig(["bench", "renderers", "--quick", "--variants", "--json", str(out), "--plot", str(plot)], capsys)
     _assert_exits_2_saying(code, err, "every one of the 2 rows failed")

@@ -214,7 +214,7 @@ def test_the_seed_table_probes_and_films_the_load_and_warp_it_is_given_and_says_
         return scene_setup(*args)
 
     def film(run, *args):
-        filmed.append((run.renderer, run.load))
+        filmed.append((run.config.renderer, run.config.scene_load))
         return film_latency(run, *args)
 
     monkeypatch.setattr(seed_table, "scene_setup", probe)
