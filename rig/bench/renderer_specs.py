@@ -9,7 +9,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from declared import Range, check, from_table, like, setting
-from rig.bench.renderer_estimate import estimated_hours
 from rig.errors import ConfigError
 from rig.sim.camera_config import CameraConfig
 from rig.sim.config import MAX_HOURS, SimulationConfig
@@ -20,6 +19,12 @@ QUICK_SPEC = Path(__file__).parent / "specs" / "renderers-quick.toml"
 
 TRIANGLES = Range(0.0, 1e8, True, True)
 """A load's triangles: a heavy VR scene draws a few million a frame, 100 million is past any GPU's budget."""
+TRIANGLES_PER_S = 1e9
+"""Triangles a second the fastest GPU draws in small random triangles."""
+PIXELS_PER_S = 1e10
+"""Pixels a second the fastest GPU warps and reads back."""
+FILMED_RENDERERS = 2
+"""Each filmed load is filmed through the direct and the warp renderer."""
 
 
 @dataclass(frozen=True)
@@ -83,9 +88,30 @@ class BenchGrid:
             raise ConfigError("a renderer bench grid needs at least one load size, resolution and rate ratio")
         if min(min(size) for size in self.resolutions) < 16:
             raise ConfigError(f"a display is at least 16x16 pixels, got {self.resolutions}")
-        if (hours := estimated_hours(self)) > MAX_HOURS:
+        if (hours := self.estimated_hours()) > MAX_HOURS:
             raise ConfigError(f"this grid would take about {hours:.3g} hours at the least, more than the {MAX_HOURS:g} hours the rig "
                               "starts: fewer or smaller loads, resolutions, phases or warp rounds, or split it into grids of its own")  # fmt: skip
+
+    def estimated_hours(self) -> float:
+        """The least time the grid takes, in hours, so that a grid that cannot finish is refused with
+        its estimate before any frame is drawn. The figures are generous on purpose (the fastest
+        GPUs' rates): the estimate is a floor, so only a grid that no machine finishes within
+        `rig.sim.config.MAX_HOURS` is refused. Each load at each resolution is drawn for its direct
+        frames (at most the direct budget of time), its client frames and warps for the image error
+        (`phases` poses, each warped at every ratio), and its warp rounds; each latency film renders
+        its load at the display's refresh for at least its duration."""
+        seconds = 0.0
+        for width, height in self.resolutions:
+            for triangles in self.triangles:
+                frame_s = triangles / TRIANGLES_PER_S
+                direct_s = min(self.direct_budget_s, self.direct_frames * frame_s)
+                image_error_s = self.phases * (frame_s + len(self.ratios) * width * height / PIXELS_PER_S)
+                rounds_s = self.warp_rounds * (frame_s + width * height / PIXELS_PER_S)
+                seconds += direct_s + image_error_s + rounds_s
+        filmed = self.latency_triangles if self.latency_triangles is not None else self.triangles
+        film_frames = self.latency_duration_s * self.refresh_hz
+        seconds += FILMED_RENDERERS * sum(film_frames * triangles / TRIANGLES_PER_S for triangles in filmed)
+        return seconds / 3600.0
 
     def latency_run(
         self, renderer: str, triangles: int, predictor: str, photon_target: str = "photons", load: str = "soup"

@@ -19,6 +19,7 @@ from rig.bench.renderers import LATENCY_FIELDS, ROW_FIELDS
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
 from rig.cli import EXIT_USER_ERROR, main
 from rig.commands import bench
+from rig.errors import ConfigError
 from rig.service.sweep import read_sweep
 from rig.sim.camera import CameraConfig
 
@@ -180,6 +181,12 @@ def test_bad_grid_options_are_rejected(capsys: pytest.CaptureFixture[str]):
         with pytest.raises(SystemExit):
             bench_parser().parse_args(["bench", "renderers", *bad])
     assert "error" in capsys.readouterr().err
+
+
+def test_a_grid_no_machine_could_finish_in_a_day_is_refused_with_its_estimate():
+    assert read_grid(QUICK_SPEC).estimated_hours() < 1e-3
+    with pytest.raises(ConfigError, match=r"this grid would take about 2\d\d hours at the least, more than the 24 hours"):
+        BenchGrid(triangles=(100_000_000,), latency_duration_s=3600.0, refresh_hz=1000.0)
 
 
 def run_quick(out, mode: str, *extra: str) -> tuple[list[dict], str]:
