@@ -18,9 +18,10 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from predictors import make as make_predictor
+from rig.bench.contract import Context
 from rig.bench.renderer_specs import LatencyRun
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import USER_ERRORS
@@ -165,19 +166,14 @@ def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: 
     return film_row(point)["film"]
 
 
-def film_latencies(
-    films: list[Film],
-    runs_dir: Path,
-    comment: str,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    progress: Callable[[float, float], object] | None = None,
-) -> list[dict[str, Any]]:
+def film_latencies(films: list[Film], comment: str, context: Context) -> list[dict[str, Any]]:
     """Each film's figures, in order. A film beyond range is not filmed (its note says why); the
     others are a sweep of explicit points with their labels, analysed within the simulation's
-    regions, written to runs_dir/FILMS_SPEC under `comment` and run by `rig.service.sweep` with
-    `film_row` into runs_dir (pointNNN, summary.csv and .json; on `rig.executor`'s workers when
-    asked), so that `rig sweep` on that file films exactly them again."""
+    regions, written to the context's folder as FILMS_SPEC under `comment` and run by
+    `rig.service.sweep` with `film_row` into that folder (pointNNN, summary.csv and .json; on the
+    context's executor, with its progress bar), so that `rig sweep` on that file films exactly
+    them again."""
+    progress = context.progress("filming the latency films")
     figures = [beyond_range_figures(run, app_s, server_s) for _, run, app_s, server_s in films]
     points = [
         {"labels": labels, **settings_of(film_config(run, app_s, server_s))}
@@ -187,7 +183,8 @@ def film_latencies(
     if not points:
         return figures
     sweep = Sweep({}, {}, {SIMULATED_ROIS: True}, points)
-    write_sweep(sweep, runs_dir / FILMS_SPEC, comment)
-    rows, _ = run_sweep(sweep, runs_dir, workers, scheduler, progress, overwrite=True, job=film_row)
+    folder = context.folder
+    write_sweep(sweep, folder / FILMS_SPEC, comment)
+    rows, _ = run_sweep(sweep, folder, context.workers, context.scheduler, progress, overwrite=True, job=film_row)
     filmed = iter(row["film"] for row in rows)
     return [next(filmed) if unfilmed is None else unfilmed for unfilmed in figures]
