@@ -37,7 +37,7 @@ from analysis import AnalysisOptions
 from analysis.sampling.model import commensurate
 from analysis.video.sources import open_frames
 from rig.bench.analyser_settings import GROUPS
-from rig.bench.contract import Bench, Context, Log, cell
+from rig.bench.contract import Bench, Context, Log, cell, new_figure
 from rig.service.batch import USER_ERRORS
 from rig.service.sweep import Sweep, SweepPoint, read_sweep, run_sweep, simulate_and_analyse, unsimulated_row
 from rig.sim.config import SimulationConfig
@@ -265,10 +265,7 @@ def table(summary: dict[str, dict[str, Any]]) -> str:
 
 def plot(summary: dict[str, dict[str, Any]], rows: list[dict[str, Any]], path: Path) -> None:
     """Speed against error, per method: every case faint, the method's median and worst bold."""
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(8, 5.5))
-    axes = figure.subplots()
+    figure, axes = new_figure((8, 5.5))
     for index, (name, s) in enumerate(summary.items()):
         colour = f"C{index}"
         clear = [row for row in rows if not row.get("refused") and not row["ambiguous"]]

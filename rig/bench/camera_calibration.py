@@ -24,7 +24,7 @@ import numpy as np
 from analysis import AnalysisError
 from analysis.shutter import ShutterOptions, measure_shutter, suggest_flash_hz
 from analysis.shutter.fit import largest_gap
-from rig.bench.contract import Bench, Context
+from rig.bench.contract import Bench, Context, new_figure
 from rig.service import SimulationConfig, simulate
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -190,11 +190,8 @@ def table(report: dict[str, Any]) -> str:
 
 def plot(report: dict[str, Any], path: Path) -> None:
     """Seconds to measure each film against its readout's and its exposure's error, by source."""
-    from matplotlib.figure import Figure
-
     found = report["rows"]
-    figure = Figure(figsize=(10, 4.5))
-    axes = figure.subplots(1, 2, sharey=True)
+    figure, axes = new_figure((10, 4.5), nrows=1, ncols=2, sharey=True)
     for source in dict.fromkeys(row["source"] for row in found):
         answered = [row for row in found if row["source"] == source and row["refused"] is None]
         rolling = [row for row in answered if row["readout_error_pct"] is not None]

@@ -111,6 +111,14 @@ class Command:
     """what runs on --workers or --scheduler; None: no such options"""
 
 
+def new_figure(size: tuple[float, float], **subplots: Any) -> tuple[Any, Any]:
+    """A matplotlib figure of `size` inches and its axes (`Figure.subplots(**subplots)`)."""
+    from matplotlib.figure import Figure  # loaded where a bench plots, never by its help
+
+    figure = Figure(figsize=size)
+    return figure, figure.subplots(**subplots)
+
+
 def cell(value: float | None, spec: str = ".1f") -> str:
     """A table's cell: the number formatted by `spec`, or "-" where there is none."""
     return "-" if value is None else format(value, spec)

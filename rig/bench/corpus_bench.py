@@ -24,7 +24,7 @@ from predictors import DEFAULT, names, resolve
 from predictors.registry import params_of
 from predictors.corpus import GROUPINGS, Recording, read_corpus
 from predictors.cross_validation import REPORTED, CorpusScores, Fold, cross_validate, groups_of, held_out_mean
-from rig.bench.contract import Context
+from rig.bench.contract import Context, new_figure
 from rig.bench.predictor_scores import by_horizon, evaluate_all, scores_of
 from rig.bench.predictors_settings import BASELINE
 from rig.service.tune import check_scorable, in_time_order
@@ -197,10 +197,7 @@ def plot(found: CorpusRun, path: Path) -> None:
     """Left: each candidate's geometric mean over people of angular RMS / constant velocity at the
     plot horizon against its cost over kalman-cv's. Right: per person held out, the chosen
     candidate's angular ratio at each horizon (or, without folds, the default's)."""
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(13.0, 5.0))
-    left, right = figure.subplots(1, 2)
+    figure, (left, right) = new_figure((13.0, 5.0), nrows=1, ncols=2)
     scores, groups, h = found.scores, found.groups("person"), found.plot_horizon_ms
     ratios = {c: scores.corpus_ratio(c, groups, "angular", h) for c in scores.candidates}
     shown = {c: r for c, r in ratios.items() if r <= _PLOTTED_ABOVE_BASELINE}

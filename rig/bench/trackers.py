@@ -47,7 +47,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from rig.bench.contract import Bench, Context, Log
+from rig.bench.contract import Bench, Context, Log, new_figure
 from rig.clock import MonotonicClock
 from rig.devices.trackers.decoders import BinaryDecoder
 from rig.devices.trackers.profile import load_profile
@@ -339,13 +339,10 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 def plot(rows: list[dict[str, Any]], path: Path) -> None:
     """CPU per sample and added latency (median and 95th percentile) per case that ran."""
-    from matplotlib.figure import Figure
-
     rows = [r for r in rows if r["failed"] is None]
     labels = ["\n".join([f"{r['source']}/{r['transport']}", *r["faults"].split(",")]) for r in rows]
     x = np.arange(len(rows))
-    figure = Figure(figsize=(max(6.0, 1.6 * len(rows)) + 2.5, 7.0))
-    cost, latency = figure.subplots(2, 1, sharex=True)
+    figure, (cost, latency) = new_figure((max(6.0, 1.6 * len(rows)) + 2.5, 7.0), nrows=2, ncols=1, sharex=True)
     cost.bar(x - 0.2, [r["reading_us_per_sample"] for r in rows], width=0.4, color="tab:blue", label="reading")
     cost.bar(x + 0.2, [r["us_per_sample"] for r in rows], width=0.4, color="tab:gray", label="whole recording process")
     cost.plot(x, [r["wake_floor_us"] for r in rows], "o", color="tab:red", label="bare thread woken per record")
