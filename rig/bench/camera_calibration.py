@@ -24,7 +24,7 @@ import numpy as np
 from analysis import AnalysisError
 from analysis.shutter import ShutterOptions, measure_shutter, suggest_flash_hz
 from analysis.shutter.fit import largest_gap
-from rig.bench.contract import Bench, Context, new_figure
+from rig.bench.contract import Bench, Context, cell, new_figure
 from rig.service import SimulationConfig, simulate
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -173,17 +173,13 @@ def targets_met(found: list[dict[str, Any]]) -> dict[str, bool]:
 def table(report: dict[str, Any]) -> str:
     """The summaries of the report's rows as a text table."""
     summaries = summary(report["rows"])
-
-    def number(value: float | None, digits: int = 2) -> str:
-        return "-" if value is None else f"{value:.{digits}f}"
-
     lines = [f"{'source':<9} {'cases':>5} {'refused':>7} {'readout err % med/max':>22} {'exposure err % med/max':>23} {'within':>6} {'covered':>7} {'s/film':>6}"]
     for name, s in summaries.items():
         lines.append(
             f"{name:<9} {s['cases']:>5} {s['refused']:>7} "
-            f"{number(s['readout_error_pct_median']) + ' / ' + number(s['readout_error_pct_max']):>22} "
-            f"{number(s['exposure_error_pct_median']) + ' / ' + number(s['exposure_error_pct_max']):>23} "
-            f"{s['within_targets']:>6} {s['covered']:>7} {number(s['estimate_s_median'], 1):>6}"
+            f"{cell(s['readout_error_pct_median'], '.2f') + ' / ' + cell(s['readout_error_pct_max'], '.2f'):>22} "
+            f"{cell(s['exposure_error_pct_median'], '.2f') + ' / ' + cell(s['exposure_error_pct_max'], '.2f'):>23} "
+            f"{s['within_targets']:>6} {s['covered']:>7} {cell(s['estimate_s_median']):>6}"
         )
     return "\n".join(lines)
 
