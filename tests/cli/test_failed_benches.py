@@ -46,7 +46,7 @@ def test_a_tracker_bench_whose_every_emulator_failed_writes_its_rows_and_exits_2
 
 def test_a_tracker_case_that_failed_is_a_row_beside_those_that_ran() -> None:
     ran = {"failed": None, "recorded": 10}
-    failed = trackers.failed_case(trackers.cases(1.0)[0], 1000.0, 2.0, RigError("no pty"))
+    failed = trackers.case_fields(trackers.cases(1.0)[0], 1000.0, 2.0, "no pty")
     assert trackers.every_case_failed([failed, ran]) is None
     assert trackers.every_case_failed([failed, {"failed": None, "recorded": 0}]) is not None
     assert {name for name, met in trackers.targets([failed]).items() if met is not None} == {"every case ran"}
