@@ -42,4 +42,3 @@ SUBJECT = Command(
     runs="keep the simulated videos and the sweep's summary.csv here (default: a temporary folder)",
     executor="the grid",
 )  # fmt: skip
-MODES: tuple[Command, ...] = ()

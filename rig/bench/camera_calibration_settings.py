@@ -30,4 +30,3 @@ SUBJECT = Command(
     outputs={"json": "write the summaries and every film's row as JSON", "plot": "plot seconds per film against each error"},
     runs="keep the simulated films here (default: a temporary folder)",
 )
-MODES: tuple[Command, ...] = ()

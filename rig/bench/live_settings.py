@@ -27,4 +27,3 @@ SUBJECT = Command(
     outputs={"json": "write the figures as JSON", "plot": "plot the figures"},
     runs="keep the run's files here (default: a temporary folder)",
 )
-MODES: tuple[Command, ...] = ()

@@ -85,4 +85,3 @@ SUBJECT = Command(
     description=__doc__.split("\n\n")[0],
     outputs={"json": "write every score, ratio and held-out result as JSON", "plot": "draw speed against error"},
 )
-MODES: tuple[Command, ...] = ()

@@ -42,4 +42,3 @@ SUBJECT = Command(
     outputs={"json": "write the rows as a JSON list", "plot": "plot CPU per sample and latency per case"},
     runs="keep the recordings and emulator logs here (default: a temporary folder)",
 )
-MODES: tuple[Command, ...] = ()

@@ -106,4 +106,4 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     benchmarks = parser.add_subparsers(dest="bench", required=True, metavar="SUBJECT")
     for module in SUBJECTS:
         declared = importlib.import_module(f"rig.bench.{module}")
-        add_subject(benchmarks, declared.SUBJECT, declared.MODES)
+        add_subject(benchmarks, declared.SUBJECT, getattr(declared, "MODES", ()))
