@@ -24,7 +24,7 @@ import numpy as np
 from analysis import AnalysisError
 from analysis.shutter import ShutterOptions, measure_shutter, suggest_flash_hz
 from analysis.shutter.fit import largest_gap
-from rig.bench.contract import Bench, Context, cell, new_figure
+from rig.bench.contract import Bench, Context, cell, every_one, new_figure
 from rig.service import SimulationConfig, simulate
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -221,16 +221,10 @@ def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
     return {"rows": found, "seconds": time.perf_counter() - started}
 
 
-def every_film_refused(found: list[dict[str, Any]]) -> str | None:
-    """Where the estimate refused every film: how many, and the first refusal."""
-    if not found or any(row["refused"] is None for row in found):
-        return None
-    return f"the estimate refused every one of the {len(found)} films (the first: {found[0]['refused']})"
-
-
 BENCH = Bench(
     run=run, table=table, plot=plot,
-    targets=lambda report: targets_met(report["rows"]), all_failed=lambda report: every_film_refused(report["rows"]),
+    targets=lambda report: targets_met(report["rows"]),
+    all_failed=lambda report: every_one(report["rows"], "refused", "the estimate refused every one of the {count} films"),
     notes=lambda report: f"{len(report['rows'])} films in {report['seconds'] / 60:.1f} minutes",
     record=lambda report: {"summary": summary(report["rows"]), "targets_met": targets_met(report["rows"]), **report},
 )

@@ -111,6 +111,14 @@ class Command:
     """what runs on --workers or --scheduler; None: no such options"""
 
 
+def every_one(items: list[dict[str, Any]], reason: str, sentence: str) -> str | None:
+    """Where every one of `items` has a `reason` (not None: every case failed, or was refused), `sentence`
+    (its {count}, how many) with the first one's; else None: `rig bench` then exits with status 2."""
+    if not items or any(item[reason] is None for item in items):
+        return None
+    return f"{sentence.format(count=len(items))} (the first: {items[0][reason]})"
+
+
 def new_figure(size: tuple[float, float], **subplots: Any) -> tuple[Any, Any]:
     """A matplotlib figure of `size` inches and its axes (`Figure.subplots(**subplots)`)."""
     from matplotlib.figure import Figure  # loaded where a bench plots, never by its help

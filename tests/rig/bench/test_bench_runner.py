@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 
 from rig.bench import SUBJECTS
-from rig.bench.contract import Bench, Command, Context, SpecFile
+from rig.bench.contract import Bench, Command, Context, SpecFile, every_one
 from rig.commands import bench as runner
 from rig.errors import RigError
 
@@ -155,3 +155,10 @@ def test_every_subject_and_mode_loads_a_bench_that_keeps_the_contract(module: st
     for command in (declared.SUBJECT, *getattr(declared, "MODES", ())):
         assert isinstance(command.bench(), Bench)
     assert (declared.SUBJECT.bench().read_spec is not None) == (declared.SUBJECT.spec_file is not None)
+
+
+def test_every_one_says_so_only_where_every_item_has_a_reason():
+    refused = [{"refused": "too dark"}, {"refused": "no swing"}]
+    assert every_one(refused, "refused", "refused every one of the {count} films") == "refused every one of the 2 films (the first: too dark)"
+    assert every_one([*refused, {"refused": None}], "refused", "{count}") is None
+    assert every_one([], "refused", "{count}") is None
