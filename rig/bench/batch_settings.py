@@ -60,6 +60,5 @@ SUBJECT = Command(
     help="what many measurements cost: a batch serially and on Dask, and the fixed cost per video",
     bench=bench_in("batch"),
     options=partial(add_declared_options, kind=BatchBenchOptions),
-    description=__doc__.split("\n\n")[0],
     outputs={"json": "write the figures as JSON", "plot": "draw the wall times"},
 )

@@ -91,8 +91,9 @@ def bench_in(module: str) -> Callable[[], Bench]:
 
 @dataclass(frozen=True)
 class Command:
-    """What the command line shows of one benchmark, declared without importing what it runs. The
-    fields from `description` on are a subject's; a mode leaves them out and has its subject's."""
+    """What the command line shows of one benchmark, declared without importing what it runs (a
+    subject's description is its declaring module's first paragraph). The fields from `outputs` on
+    are a subject's; a mode leaves them out and has its subject's."""
 
     name: str
     """the subject (`rig bench NAME`), or a mode's flag (`--NAME`)"""
@@ -101,7 +102,6 @@ class Command:
     """loads the bench (`bench_in`)"""
     options: Callable[[argparse.ArgumentParser], object] = lambda parser: None
     """adds the bench's own options (a mode's join its subject's)"""
-    description: str = ""
     outputs: dict[str, str] = field(default_factory=dict)
     """the help of each output it writes, by kind: json, plot, csv"""
     spec_file: SpecFile | None = None
