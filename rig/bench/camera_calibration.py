@@ -17,7 +17,7 @@ import statistics
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -57,17 +57,6 @@ class CalibrationGrid:
 
 
 QUICK_GRID = CalibrationGrid(fps=(60.0, 240.0), readout_shares=(0.6,), exposure_shares=(0.5,), sources=("light", "display"), width=160, height=120)
-
-
-def rows(grid: CalibrationGrid, folder: Path, log: Callable[[str], object] = lambda _: None) -> list[dict[str, Any]]:
-    """One row per case of the grid (see the module), each filmed in its own folder in `folder`."""
-    cases = list(itertools.product(grid.fps, grid.readout_shares, grid.exposure_shares, grid.sources))
-    found = []
-    for index, (fps, readout_share, exposure_share, source) in enumerate(cases):
-        row = case_row(grid, fps, readout_share / fps, exposure_share / fps, source, grid.seed + index, folder / f"case{index:03d}")
-        log(f"[{index + 1}/{len(cases)}] {_case_text(row)}")
-        found.append(row)
-    return found
 
 
 def case_row(grid: CalibrationGrid, fps: float, readout_s: float, exposure_s: float, source: str, seed: int, folder: Path) -> dict[str, Any]:
@@ -215,9 +204,17 @@ def _case_text(row: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
-    """Every film of the grid (the quick one with --quick), and how long they took."""
+    """One row per case of the grid (the quick one with --quick; see the module), each filmed in its
+    own folder in the context's, and how long they took."""
     started = time.perf_counter()
-    found = rows(QUICK_GRID if args.quick else CalibrationGrid(), context.folder, context.log)
+    grid = QUICK_GRID if args.quick else CalibrationGrid()
+    cases = list(itertools.product(grid.fps, grid.readout_shares, grid.exposure_shares, grid.sources))
+    found = []
+    for index, (fps, readout_share, exposure_share, source) in enumerate(cases):
+        folder = context.folder / f"case{index:03d}"
+        row = case_row(grid, fps, readout_share / fps, exposure_share / fps, source, grid.seed + index, folder)
+        context.log(f"[{index + 1}/{len(cases)}] {_case_text(row)}")
+        found.append(row)
     return {"rows": found, "seconds": time.perf_counter() - started}
 
 
