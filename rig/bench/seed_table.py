@@ -26,7 +26,6 @@ import argparse
 import math
 import time
 from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -214,12 +213,9 @@ def spec(args: argparse.Namespace) -> SeedTableSpec:
     return replace(chosen, grid=with_options(chosen.grid, args), **given(args, "max_frame_s", "max_triangles", "load"))
 
 
-def _plot(rows: list[dict[str, Any]], path: Path) -> None:
-    renderer_plots.plot_seed_table(rows, seed_rows(), path, run_label(rows))
-
-
 BENCH = Bench(
     spec=spec, run=run, table=seed_table_text,
     record=lambda rows: plain(rows + seed_rows()),
-    plot=_plot, all_failed=every_row_failed,
+    plot=lambda rows, path: renderer_plots.plot_seed_table(rows, seed_rows(), path, run_label(rows)),
+    all_failed=every_row_failed,
 )
