@@ -1,7 +1,8 @@
 """Benchmarks behind `rig bench`: speed against error, one module per bench (`rig.bench.contract`).
 
 SUBJECTS registers them: per subject, the light module that declares its command (`SUBJECT`, and
-`MODES` where it has modes); each bench's own module is imported only when it runs."""
+`MODES` where it has modes; its docstring's first paragraph is the command's description); each
+bench's own module is imported only when it runs."""
 
 SUBJECTS = (
     "analyser_settings",

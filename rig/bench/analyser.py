@@ -37,7 +37,7 @@ from analysis import AnalysisOptions
 from analysis.sampling.model import commensurate
 from analysis.video.sources import open_frames
 from rig.bench.analyser_settings import GROUPS
-from rig.bench.contract import Bench, Context, Log, cell
+from rig.bench.contract import Bench, Context, Log, cell, every_one, new_figure
 from rig.service.batch import USER_ERRORS
 from rig.service.sweep import Sweep, SweepPoint, read_sweep, run_sweep, simulate_and_analyse, unsimulated_row
 from rig.sim.config import SimulationConfig
@@ -265,10 +265,7 @@ def table(summary: dict[str, dict[str, Any]]) -> str:
 
 def plot(summary: dict[str, dict[str, Any]], rows: list[dict[str, Any]], path: Path) -> None:
     """Speed against error, per method: every case faint, the method's median and worst bold."""
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(8, 5.5))
-    axes = figure.subplots()
+    figure, axes = new_figure((8, 5.5))
     for index, (name, s) in enumerate(summary.items()):
         colour = f"C{index}"
         clear = [row for row in rows if not row.get("refused") and not row["ambiguous"]]
@@ -323,13 +320,6 @@ def run(sweep: Sweep, context: Context) -> dict[str, Any]:
             "sweep": rows, "seconds": time.perf_counter() - started}  # fmt: skip
 
 
-def every_case_refused(cases: list[dict[str, Any]]) -> str | None:
-    """Where the analyser refused every case: how many, and the first refusal."""
-    if not cases or any(case["refused"] is None for case in cases):
-        return None
-    return f"the analyser refused every one of the {len(cases)} cases (the first: {cases[0]['refused']})"
-
-
 def tables(report: dict[str, Any]) -> str:
     """Each group's summary as a table under its name and count."""
     return "\n".join(f"{group} ({summary['sinefit']['cases']} cases):\n{table(summary)}" for group, summary in report["summaries"].items())
@@ -339,7 +329,7 @@ BENCH = Bench(
     spec=lambda args: of_groups(args.spec, args.grid), read_spec=read_sweep,
     run=run, table=tables,
     targets=lambda report: report["targets_met"],
-    all_failed=lambda report: every_case_refused(report["cases"]),
+    all_failed=lambda report: every_one(report["cases"], "refused", "the analyser refused every one of the {count} cases"),
     notes=lambda report: f"{len(report['cases'])} cases in {report['seconds'] / 60:.1f} minutes",
     plot=lambda report, path: plot(report["summary"], report["cases"], path),
 )  # fmt: skip

@@ -34,7 +34,6 @@ SUBJECT = Command(
     help="error, interval coverage, confidently wrong answers and speed of each latency estimator on simulated videos",
     bench=bench_in("analyser"),
     options=_options,
-    description=__doc__.split("\n\n")[0],
     outputs={"json": "write the summaries, every case and the sweep's rows as JSON", "plot": "plot speed against error per method"},
     spec_file=SpecFile(SPEC, QUICK_SPEC,
                        help="the cases, as a sweep whose points are labelled case, group (mixed, named or hard) and impairment "
@@ -42,4 +41,3 @@ SUBJECT = Command(
     runs="keep the simulated videos and the sweep's summary.csv here (default: a temporary folder)",
     executor="the grid",
 )  # fmt: skip
-MODES: tuple[Command, ...] = ()

@@ -115,8 +115,10 @@ def scale_out(paths: list[Path], workers: int, rounds: int, log: Log) -> dict[st
     }
 
 
-def fixed_cost(clip: Path, log: Log) -> dict[str, Any]:
-    """`rig analyse` in a fresh process against decoding alone, with an empty then a filled cache."""
+def clip_cost(folder: Path, duration_s: float, log: Log) -> dict[str, Any]:
+    """A clip simulated into `folder`, then `rig analyse` of it in a fresh process against decoding
+    it alone, with an empty then a filled cache."""
+    clip = simulate(replace(SimulationConfig(duration_s=duration_s), seed=99), folder, overwrite=True).video_path
     rig = str(Path(sys.executable).with_name("rig"))
     with tempfile.TemporaryDirectory(prefix="rig-bench-cache-") as cache:
         environment = {**os.environ, "JAX_COMPILATION_CACHE_DIR": cache}
@@ -132,12 +134,6 @@ def fixed_cost(clip: Path, log: Log) -> dict[str, Any]:
         "ratio_cold": cold / decode,
         "ratio_warm": warm / decode,
     }
-
-
-def clip_cost(folder: Path, duration_s: float, log: Log) -> dict[str, Any]:
-    """A clip simulated into `folder`, then its fixed cost (`fixed_cost`)."""
-    clip = simulate(replace(SimulationConfig(duration_s=duration_s), seed=99), folder, overwrite=True).video_path
-    return fixed_cost(clip, log)
 
 
 def run(spec: BatchBenchOptions, context: Context) -> dict[str, Any]:

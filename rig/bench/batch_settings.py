@@ -5,8 +5,8 @@ Declared here, without the bench's libraries, for the command line; `rig.bench.b
 
 from __future__ import annotations
 
-import argparse
 from dataclasses import dataclass
+from functools import partial
 
 from declared import Flag, Range, check, like, setting
 from rig.bench.contract import Command, bench_in
@@ -55,16 +55,10 @@ class BatchBenchOptions:
         return (simulating + analysing) / 3600.0
 
 
-def _options(parser: argparse.ArgumentParser) -> None:
-    add_declared_options(parser, BatchBenchOptions)
-
-
 SUBJECT = Command(
     name="batch",
     help="what many measurements cost: a batch serially and on Dask, and the fixed cost per video",
     bench=bench_in("batch"),
-    options=_options,
-    description=__doc__.split("\n\n")[0],
+    options=partial(add_declared_options, kind=BatchBenchOptions),
     outputs={"json": "write the figures as JSON", "plot": "draw the wall times"},
 )
-MODES: tuple[Command, ...] = ()

@@ -17,14 +17,14 @@ import statistics
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from analysis import AnalysisError
 from analysis.shutter import ShutterOptions, measure_shutter, suggest_flash_hz
 from analysis.shutter.fit import largest_gap
-from rig.bench.contract import Bench, Context
+from rig.bench.contract import Bench, Context, cell, every_one, new_figure
 from rig.service import SimulationConfig, simulate
 from rig.sim.camera import CameraConfig
 from rig.sim.display import DisplayConfig
@@ -57,17 +57,6 @@ class CalibrationGrid:
 
 
 QUICK_GRID = CalibrationGrid(fps=(60.0, 240.0), readout_shares=(0.6,), exposure_shares=(0.5,), sources=("light", "display"), width=160, height=120)
-
-
-def rows(grid: CalibrationGrid, folder: Path, log: Callable[[str], object] = lambda _: None) -> list[dict[str, Any]]:
-    """One row per case of the grid (see the module), each filmed in its own folder in `folder`."""
-    cases = list(itertools.product(grid.fps, grid.readout_shares, grid.exposure_shares, grid.sources))
-    found = []
-    for index, (fps, readout_share, exposure_share, source) in enumerate(cases):
-        row = case_row(grid, fps, readout_share / fps, exposure_share / fps, source, grid.seed + index, folder / f"case{index:03d}")
-        log(f"[{index + 1}/{len(cases)}] {_case_text(row)}")
-        found.append(row)
-    return found
 
 
 def case_row(grid: CalibrationGrid, fps: float, readout_s: float, exposure_s: float, source: str, seed: int, folder: Path) -> dict[str, Any]:
@@ -173,28 +162,21 @@ def targets_met(found: list[dict[str, Any]]) -> dict[str, bool]:
 def table(report: dict[str, Any]) -> str:
     """The summaries of the report's rows as a text table."""
     summaries = summary(report["rows"])
-
-    def number(value: float | None, digits: int = 2) -> str:
-        return "-" if value is None else f"{value:.{digits}f}"
-
     lines = [f"{'source':<9} {'cases':>5} {'refused':>7} {'readout err % med/max':>22} {'exposure err % med/max':>23} {'within':>6} {'covered':>7} {'s/film':>6}"]
     for name, s in summaries.items():
         lines.append(
             f"{name:<9} {s['cases']:>5} {s['refused']:>7} "
-            f"{number(s['readout_error_pct_median']) + ' / ' + number(s['readout_error_pct_max']):>22} "
-            f"{number(s['exposure_error_pct_median']) + ' / ' + number(s['exposure_error_pct_max']):>23} "
-            f"{s['within_targets']:>6} {s['covered']:>7} {number(s['estimate_s_median'], 1):>6}"
+            f"{cell(s['readout_error_pct_median'], '.2f') + ' / ' + cell(s['readout_error_pct_max'], '.2f'):>22} "
+            f"{cell(s['exposure_error_pct_median'], '.2f') + ' / ' + cell(s['exposure_error_pct_max'], '.2f'):>23} "
+            f"{s['within_targets']:>6} {s['covered']:>7} {cell(s['estimate_s_median']):>6}"
         )
     return "\n".join(lines)
 
 
 def plot(report: dict[str, Any], path: Path) -> None:
     """Seconds to measure each film against its readout's and its exposure's error, by source."""
-    from matplotlib.figure import Figure
-
     found = report["rows"]
-    figure = Figure(figsize=(10, 4.5))
-    axes = figure.subplots(1, 2, sharey=True)
+    figure, axes = new_figure((10, 4.5), nrows=1, ncols=2, sharey=True)
     for source in dict.fromkeys(row["source"] for row in found):
         answered = [row for row in found if row["source"] == source and row["refused"] is None]
         rolling = [row for row in answered if row["readout_error_pct"] is not None]
@@ -222,22 +204,24 @@ def _case_text(row: dict[str, Any]) -> str:
 
 
 def run(args: argparse.Namespace, context: Context) -> dict[str, Any]:
-    """Every film of the grid (the quick one with --quick), and how long they took."""
+    """One row per case of the grid (the quick one with --quick; see the module), each filmed in its
+    own folder in the context's, and how long they took."""
     started = time.perf_counter()
-    found = rows(QUICK_GRID if args.quick else CalibrationGrid(), context.folder, context.log)
+    grid = QUICK_GRID if args.quick else CalibrationGrid()
+    cases = list(itertools.product(grid.fps, grid.readout_shares, grid.exposure_shares, grid.sources))
+    found = []
+    for index, (fps, readout_share, exposure_share, source) in enumerate(cases):
+        folder = context.folder / f"case{index:03d}"
+        row = case_row(grid, fps, readout_share / fps, exposure_share / fps, source, grid.seed + index, folder)
+        context.log(f"[{index + 1}/{len(cases)}] {_case_text(row)}")
+        found.append(row)
     return {"rows": found, "seconds": time.perf_counter() - started}
-
-
-def every_film_refused(found: list[dict[str, Any]]) -> str | None:
-    """Where the estimate refused every film: how many, and the first refusal."""
-    if not found or any(row["refused"] is None for row in found):
-        return None
-    return f"the estimate refused every one of the {len(found)} films (the first: {found[0]['refused']})"
 
 
 BENCH = Bench(
     run=run, table=table, plot=plot,
-    targets=lambda report: targets_met(report["rows"]), all_failed=lambda report: every_film_refused(report["rows"]),
+    targets=lambda report: targets_met(report["rows"]),
+    all_failed=lambda report: every_one(report["rows"], "refused", "the estimate refused every one of the {count} films"),
     notes=lambda report: f"{len(report['rows'])} films in {report['seconds'] / 60:.1f} minutes",
     record=lambda report: {"summary": summary(report["rows"]), "targets_met": targets_met(report["rows"]), **report},
 )

@@ -26,8 +26,6 @@ SUBJECT = Command(
     help="rig calibrate-camera's readout and exposure error on simulated films, 30 to 240 fps",
     bench=bench_in("camera_calibration"),
     options=_options,
-    description=__doc__.split("\n\n")[0],
     outputs={"json": "write the summaries and every film's row as JSON", "plot": "plot seconds per film against each error"},
     runs="keep the simulated films here (default: a temporary folder)",
 )
-MODES: tuple[Command, ...] = ()

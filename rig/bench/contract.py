@@ -91,8 +91,9 @@ def bench_in(module: str) -> Callable[[], Bench]:
 
 @dataclass(frozen=True)
 class Command:
-    """What the command line shows of one benchmark, declared without importing what it runs. The
-    fields from `description` on are a subject's; a mode leaves them out and has its subject's."""
+    """What the command line shows of one benchmark, declared without importing what it runs (a
+    subject's description is its declaring module's first paragraph). The fields from `outputs` on
+    are a subject's; a mode leaves them out and has its subject's."""
 
     name: str
     """the subject (`rig bench NAME`), or a mode's flag (`--NAME`)"""
@@ -101,7 +102,6 @@ class Command:
     """loads the bench (`bench_in`)"""
     options: Callable[[argparse.ArgumentParser], object] = lambda parser: None
     """adds the bench's own options (a mode's join its subject's)"""
-    description: str = ""
     outputs: dict[str, str] = field(default_factory=dict)
     """the help of each output it writes, by kind: json, plot, csv"""
     spec_file: SpecFile | None = None
@@ -109,6 +109,22 @@ class Command:
     """the help of --runs (what it keeps there); None: no --runs, the runs are temporary"""
     executor: str | None = None
     """what runs on --workers or --scheduler; None: no such options"""
+
+
+def every_one(items: list[dict[str, Any]], reason: str, sentence: str) -> str | None:
+    """Where every one of `items` has a `reason` (not None: every case failed, or was refused), `sentence`
+    (its {count}, how many) with the first one's; else None: `rig bench` then exits with status 2."""
+    if not items or any(item[reason] is None for item in items):
+        return None
+    return f"{sentence.format(count=len(items))} (the first: {items[0][reason]})"
+
+
+def new_figure(size: tuple[float, float], **subplots: Any) -> tuple[Any, Any]:
+    """A matplotlib figure of `size` inches and its axes (`Figure.subplots(**subplots)`)."""
+    from matplotlib.figure import Figure  # loaded where a bench plots, never by its help
+
+    figure = Figure(figsize=size)
+    return figure, figure.subplots(**subplots)
 
 
 def cell(value: float | None, spec: str = ".1f") -> str:

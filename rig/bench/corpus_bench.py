@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import math
 from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -23,8 +24,8 @@ from predictors import DEFAULT, names, resolve
 from predictors.registry import params_of
 from predictors.corpus import GROUPINGS, Recording, read_corpus
 from predictors.cross_validation import REPORTED, CorpusScores, Fold, cross_validate, groups_of, held_out_mean
-from rig.bench.contract import Context
-from rig.bench.predictor_scores import evaluate_all, finite_or_none, label
+from rig.bench.contract import Context, new_figure
+from rig.bench.predictor_scores import by_horizon, evaluate_all, scores_of
 from rig.bench.predictors_settings import BASELINE
 from rig.service.tune import check_scorable, in_time_order
 
@@ -79,10 +80,8 @@ def run(args: argparse.Namespace, context: Context) -> CorpusRun:
     specs = [*(s for s in ((BASELINE, {}), (COST_REFERENCE, {})) if s not in specs), *specs]
     results = evaluate_all([r.trace for r in recordings], specs, args.horizons_ms, args.timing_repeats,
                            context.progress("benchmarking predictors on the corpus"))  # fmt: skip
-    evaluations: dict[str, dict[str, Any]] = {}
-    for result in results:
-        evaluations.setdefault(label(result.predictor, result.params), {})[result.trace] = result
-    scores = CorpusScores(evaluations, BASELINE, tuple(args.horizons_ms))
+    scores = scores_of(results, args.horizons_ms)
+    evaluations = scores.evaluations
     costs = {name: float(np.median([by[r].us_per_update / evaluations[COST_REFERENCE][r].us_per_update for r in by]))
              for name, by in evaluations.items()}  # fmt: skip
     folds = {by: cross_validate(scores, groups_of(recordings, by)) for by in GROUPINGS} if args.cross_validate else {}
@@ -157,8 +156,8 @@ def text(found: CorpusRun) -> str:
 
 def _ratios(found: CorpusRun, candidate: str, recordings: Sequence[str]) -> dict[str, dict[str, float | None]]:
     """The candidate's ratios over the recordings (their geometric mean) per reported part and horizon."""
-    out = {part: {f"{h:g}": found.scores.group_ratio(candidate, recordings, part, h) for h in found.shown} for part in REPORTED}
-    return {part: {h: finite_or_none(v) for h, v in by.items()} for part, by in out.items()}
+    return {part: by_horizon(partial(found.scores.group_ratio, candidate, recordings, part), found.shown)
+            for part in REPORTED}  # fmt: skip
 
 
 def record(found: CorpusRun) -> dict[str, Any]:
@@ -177,7 +176,7 @@ def record(found: CorpusRun) -> dict[str, Any]:
                 "cost_over_kalman_cv": found.costs[c],
                 "recordings": {r.name: _ratios(found, c, [r.name]) for r in found.recordings},
                 "groups": {by: {g: _ratios(found, c, members) for g, members in groups.items()} for by, groups in groupings.items()},
-                "geometric_mean": {by: {part: {f"{h:g}": finite_or_none(scores.corpus_ratio(c, groups, part, h)) for h in found.shown}
+                "geometric_mean": {by: {part: by_horizon(partial(scores.corpus_ratio, c, groups, part), found.shown)
                                         for part in REPORTED} for by, groups in groupings.items()},  # fmt: skip
             }
             for c in scores.candidates
@@ -186,8 +185,7 @@ def record(found: CorpusRun) -> dict[str, Any]:
             by: {
                 "folds": [{"group": f.group, "recordings": list(f.recordings), "chosen": f.chosen,
                            "ratios": _ratios(found, f.chosen, f.recordings)} for f in folds],  # fmt: skip
-                "geometric_mean": {part: {f"{h:g}": finite_or_none(held_out_mean(folds, part, h)) for h in found.shown}
-                                   for part in REPORTED},  # fmt: skip
+                "geometric_mean": {part: by_horizon(partial(held_out_mean, folds, part), found.shown) for part in REPORTED},
             }
             for by, folds in found.folds.items()
         },
@@ -199,10 +197,7 @@ def plot(found: CorpusRun, path: Path) -> None:
     """Left: each candidate's geometric mean over people of angular RMS / constant velocity at the
     plot horizon against its cost over kalman-cv's. Right: per person held out, the chosen
     candidate's angular ratio at each horizon (or, without folds, the default's)."""
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(13.0, 5.0))
-    left, right = figure.subplots(1, 2)
+    figure, (left, right) = new_figure((13.0, 5.0), nrows=1, ncols=2)
     scores, groups, h = found.scores, found.groups("person"), found.plot_horizon_ms
     ratios = {c: scores.corpus_ratio(c, groups, "angular", h) for c in scores.candidates}
     shown = {c: r for c, r in ratios.items() if r <= _PLOTTED_ABOVE_BASELINE}

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from rig.bench.contract import Bench, Context
+from rig.bench.contract import Bench, Context, new_figure
 from rig.clock import MonotonicClock
 from rig.errors import RigError
 from rig.devices.window import SWAP_COLUMNS, SwapRecord, WindowDisplay, WindowSettings
@@ -162,10 +162,7 @@ def table(report: dict[str, Any]) -> str:
 
 def plot(report: dict[str, Any], path: Path) -> None:
     """Each figure's median, with a bar to its 95th percentile."""
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(6.0, 3.0))
-    axes = figure.subplots()
+    figure, axes = new_figure((6.0, 3.0))
     for i, (key, _) in enumerate(MEASURED):
         f = report[key]
         if "failed" in f:

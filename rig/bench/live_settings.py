@@ -23,8 +23,6 @@ SUBJECT = Command(
     help="the live loop's overhead: sample arrival to the pose the renderer gets, swap to log (needs an X display)",
     bench=bench_in("live"),
     options=_options,
-    description=__doc__.split("\n\n")[0],
     outputs={"json": "write the figures as JSON", "plot": "plot the figures"},
     runs="keep the run's files here (default: a temporary folder)",
 )
-MODES: tuple[Command, ...] = ()

@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Callable, Sequence
 
 from predictors import Evaluation, PredictorError, Trace, evaluate
+from predictors.cross_validation import PARTS, CorpusScores
 from rig.bench.predictors_settings import BASELINE
 
 
@@ -60,38 +62,13 @@ def evaluate_all(
     return results
 
 
-@dataclass(frozen=True)
-class Ratios:
-    """One predictor's RMS errors over constant velocity's on each trace, per horizon (ms): angular,
-    and positional (NaN where constant velocity's position error is zero: no position to predict)."""
-
-    predictor: str
-    angular: dict[str, dict[float, float]]
-    position: dict[str, dict[float, float]]
-    us_per_update: dict[str, float]
-
-    def geometric_mean(self, part: str, horizon_ms: float) -> float:
-        """The geometric mean of one part's ratios across the traces that have it (NaN if none)."""
-        values = [by_horizon[horizon_ms] for by_horizon in getattr(self, part).values()]
-        values = [v for v in values if math.isfinite(v) and v > 0.0]
-        return math.exp(sum(math.log(v) for v in values) / len(values)) if values else math.nan
-
-    def worst(self, part: str, horizon_ms: float) -> float:
-        """The largest ratio of one part across the traces (NaN if none)."""
-        values = [by_horizon[horizon_ms] for by_horizon in getattr(self, part).values()]
-        values = [v for v in values if math.isfinite(v)]
-        return max(values) if values else math.nan
-
-    def to_dict(self, horizons: Sequence[float]) -> dict[str, Any]:
-        """Plain JSON-ready values, the geometric means and worst ratios per horizon included."""
-        return {
-            "predictor": self.predictor,
-            "angular": _keyed(self.angular),
-            "position": _keyed(self.position),
-            "us_per_update": self.us_per_update,
-            "geometric_mean": {part: {f"{h:g}": finite_or_none(self.geometric_mean(part, h)) for h in horizons} for part in ("angular", "position")},
-            "worst": {part: {f"{h:g}": finite_or_none(self.worst(part, h)) for h in horizons} for part in ("angular", "position")},
-        }
+def scores_of(results: Sequence[Evaluation], horizons: Sequence[float]) -> CorpusScores:
+    """The evaluations by predictor label then trace, scored against BASELINE with its defaults
+    (`predictors.cross_validation.CorpusScores`: each ratio, their geometric mean and worst)."""
+    evaluations: dict[str, dict[str, Evaluation]] = {}
+    for result in results:
+        evaluations.setdefault(label(result.predictor, result.params), {})[result.trace] = result
+    return CorpusScores(evaluations, BASELINE, tuple(horizons))
 
 
 def finite_or_none(value: float) -> float | None:
@@ -99,24 +76,26 @@ def finite_or_none(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def _keyed(ratios: dict[str, dict[float, float]]) -> dict[str, dict[str, float | None]]:
-    return {trace: {f"{h:g}": finite_or_none(v) for h, v in by_horizon.items()} for trace, by_horizon in ratios.items()}
+def by_horizon(value: Callable[[float], float], horizons: Sequence[float]) -> dict[str, float | None]:
+    """`value` at each horizon (ms), keyed as JSON holds it, None where it is not finite."""
+    return {f"{h:g}": finite_or_none(value(h)) for h in horizons}
 
 
-def ratios(results: Sequence[Evaluation], horizons: Sequence[float]) -> list[Ratios]:
-    """Every predictor's ratios to the baseline (`BASELINE`, which must be among the results)."""
-    baseline = {r.trace: r for r in results if r.predictor == BASELINE and not r.params}
-    missing = sorted({r.trace for r in results} - set(baseline))
-    if missing:
-        raise ValueError(f"ratios need {BASELINE} with its defaults on every trace; missing on {', '.join(missing)}")
-    by_label: dict[str, Ratios] = {}
-    for result in results:
-        entry = by_label.setdefault(label(result.predictor, result.params), Ratios(label(result.predictor, result.params), {}, {}, {}))
-        base = baseline[result.trace]
-        entry.angular[result.trace] = {h: _ratio(result.at(h).angular_rms_deg, base.at(h).angular_rms_deg) for h in horizons}
-        entry.position[result.trace] = {h: _ratio(result.at(h).position_rms_mm, base.at(h).position_rms_mm) for h in horizons}
-        entry.us_per_update[result.trace] = result.us_per_update
-    return list(by_label.values())
+def ratios_record(scores: CorpusScores) -> list[dict[str, Any]]:
+    """Per predictor, its angular and position ratios to the baseline on each trace it was scored
+    on, its cost there, and the geometric mean and worst of each part over those traces, at every
+    horizon, as JSON-ready values."""
+    record = []
+    for name, on in scores.evaluations.items():
+        traces, at = list(on), scores.horizons_ms
+        record.append({
+            "predictor": name,
+            **{part: {t: by_horizon(partial(scores.ratio, name, t, part), at) for t in traces} for part in PARTS},
+            "us_per_update": {t: evaluation.us_per_update for t, evaluation in on.items()},
+            "geometric_mean": {part: by_horizon(partial(scores.group_ratio, name, traces, part), at) for part in PARTS},
+            "worst": {part: by_horizon(partial(scores.worst, name, traces, part), at) for part in PARTS},
+        })
+    return record
 
 
 def _ratio(error: float, baseline: float) -> float:

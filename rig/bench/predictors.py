@@ -38,13 +38,16 @@ import numpy as np
 
 import predictors
 from predictors import Evaluation, Trace, read_trace
+from predictors.cross_validation import CorpusScores
 from predictors.stress import stress_streams
 from predictors.synthetic import head_motion
 from rig.bench import corpus_bench
 from rig.bench.contract import Bench, Context
 from rig.bench.corpus_bench import CorpusRun
 from rig.bench.predictors_settings import BASELINE
-from rig.bench.predictor_scores import FailedEvaluation, HeldOut, Ratios, cost_ratios, evaluate_all, label, leave_one_out, ratios
+from rig.bench.predictor_scores import (
+    FailedEvaluation, HeldOut, cost_ratios, evaluate_all, label, leave_one_out, ratios_record, scores_of,
+)
 from rig.errors import ConfigError
 from rig.service.tune import check_scorable, in_time_order
 from rig.sim.pendulum import Pendulum, PendulumConfig
@@ -86,16 +89,24 @@ def table(results: Sequence[Evaluation], horizons: Sequence[float]) -> str:
     return "\n".join(rows)
 
 
-def ratio_table(entries: Sequence[Ratios], part: str, horizons: Sequence[float]) -> str:
+def _has(scores: CorpusScores, part: str, trace: str | None = None) -> bool:
+    """Whether any predictor's ratio of `part` is finite at any horizon on `trace` (None: on any it was scored on)."""
+    return any(math.isfinite(scores.ratio(name, t, part, h)) for name, on in scores.evaluations.items()
+               for t in on if trace in (None, t) for h in scores.horizons_ms)  # fmt: skip
+
+
+def ratio_table(scores: CorpusScores, part: str, horizons: Sequence[float]) -> str:
     """A Markdown table of one part's ratios to constant velocity: per predictor, each trace's
     ratios at `horizons` (ms) joined by " / ", their geometric mean and worst, and the median cost."""
-    traces = [t for t in entries[0].angular if any(math.isfinite(v) for e in entries for v in getattr(e, part)[t].values())]
+    traces = [t for t in scores.evaluations[scores.candidates[0]] if _has(scores, part, t)]
     head = "| predictor | " + " | ".join(traces) + " | geometric mean | worst | us/update (median) |"
     rows = [head, "|" + "---|" * (len(traces) + 4)]
-    for entry in entries:
-        cells = [" / ".join(f"{getattr(entry, part)[t][h]:.3f}" for h in horizons) for t in traces]
-        summary = [" / ".join(f"{entry.geometric_mean(part, h):.3f}" for h in horizons), " / ".join(f"{entry.worst(part, h):.3f}" for h in horizons)]
-        rows.append(f"| {entry.predictor} | " + " | ".join(cells + summary) + f" | {float(np.median(list(entry.us_per_update.values()))):.1f} |")
+    for name, on in scores.evaluations.items():
+        cells = [" / ".join(f"{scores.ratio(name, t, part, h):.3f}" for h in horizons) for t in traces]
+        for over in (scores.group_ratio, scores.worst):
+            cells.append(" / ".join(f"{over(name, list(on), part, h):.3f}" for h in horizons))
+        cost = float(np.median([evaluation.us_per_update for evaluation in on.values()]))
+        rows.append(f"| {name} | " + " | ".join(cells) + f" | {cost:.1f} |")
     return "\n".join(rows)
 
 
@@ -156,7 +167,7 @@ class Scores:
     horizons_ms: tuple[float, ...]
     plot_horizon_ms: float
     results: list[Evaluation]
-    ratios: list[Ratios]
+    ratios: CorpusScores
     costs: dict[str, float]
     held: list[HeldOut]
     failed: list[FailedEvaluation]
@@ -197,7 +208,7 @@ def run(args: argparse.Namespace, context: Context) -> Scores | CorpusRun:
     scored = {r.trace for r in results if r.predictor == BASELINE and not r.params}
     held = [h for name in args.leave_one_out or () for h in leave_one_out(name, traces, plot_horizon, args.tune_iterations,
                                                                              context.progress(f"tuning {name}, each trace held out in turn"))]  # fmt: skip
-    compared = ratios([r for r in results if r.trace in scored], horizons)
+    compared = scores_of([r for r in results if r.trace in scored], horizons)
     return Scores(horizons, plot_horizon, results, compared, cost_ratios(results), held, failed)
 
 
@@ -218,9 +229,9 @@ def text(scores: Scores | CorpusRun) -> str:
     at = " / ".join(f"{h:g}" for h in shown)
     lines = [table(scores.results, horizons)]
     lines += [f"| {f.trace} | {f.predictor} | failed: {f.failed} |" for f in scores.failed]
-    if scores.ratios:
+    if scores.ratios.candidates:
         lines += [f"\nangular RMS error / constant velocity ({BASELINE}) at {at} ms:", ratio_table(scores.ratios, "angular", shown)]
-    if any(math.isfinite(v) for entry in scores.ratios for by_horizon in entry.position.values() for v in by_horizon.values()):
+    if _has(scores.ratios, "position"):
         lines += [f"\nposition RMS error / constant velocity at {at} ms (traces with position):", ratio_table(scores.ratios, "position", shown)]
     lines += [f"kalman-cv / desp cost on {trace}: {ratio:.2f}" for trace, ratio in scores.costs.items()]
     if scores.held:
@@ -238,7 +249,7 @@ def record(scores: Scores | CorpusRun) -> dict[str, Any]:
         "horizons_ms": list(horizons),
         "baseline": BASELINE,
         "kalman_cv_over_desp_cost": scores.costs,
-        "ratios": [entry.to_dict(horizons) for entry in scores.ratios],
+        "ratios": ratios_record(scores.ratios),
         "leave_one_out": [h.to_dict() for h in scores.held],
         "results": [r.to_dict() for r in scores.results],
         "failed": [f.to_dict() for f in scores.failed],

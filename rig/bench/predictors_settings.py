@@ -82,7 +82,5 @@ SUBJECT = Command(
     help="score every predictor on traces: error against constant velocity at several horizons, and cost per update",
     bench=bench_in("predictors"),
     options=_options,
-    description=__doc__.split("\n\n")[0],
     outputs={"json": "write every score, ratio and held-out result as JSON", "plot": "draw speed against error"},
 )
-MODES: tuple[Command, ...] = ()

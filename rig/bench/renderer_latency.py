@@ -16,19 +16,19 @@ LED and the sphere in: `film_latencies` films many as one sweep, written out as 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from predictors import make as make_predictor
+from rig.bench.contract import Context
+from rig.bench.renderer_specs import LatencyRun
 from rig.service.analyse import AnalysisRequest
 from rig.service.batch import USER_ERRORS
 from rig.service.sweep import (
     SIMULATED_ROIS, PointRun, Sweep, SweepPoint, run_sweep, settings_of, simulate_and_analyse, unsimulated_row, write_sweep,
 )
-from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
-from rig.sim.display import DisplayConfig
 from rig.sim.pendulum import PendulumConfig
 
 LATENCY_PERIOD_FRACTION = 0.3
@@ -44,31 +44,6 @@ FILMS_SPEC = "films.toml"
 """The sweep of a bench's films, written beside their runs (`film_latencies`)."""
 
 
-@dataclass(frozen=True)
-class LatencyRun:
-    """One filmed run: a renderer spec on a load of `triangles` (shaped as `load` says,
-    `rig.render.gl.LOAD_SHAPES`), a display of `size` at `refresh_hz`, a predictor and photon
-    target, and its costs (ms, modelled; None: measured)."""
-
-    renderer: str
-    triangles: int
-    size: tuple[int, int]
-    predictor: str = "hold"
-    predictor_params: tuple[tuple[str, Any], ...] = ()
-    app_frame_ms: float | None = None
-    server_ms: float | None = None
-    photon_target: str = "photons"
-    refresh_hz: float = 60.0
-    camera: CameraConfig = CameraConfig()
-    min_duration_s: float = 6.0
-    max_period_s: float = 8.0
-    load: str = "soup"
-
-    @property
-    def composes(self) -> bool:
-        return composes(self.renderer)
-
-
 def composes(renderer: str) -> bool:
     """Whether a renderer spec composes images at refreshes (a warp) rather than drawing each frame (direct)."""
     return not renderer.startswith("direct")
@@ -81,9 +56,9 @@ Film = tuple[dict[str, Any], LatencyRun, float, float]
 def expected_latency_s(run: LatencyRun, app_frame_s: float, server_s: float) -> float:
     """A generous guess of the run's latency from its costs (s): a direct renderer's two frames; a
     compositing server's refreshes (a cost over one refresh makes it skip some)."""
-    if not run.composes:
+    if not composes(run.config.renderer):
         return 2.0 * app_frame_s + BASE_LATENCY_S
-    refresh_s = 1.0 / run.refresh_hz
+    refresh_s = 1.0 / run.config.display.refresh_hz
     return (math.ceil(server_s / refresh_s) + 1) * refresh_s + BASE_LATENCY_S
 
 
@@ -93,32 +68,15 @@ def _period_s(run: LatencyRun, app_frame_s: float, server_s: float) -> tuple[flo
     return expected_s, max(PendulumConfig().period_s, expected_s / LATENCY_PERIOD_FRACTION)
 
 
-def run_config(run: LatencyRun) -> SimulationConfig:
-    """What `run` is, as a simulation: renderer, load, display, predictor, photon target and costs
-    (how it is filmed is `film_config`'s)."""
-    width, height = run.size
-    return SimulationConfig(
-        display=DisplayConfig(refresh_hz=run.refresh_hz, width=width, height=height),
-        renderer=run.renderer,
-        predictor=run.predictor,
-        predictor_params=dict(run.predictor_params),
-        scene_triangles=run.triangles,
-        scene_load=run.load,
-        app_frame_ms=run.app_frame_ms,
-        warp_ms=run.server_ms,
-        photon_target=run.photon_target,
-    )
-
-
 def film_config(run: LatencyRun, app_frame_s: float, server_s: float) -> SimulationConfig:
     """The simulation that films `run`, with `app_frame_s` and `server_s` the costs expected (s):
     they set the pendulum's period, the film's length and frame rate, and the warm-up."""
     _, period = _period_s(run, app_frame_s, server_s)
     return replace(
-        run_config(run),
+        run.config,
         duration_s=max(run.min_duration_s, LATENCY_PERIODS * period),
         pendulum=PendulumConfig(period_s=period),
-        camera=replace(run.camera, fps=min(240.0, max(MIN_CAMERA_FPS, CAMERA_FRAMES_PER_PERIOD / period))),
+        camera=replace(run.config.camera, fps=min(240.0, max(MIN_CAMERA_FPS, CAMERA_FRAMES_PER_PERIOD / period))),
         # the first frame must be on show when filming starts; and the truth's latency search looks
         # up to about a period back, which the session's pendulum covers only within its warm-up
         warmup_s=max(app_frame_s + 0.5, period),
@@ -143,7 +101,7 @@ def beyond_range_figures(run: LatencyRun, app_frame_s: float, server_s: float) -
     if period <= run.max_period_s:
         return None
     note = f"beyond range: about {expected_s:.1f} s expected, which needs a pendulum period over {run.max_period_s:g} s"
-    return {**_no_figures(run_config(run)), "latency_note": note}
+    return {**_no_figures(run.config), "latency_note": note}
 
 
 def film_figures(filmed: PointRun) -> dict[str, Any]:
@@ -205,25 +163,17 @@ def film_latency(run: LatencyRun, app_frame_s: float, server_s: float, out_dir: 
     if unfilmed is not None:
         return unfilmed
     point = SweepPoint(0, film_config(run, app_frame_s, server_s), {}, out_dir, AnalysisRequest(out_dir / "video.avi"), simulated_rois=True)
-    try:
-        return film_figures(simulate_and_analyse(point))
-    except USER_ERRORS as error:
-        return failed_figures(point.config, f"not simulated: {error}")
+    return film_row(point)["film"]
 
 
-def film_latencies(
-    films: list[Film],
-    runs_dir: Path,
-    comment: str,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    progress: Callable[[float, float], object] | None = None,
-) -> list[dict[str, Any]]:
+def film_latencies(films: list[Film], comment: str, context: Context) -> list[dict[str, Any]]:
     """Each film's figures, in order. A film beyond range is not filmed (its note says why); the
     others are a sweep of explicit points with their labels, analysed within the simulation's
-    regions, written to runs_dir/FILMS_SPEC under `comment` and run by `rig.service.sweep` with
-    `film_row` into runs_dir (pointNNN, summary.csv and .json; on `rig.executor`'s workers when
-    asked), so that `rig sweep` on that file films exactly them again."""
+    regions, written to the context's folder as FILMS_SPEC under `comment` and run by
+    `rig.service.sweep` with `film_row` into that folder (pointNNN, summary.csv and .json; on the
+    context's executor, with its progress bar), so that `rig sweep` on that file films exactly
+    them again."""
+    progress = context.progress("filming the latency films")
     figures = [beyond_range_figures(run, app_s, server_s) for _, run, app_s, server_s in films]
     points = [
         {"labels": labels, **settings_of(film_config(run, app_s, server_s))}
@@ -233,7 +183,8 @@ def film_latencies(
     if not points:
         return figures
     sweep = Sweep({}, {}, {SIMULATED_ROIS: True}, points)
-    write_sweep(sweep, runs_dir / FILMS_SPEC, comment)
-    rows, _ = run_sweep(sweep, runs_dir, workers, scheduler, progress, overwrite=True, job=film_row)
+    folder = context.folder
+    write_sweep(sweep, folder / FILMS_SPEC, comment)
+    rows, _ = run_sweep(sweep, folder, context.workers, context.scheduler, progress, overwrite=True, job=film_row)
     filmed = iter(row["film"] for row in rows)
     return [next(filmed) if unfilmed is None else unfilmed for unfilmed in figures]

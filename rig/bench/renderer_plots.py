@@ -7,13 +7,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Callable
 
+from rig.bench.contract import new_figure
+
 
 def _draw(path: Path, draw: Callable[[Any, list[Any]], None]) -> None:
     """A figure of two panels side by side, drawn by `draw(figure, axes)` and saved to `path`."""
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(12, 4.8))
-    axes = figure.subplots(1, 2)
+    figure, axes = new_figure((12, 4.8), nrows=1, ncols=2)
     draw(figure, list(axes))
     figure.tight_layout()
     figure.savefig(path, dpi=110)

@@ -7,23 +7,35 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-from declared import Range, check, like, setting
-from rig.bench.renderer_estimate import estimated_hours
-from rig.bench.spec_reader import read_spec
+from declared import Range, check, from_table, like, setting
 from rig.errors import ConfigError
 from rig.sim.camera_config import CameraConfig
-from rig.sim.config import MAX_HOURS
+from rig.sim.config import MAX_HOURS, SimulationConfig
 from rig.sim.display_config import DisplayConfig
-
-if TYPE_CHECKING:
-    from rig.bench.renderer_latency import LatencyRun
+from rig.toml_file import read_toml
 
 QUICK_SPEC = Path(__file__).parent / "specs" / "renderers-quick.toml"
 
 TRIANGLES = Range(0.0, 1e8, True, True)
 """A load's triangles: a heavy VR scene draws a few million a frame, 100 million is past any GPU's budget."""
+TRIANGLES_PER_S = 1e9
+"""Triangles a second the fastest GPU draws in small random triangles."""
+PIXELS_PER_S = 1e10
+"""Pixels a second the fastest GPU warps and reads back."""
+FILMED_RENDERERS = 2
+"""Each filmed load is filmed through the direct and the warp renderer."""
+
+
+@dataclass(frozen=True)
+class LatencyRun:
+    """One filmed run: what it is, as a simulation (`config`: renderer, load, display, predictor,
+    photon target, camera, and the costs modelled, None where measured), its shortest film and its
+    longest pendulum period (how it is filmed is `rig.bench.renderer_latency.film_config`'s)."""
+
+    config: SimulationConfig
+    min_duration_s: float = 6.0
+    max_period_s: float = 8.0
 
 
 @dataclass(frozen=True)
@@ -76,28 +88,50 @@ class BenchGrid:
             raise ConfigError("a renderer bench grid needs at least one load size, resolution and rate ratio")
         if min(min(size) for size in self.resolutions) < 16:
             raise ConfigError(f"a display is at least 16x16 pixels, got {self.resolutions}")
-        if (hours := estimated_hours(self)) > MAX_HOURS:
+        if (hours := self.estimated_hours()) > MAX_HOURS:
             raise ConfigError(f"this grid would take about {hours:.3g} hours at the least, more than the {MAX_HOURS:g} hours the rig "
                               "starts: fewer or smaller loads, resolutions, phases or warp rounds, or split it into grids of its own")  # fmt: skip
+
+    def estimated_hours(self) -> float:
+        """The least time the grid takes, in hours, so that a grid that cannot finish is refused with
+        its estimate before any frame is drawn. The figures are generous on purpose (the fastest
+        GPUs' rates): the estimate is a floor, so only a grid that no machine finishes within
+        `rig.sim.config.MAX_HOURS` is refused. Each load at each resolution is drawn for its direct
+        frames (at most the direct budget of time), its client frames and warps for the image error
+        (`phases` poses, each warped at every ratio), and its warp rounds; each latency film renders
+        its load at the display's refresh for at least its duration."""
+        seconds = 0.0
+        for width, height in self.resolutions:
+            for triangles in self.triangles:
+                frame_s = triangles / TRIANGLES_PER_S
+                direct_s = min(self.direct_budget_s, self.direct_frames * frame_s)
+                image_error_s = self.phases * (frame_s + len(self.ratios) * width * height / PIXELS_PER_S)
+                rounds_s = self.warp_rounds * (frame_s + width * height / PIXELS_PER_S)
+                seconds += direct_s + image_error_s + rounds_s
+        filmed = self.latency_triangles if self.latency_triangles is not None else self.triangles
+        film_frames = self.latency_duration_s * self.refresh_hz
+        seconds += FILMED_RENDERERS * sum(film_frames * triangles / TRIANGLES_PER_S for triangles in filmed)
+        return seconds / 3600.0
 
     def latency_run(
         self, renderer: str, triangles: int, predictor: str, photon_target: str = "photons", load: str = "soup"
     ) -> LatencyRun:
         """The filmed run of `renderer` on `triangles` (shaped as `load` says) at the first
         resolution, costs measured (the server's modelled if `server_ms` says)."""
-        from rig.bench.renderer_latency import LatencyRun  # the simulation's libraries: only when a bench runs
-
-        return LatencyRun(
-            renderer, triangles, self.resolutions[0], predictor, server_ms=self.server_ms, photon_target=photon_target,
-            refresh_hz=self.refresh_hz, camera=self.latency_camera, min_duration_s=self.latency_duration_s,
-            max_period_s=self.max_period_s, load=load,
+        width, height = self.resolutions[0]
+        config = SimulationConfig(
+            display=DisplayConfig(refresh_hz=self.refresh_hz, width=width, height=height), renderer=renderer, predictor=predictor,
+            scene_triangles=triangles, scene_load=load, app_frame_ms=None, warp_ms=self.server_ms, photon_target=photon_target,
+            camera=self.latency_camera,
         )  # fmt: skip
+        return LatencyRun(config, self.latency_duration_s, self.max_period_s)
 
 
 def read_grid(path: Path | None) -> BenchGrid:
-    """The grid a TOML spec sets (`rig.bench.spec_reader`: every key and value checked), the
-    defaults where it is silent; with no spec, the defaults."""
-    return read_spec(BenchGrid, path) if path is not None else BenchGrid()
+    """The grid a TOML spec sets (`declared.from_table`: every key and value checked, a typo or a
+    wrong type one line naming the file and the key), the defaults where it is silent; with no
+    spec, the defaults."""
+    return from_table(BenchGrid, read_toml(path, "spec"), ConfigError, str(path)) if path is not None else BenchGrid()
 
 
 @dataclass(frozen=True)

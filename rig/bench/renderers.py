@@ -225,8 +225,7 @@ def run(grid: BenchGrid, context: Context) -> list[dict[str, Any]]:
                "were chosen from the costs the timings measured. `rig sweep films.toml --out DIR` films them\n"
                "again, every cost measured again on the machine that runs it.")  # fmt: skip
 
-    progress = context.progress("filming the latency films")
-    for (labels, *_), figures in zip(films, film_latencies(films, context.folder, comment, context.workers, context.scheduler, progress)):
+    for (labels, *_), figures in zip(films, film_latencies(films, comment, context)):
         measured = figures["latency_measured_ms"]
         shown = f"{measured:.1f} ms measured, {figures['latency_true_ms']:.1f} ms true" if measured is not None else figures["latency_note"]
         if figures["failed"] is not None:

@@ -80,7 +80,6 @@ SUBJECT = Command(
     help="frame cost, latency and image error of the direct and warp renderers against scene size",
     bench=bench_in("renderers"),
     options=_renderers_options,
-    description=__doc__.split("\n\n")[0],
     outputs={"json": "write the rows as a JSON list", "csv": "write the rows as CSV",
              "plot": "plot the run (latency against N, error against latency saved, ...)"},
     spec_file=SpecFile(None, QUICK_SPEC,

@@ -26,14 +26,13 @@ import argparse
 import math
 import time
 from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
-from rig.bench.renderer_latency import check_predictors, failed_figures, film_latency, run_config
+from rig.bench.renderer_latency import check_predictors, failed_figures, film_latency
 from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import machine_name, open_warp, pose_of, scene_setup
 from rig.bench.renderer_specs import BenchGrid, SeedTableSpec
@@ -133,7 +132,7 @@ def run(spec: SeedTableSpec, context: Context) -> list[dict[str, Any]]:
         except RigError as error:
             log(f"{triangles} triangles: not timed: {error}; the table stops here")
             for renderer in ("direct", grid.warp):
-                config = run_config(grid.latency_run(renderer, triangles, grid.predictor, load=spec.load))
+                config = grid.latency_run(renderer, triangles, grid.predictor, load=spec.load).config
                 rows.append(_row(failed_figures(config, f"not timed: {error}"), renderer, spec.load, refresh_ms, machine))
             break
         if direct_s > spec.max_frame_s:
@@ -214,12 +213,9 @@ def spec(args: argparse.Namespace) -> SeedTableSpec:
     return replace(chosen, grid=with_options(chosen.grid, args), **given(args, "max_frame_s", "max_triangles", "load"))
 
 
-def _plot(rows: list[dict[str, Any]], path: Path) -> None:
-    renderer_plots.plot_seed_table(rows, seed_rows(), path, run_label(rows))
-
-
 BENCH = Bench(
     spec=spec, run=run, table=seed_table_text,
     record=lambda rows: plain(rows + seed_rows()),
-    plot=_plot, all_failed=every_row_failed,
+    plot=lambda rows, path: renderer_plots.plot_seed_table(rows, seed_rows(), path, run_label(rows)),
+    all_failed=every_row_failed,
 )

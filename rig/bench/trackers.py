@@ -47,7 +47,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from rig.bench.contract import Bench, Context, Log
+from rig.bench.contract import Bench, Context, Log, new_figure
 from rig.clock import MonotonicClock
 from rig.devices.trackers.decoders import BinaryDecoder
 from rig.devices.trackers.profile import load_profile
@@ -173,13 +173,7 @@ def run_case(case: Case, rate_hz: float, duration_s: float, folder: Path, log: L
     counters = recording.sidecar["counters"]
     tracker_latency = recording.sidecar.get("latency") or {}
     row = {
-        "failed": None,
-        "source": case.source,
-        "transport": case.transport,
-        "profile": case.profile or "pose (7 channels)",
-        "faults": case.faults,
-        "rate_hz": rate_hz,
-        "duration_s": duration_s,
+        **case_fields(case, rate_hz, duration_s),
         "sent": len(intact) + damaged,
         "damaged_sent": damaged,
         "lost_sent": lost,
@@ -232,9 +226,9 @@ def wake_floor(rate_hz: float, duration_s: float, folder: Path) -> float:
     return cpu_s / max(records, 1.0) * 1e6
 
 
-def failed_case(case: Case, rate_hz: float, duration_s: float, error: Exception) -> dict[str, Any]:
-    """The row of a case that could not run: what it was, and why."""
-    return {"failed": str(error), "source": case.source, "transport": case.transport, "profile": case.profile or "pose (7 channels)",
+def case_fields(case: Case, rate_hz: float, duration_s: float, failed: str | None = None) -> dict[str, Any]:
+    """A case's row as far as what it is goes, and why it could not run (`failed`; None: it ran)."""
+    return {"failed": failed, "source": case.source, "transport": case.transport, "profile": case.profile or "pose (7 channels)",
             "faults": case.faults, "rate_hz": rate_hz, "duration_s": duration_s}  # fmt: skip
 
 
@@ -303,7 +297,7 @@ def run(args: argparse.Namespace, context: Context) -> list[dict[str, Any]]:
             row = run_case(case, args.rate, args.duration, context.folder / f"case{index}", context.log)
         except RigError as error:
             context.log(f"{case.source}/{case.transport}/{case.profile or 'pose'} faults {case.faults}: FAILED: {error}")
-            row = failed_case(case, args.rate, args.duration, error)
+            row = case_fields(case, args.rate, args.duration, str(error))
         rows.append({**row, "load_average_1min": load, "wake_floor_us": floor, "stolen_cpu_pct": stolen_pct(before, cpu_ticks())})
     progress(len(every), len(every))
     return rows
@@ -339,13 +333,10 @@ def table(rows: list[dict[str, Any]]) -> str:
 
 def plot(rows: list[dict[str, Any]], path: Path) -> None:
     """CPU per sample and added latency (median and 95th percentile) per case that ran."""
-    from matplotlib.figure import Figure
-
     rows = [r for r in rows if r["failed"] is None]
     labels = ["\n".join([f"{r['source']}/{r['transport']}", *r["faults"].split(",")]) for r in rows]
     x = np.arange(len(rows))
-    figure = Figure(figsize=(max(6.0, 1.6 * len(rows)) + 2.5, 7.0))
-    cost, latency = figure.subplots(2, 1, sharex=True)
+    figure, (cost, latency) = new_figure((max(6.0, 1.6 * len(rows)) + 2.5, 7.0), nrows=2, ncols=1, sharex=True)
     cost.bar(x - 0.2, [r["reading_us_per_sample"] for r in rows], width=0.4, color="tab:blue", label="reading")
     cost.bar(x + 0.2, [r["us_per_sample"] for r in rows], width=0.4, color="tab:gray", label="whole recording process")
     cost.plot(x, [r["wake_floor_us"] for r in rows], "o", color="tab:red", label="bare thread woken per record")

@@ -38,8 +38,6 @@ SUBJECT = Command(
     help="the serial and LSL tracker sources fed by the emulators: loss, fabrication, CPU per sample, added latency",
     bench=bench_in("trackers"),
     options=_options,
-    description=__doc__.split("\n\n")[0],
     outputs={"json": "write the rows as a JSON list", "plot": "plot CPU per sample and latency per case"},
     runs="keep the recordings and emulator logs here (default: a temporary folder)",
 )
-MODES: tuple[Command, ...] = ()

@@ -21,7 +21,7 @@ import numpy as np
 
 from rig.bench import renderer_plots
 from rig.bench.contract import Bench, Context, cell, given
-from rig.bench.renderer_latency import check_predictors, failed_figures, film_latency, run_config
+from rig.bench.renderer_latency import check_predictors, failed_figures, film_latency
 from rig.bench.renderer_rows import every_row_failed
 from rig.bench.renderer_setup import QUALITY_FIGURES, machine_name, open_warp, scene_setup, warp_renderer
 from rig.bench.renderer_specs import BenchGrid
@@ -60,7 +60,7 @@ def untimed_row(spec: VariantSpec, variant: str, triangles: int, reason: str, ma
     """The row of a variant on a load that could not be timed: no figures, failed with `reason`."""
     run = spec.grid.latency_run(variant, triangles, spec.grid.predictor, load=spec.load)
     return {
-        **failed_figures(run_config(run), reason), **dict.fromkeys(QUALITY_FIGURES), "spec": variant, "renderer": "warp",
+        **failed_figures(run.config, reason), **dict.fromkeys(QUALITY_FIGURES), "spec": variant, "renderer": "warp",
         "rate_ratio": spec.grid.ratios[0], "load": spec.load, "server_ms_median": None, "client_ms_median": None,
         "direct_latency_ms": None, "latency_saved_ms": None, "machine": machine,
     }  # fmt: skip

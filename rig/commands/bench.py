@@ -72,12 +72,15 @@ def run(subject: Command, args: argparse.Namespace) -> int:
     return 0
 
 
-def add_subject(benchmarks: argparse._SubParsersAction, subject: Command, modes: tuple[Command, ...] = ()) -> None:
-    """`rig bench SUBJECT`: its modes' flags, outputs, spec file, options (its modes' too), runs folder and executor."""
+def add_subject(
+    benchmarks: argparse._SubParsersAction, subject: Command, modes: tuple[Command, ...] = (), description: str = ""
+) -> None:
+    """`rig bench SUBJECT`, described by `description`: its modes' flags, outputs, spec file, options
+    (its modes' too), runs folder and executor."""
     files = subject.spec_file
     own = files.default if files is not None and files.default is not None else "its settings' defaults"
     where = f" Its spec: {own} (--quick: {files.quick.name}); --spec runs an edited copy." if files else ""
-    parser = benchmarks.add_parser(subject.name, help=subject.help, description=subject.description + where)
+    parser = benchmarks.add_parser(subject.name, help=subject.help, description=description + where)
     if modes:
         chosen = parser.add_mutually_exclusive_group()
         for mode in modes:
@@ -106,4 +109,4 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     benchmarks = parser.add_subparsers(dest="bench", required=True, metavar="SUBJECT")
     for module in SUBJECTS:
         declared = importlib.import_module(f"rig.bench.{module}")
-        add_subject(benchmarks, declared.SUBJECT, declared.MODES)
+        add_subject(benchmarks, declared.SUBJECT, getattr(declared, "MODES", ()), declared.__doc__.split("\n\n")[0])

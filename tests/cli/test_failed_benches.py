@@ -46,7 +46,7 @@ def test_a_tracker_bench_whose_every_emulator_failed_writes_its_rows_and_exits_2
 
 def test_a_tracker_case_that_failed_is_a_row_beside_those_that_ran() -> None:
     ran = {"failed": None, "recorded": 10}
-    failed = trackers.failed_case(trackers.cases(1.0)[0], 1000.0, 2.0, RigError("no pty"))
+    failed = trackers.case_fields(trackers.cases(1.0)[0], 1000.0, 2.0, "no pty")
     assert trackers.every_case_failed([failed, ran]) is None
     assert trackers.every_case_failed([failed, {"failed": None, "recorded": 0}]) is not None
     assert {name for name, met in trackers.targets([failed]).items() if met is not None} == {"every case ran"}
@@ -329,7 +329,7 @@ def test_a_warp_variant_that_cannot_be_opened_is_a_failed_row_beside_the_others(
         return opened(variant, *args)
 
     monkeypatch.setattr(warp_variants, "open_warp", two_views_refused)
-    monkeypatch.setattr(warp_variants, "film_latency", lambda run, *_: renderer_latency.failed_figures(renderer_latency.run_config(run), "not filmed here"))
+    monkeypatch.setattr(warp_variants, "film_latency", lambda run, *_: renderer_latency.failed_figures(run.config, "not filmed here"))
     out, plot = tmp_path / "variants.json", tmp_path / "variants.png"
     code, printed, err = run_rig(["bench", "renderers", "--quick", "--variants", "--json", str(out), "--plot", str(plot)], capsys)
     _assert_exits_2_saying(code, err, "every one of the 2 rows failed")

@@ -1,7 +1,6 @@
 """`rig bench analyser --quick`: the whole benchmark on three tiny simulated videos; its spec (a
 sweep), and `rig sweep` on it giving the bench's rows."""
 
-import argparse
 import json
 import tomllib
 from collections import Counter
@@ -11,24 +10,19 @@ import pytest
 
 from rig.bench import analyser, analyser_settings
 from rig.bench.contract import Context
-from rig.cli import main
-from rig.commands import bench
+from rig.cli import build_parser, main
 from rig.service.sweep import SweepPoint, read_sweep
 from rig.sim.placement import placement
 
-
-@pytest.fixture
-def parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rig")
-    bench.add_parser(parser.add_subparsers())
-    return parser
+RIG_BENCH = build_parser(["bench"])
+"""`rig`'s command line with its bench command."""
 
 
 def test_quick_bench_reports_every_method_with_errors_coverage_and_speed(
-    parser: argparse.ArgumentParser, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out, plot = tmp_path / "bench.json", tmp_path / "bench.png"
-    args = parser.parse_args(["bench", "analyser", "--quick", "--json", str(out), "--plot", str(plot)])
+    args = RIG_BENCH.parse_args(["bench", "analyser", "--quick", "--json", str(out), "--plot", str(plot)])
     assert args.func(args) == 0
     report = json.loads(out.read_text())
     assert set(report["summary"]) == {"fft", "xcorr", "sinefit", "bayes"}

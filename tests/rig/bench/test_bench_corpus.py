@@ -10,7 +10,7 @@ import pytest
 from predictors import Trace, write_trace
 from predictors.synthetic import head_motion
 from rig.errors import ConfigError
-from tests.rig.bench.test_bench_predictors import parser
+from tests.rig.bench.test_bench_predictors import RIG_BENCH
 
 
 def corpus(folder):
@@ -26,7 +26,7 @@ def corpus(folder):
 
 def run(tmp_path, *extra):
     corpus(tmp_path)
-    args = parser().parse_args(["bench", "predictors", "--corpus", str(tmp_path), "--predictor", "hold", "--predictor", "kalman-cv",
+    args = RIG_BENCH.parse_args(["bench", "predictors", "--corpus", str(tmp_path), "--predictor", "hold", "--predictor", "kalman-cv",
                                 "--horizons-ms", "20,50", "--timing-repeats", "1", *extra])  # fmt: skip
     return args.func(args)
 
@@ -75,7 +75,7 @@ def test_the_corpus_bench_refuses_other_traces(tmp_path, extra, message):
 
 
 def test_cross_validation_needs_a_corpus():
-    args = parser().parse_args(["bench", "predictors", "--cross-validate", "--predictor", "hold"])
+    args = RIG_BENCH.parse_args(["bench", "predictors", "--cross-validate", "--predictor", "hold"])
     with pytest.raises(ConfigError, match="need --corpus DIR"):
         args.func(args)
 
@@ -87,7 +87,7 @@ def test_a_manifest_given_labels_the_corpus(tmp_path, capsys):
             "hmd_user9.csv,vive,dee,,", "arm_robot_1.csv,quest,robot,,yes"]  # fmt: skip
     manifest = tmp_path / "labels.csv"
     manifest.write_text("file,device,person,scene,apart\n" + "\n".join(rows) + "\n")
-    args = parser().parse_args(["bench", "predictors", "--corpus", str(tmp_path), "--manifest", str(manifest), "--predictor", "hold",
+    args = RIG_BENCH.parse_args(["bench", "predictors", "--corpus", str(tmp_path), "--manifest", str(manifest), "--predictor", "hold",
                                 "--horizons-ms", "50", "--timing-repeats", "0", "--cross-validate", "--json", str(tmp_path / "out.json")])  # fmt: skip
     assert args.func(args) == 0
     record = json.loads((tmp_path / "out.json").read_text())

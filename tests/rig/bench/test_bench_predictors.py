@@ -1,6 +1,5 @@
 """`rig bench predictors` on tiny traces: tables, ratios to constant velocity, leave-one-out, JSON and plot."""
 
-import argparse
 import json
 import math
 
@@ -12,20 +11,17 @@ from predictors import quaternion as quat
 from predictors.synthetic import head_motion
 from rig.bench import predictor_scores
 from rig.bench import predictors as bench
-from rig.commands import bench as bench_command
+from rig.cli import build_parser
 
-
-def parser() -> argparse.ArgumentParser:
-    root = argparse.ArgumentParser(prog="rig")
-    bench_command.add_parser(root.add_subparsers(dest="command", required=True))
-    return root
+RIG_BENCH = build_parser(["bench"])
+"""`rig`'s command line with its bench command."""
 
 
 def test_bench_on_a_tiny_trace_prints_the_tables_and_writes_json_and_plot(tmp_path, capsys):
     t = np.arange(120) / 60.0
     trace = Trace.from_samples("tiny", t, np.outer(t, [0.2, 0.0, 0.0]), quat.from_rotation_vector(np.outer(t, [0, 1.0, 0])))
     write_trace(tmp_path / "tiny.csv", trace)
-    args = parser().parse_args([
+    args = RIG_BENCH.parse_args([
         "bench", "predictors", "--trace", str(tmp_path / "tiny.csv"), "--predictor", "slerp", "--predictor", "kalman-cv",
         "--predictor", "desp:position_alpha=0.4", "--horizons-ms", "0,50", "--timing-repeats", "1",
         "--json", str(tmp_path / "out.json"), "--plot", str(tmp_path / "out.png"),
@@ -46,7 +42,7 @@ def test_bench_on_a_tiny_trace_prints_the_tables_and_writes_json_and_plot(tmp_pa
 
 def test_constant_velocity_is_always_run_as_the_baseline(tmp_path, capsys):
     write_trace(tmp_path / "head.csv", head_motion(2.0, 60.0, seed=1))
-    args = parser().parse_args(["bench", "predictors", "--trace", str(tmp_path / "head.csv"), "--predictor", "hold",
+    args = RIG_BENCH.parse_args(["bench", "predictors", "--trace", str(tmp_path / "head.csv"), "--predictor", "hold",
                                 "--horizons-ms", "20", "--plot-horizon-ms", "20", "--timing-repeats", "0"])  # fmt: skip
     assert args.func(args) == 0
     assert "| head | slerp |" in capsys.readouterr().out
@@ -56,31 +52,34 @@ def test_ratios_are_errors_over_constant_velocity_and_their_geometric_mean():
     traces = [head_motion(3.0, 60.0, seed=s).with_noise(0.001, math.radians(0.2), seed=s) for s in (1, 2)]
     traces = [Trace.from_samples(f"head{k}", tr.t, tr.position, tr.orientation) for k, tr in enumerate(traces)]
     results = bench.evaluate_all(traces, [("slerp", {}), ("hold", {})], [20.0, 50.0], timing_repeats=1)
-    ratios = {entry.predictor: entry for entry in predictor_scores.ratios(results, [20.0, 50.0])}
+    record = predictor_scores.ratios_record(predictor_scores.scores_of(results, [20.0, 50.0]))
+    ratios = {entry["predictor"]: entry for entry in record}
     by = {(r.trace, r.predictor): r for r in results}
     for trace in ("head0", "head1"):
         expected = by[(trace, "hold")].at(50.0).angular_rms_deg / by[(trace, "slerp")].at(50.0).angular_rms_deg
-        assert ratios["hold"].angular[trace][50.0] == pytest.approx(expected)
-        assert ratios["slerp"].angular[trace][50.0] == 1.0
-    hold = ratios["hold"]
-    assert hold.geometric_mean("angular", 50.0) == pytest.approx(math.sqrt(hold.angular["head0"][50.0] * hold.angular["head1"][50.0]))
-    assert hold.worst("angular", 50.0) == max(hold.angular["head0"][50.0], hold.angular["head1"][50.0])
+        assert ratios["hold"]["angular"][trace]["50"] == pytest.approx(expected)
+        assert ratios["slerp"]["angular"][trace]["50"] == 1.0
+        assert ratios["hold"]["us_per_update"][trace] == by[(trace, "hold")].us_per_update
+    hold = ratios["hold"]["angular"]
+    geometric_mean = math.sqrt(hold["head0"]["50"] * hold["head1"]["50"])
+    assert ratios["hold"]["geometric_mean"]["angular"]["50"] == pytest.approx(geometric_mean)
+    assert ratios["hold"]["worst"]["angular"]["50"] == max(hold["head0"]["50"], hold["head1"]["50"])
 
 
 def test_a_trace_without_position_has_no_position_ratio():
     trace = head_motion(2.0, 60.0, seed=3)
     still = Trace.from_samples("still", trace.t, np.zeros((len(trace), 3)), trace.orientation)
     results = bench.evaluate_all([still], [("slerp", {}), ("adaptive", {})], [50.0], timing_repeats=0)
-    entry = predictor_scores.ratios(results, [50.0])[1]
-    assert math.isnan(entry.position["still"][50.0]) and math.isnan(entry.geometric_mean("position", 50.0))
-    assert entry.to_dict([50.0])["position"]["still"]["50"] is None
+    entry = predictor_scores.ratios_record(predictor_scores.scores_of(results, [50.0]))[1]
+    assert entry["position"]["still"]["50"] is None and entry["geometric_mean"]["position"]["50"] is None
+    assert entry["angular"]["still"]["50"] > 0.0
 
 
 @pytest.mark.slow
 def test_leave_one_out_tunes_on_the_others_and_scores_the_one_held_out(tmp_path, capsys):
     for seed in (4, 5):
         write_trace(tmp_path / f"head{seed}.csv", head_motion(4.0, 60.0, seed=seed).with_noise(0.001, math.radians(0.3), seed=seed))
-    args = parser().parse_args([
+    args = RIG_BENCH.parse_args([
         "bench", "predictors", "--trace", str(tmp_path / "head4.csv"), "--trace", str(tmp_path / "head5.csv"),
         "--predictor", "desp", "--horizons-ms", "50", "--timing-repeats", "0", "--leave-one-out", "desp",
         "--tune-iterations", "3", "--json", str(tmp_path / "out.json"),
@@ -95,9 +94,9 @@ def test_leave_one_out_tunes_on_the_others_and_scores_the_one_held_out(tmp_path,
 
 def test_leave_one_out_needs_a_tunable_predictor_and_two_traces(tmp_path):
     with pytest.raises(SystemExit):
-        parser().parse_args(["bench", "predictors", "--leave-one-out", "adaptive"])
+        RIG_BENCH.parse_args(["bench", "predictors", "--leave-one-out", "adaptive"])
     write_trace(tmp_path / "head.csv", head_motion(2.0, 60.0, seed=1))
-    args = parser().parse_args(["bench", "predictors", "--trace", str(tmp_path / "head.csv"), "--predictor", "desp",
+    args = RIG_BENCH.parse_args(["bench", "predictors", "--trace", str(tmp_path / "head.csv"), "--predictor", "desp",
                                 "--horizons-ms", "50", "--timing-repeats", "0", "--leave-one-out", "desp"])  # fmt: skip
     with pytest.raises(Exception, match="at least two traces"):
         args.func(args)
@@ -111,7 +110,7 @@ def test_the_default_traces_are_pendulum_synthetic_head_and_both_recordings():
 
 
 def test_stress_runs_the_stress_streams(tmp_path, capsys):
-    args = parser().parse_args(["bench", "predictors", "--stress", "--duration", "1", "--predictor", "hold",
+    args = RIG_BENCH.parse_args(["bench", "predictors", "--stress", "--duration", "1", "--predictor", "hold",
                                 "--horizons-ms", "20", "--plot-horizon-ms", "20", "--timing-repeats", "0"])  # fmt: skip
     assert args.func(args) == 0
     out = capsys.readouterr().out

@@ -17,29 +17,26 @@ from rig.bench.renderer_setup import scene_setup
 from rig.bench.renderer_specs import QUICK_SPEC, BenchGrid, read_grid
 from rig.bench.renderers import LATENCY_FIELDS, ROW_FIELDS
 from rig.bench.seed_table import SEED_SOURCE, SEED_TABLE_2, crossover, seed_rows
-from rig.bench.spec_reader import read_spec
-from rig.cli import EXIT_USER_ERROR, main
+from rig.cli import EXIT_USER_ERROR, build_parser, main
 from rig.commands import bench
+from rig.errors import ConfigError
 from rig.service.sweep import read_sweep
 from rig.sim.camera import CameraConfig
 
-QUICK_GRID = read_spec(BenchGrid, QUICK_SPEC)
+RIG_BENCH = build_parser(["bench"])
+"""`rig`'s command line with its bench command."""
+
+QUICK_GRID = read_grid(QUICK_SPEC)
 
 
 def _grid(args: argparse.Namespace) -> BenchGrid:
     return bench.spec(renderers_settings.SUBJECT, args)
 
 
-def bench_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rig")
-    bench.add_parser(parser.add_subparsers(dest="command", required=True))
-    return parser
-
-
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory: pytest.TempPathFactory):
     out = tmp_path_factory.mktemp("bench")
-    args = bench_parser().parse_args(
+    args = RIG_BENCH.parse_args(
         ["bench", "renderers", "--quick", "--json", str(out / "rows.json"), "--csv", str(out / "rows.csv"), "--plot", str(out / "bench.png"),
          "--runs", str(out / "runs")]
     )  # fmt: skip
@@ -140,12 +137,12 @@ def test_the_specs_are_package_data():
 def test_the_options_override_the_spec(tmp_path):
     spec = tmp_path / "grid.toml"
     spec.write_text('triangles = [500]\nwarp = "warp:recon=grid"\nserver_ms = 3.0\npredictor = "kalman-cv"\n')
-    args = bench_parser().parse_args(["bench", "renderers", "--spec", str(spec)])
+    args = RIG_BENCH.parse_args(["bench", "renderers", "--spec", str(spec)])
     assert _grid(args) == BenchGrid(triangles=(500,), warp="warp:recon=grid", server_ms=3.0, predictor="kalman-cv")
-    args = bench_parser().parse_args(["bench", "renderers", "--spec", str(spec), "--triangles", "7,9", "--resolutions", "64x48",
+    args = RIG_BENCH.parse_args(["bench", "renderers", "--spec", str(spec), "--triangles", "7,9", "--resolutions", "64x48",
                                       "--ratios", "2", "--warp", "warp", "--server-ms", "1", "--predictor", "hold", "--direct-predictor", "slerp"])  # fmt: skip
     assert _grid(args) == BenchGrid(triangles=(7, 9), resolutions=((64, 48),), ratios=(2,), server_ms=1.0, predictor="hold", direct_predictor="slerp")
-    assert _grid(bench_parser().parse_args(["bench", "renderers", "--quick", "--ratios", "4"])).ratios == (4,)
+    assert _grid(RIG_BENCH.parse_args(["bench", "renderers", "--quick", "--ratios", "4"])).ratios == (4,)
 
 
 @pytest.mark.parametrize(
@@ -179,12 +176,18 @@ def test_a_bad_spec_is_one_line_and_exit_status_2(tmp_path, capsys, text, messag
 def test_bad_grid_options_are_rejected(capsys: pytest.CaptureFixture[str]):
     for bad in (["--resolutions", "640by480"], ["--ratios", "0"], ["--triangles", "ten"]):
         with pytest.raises(SystemExit):
-            bench_parser().parse_args(["bench", "renderers", *bad])
+            RIG_BENCH.parse_args(["bench", "renderers", *bad])
     assert "error" in capsys.readouterr().err
 
 
+def test_a_grid_no_machine_could_finish_in_a_day_is_refused_with_its_estimate():
+    assert read_grid(QUICK_SPEC).estimated_hours() < 1e-3
+    with pytest.raises(ConfigError, match=r"this grid would take about 2\d\d hours at the least, more than the 24 hours"):
+        BenchGrid(triangles=(100_000_000,), latency_duration_s=3600.0, refresh_hz=1000.0)
+
+
 def run_quick(out, mode: str, *extra: str) -> tuple[list[dict], str]:
-    args = bench_parser().parse_args(["bench", "renderers", "--quick", mode, "--json", str(out / "rows.json"), "--plot", str(out / "plot.png"), *extra])
+    args = RIG_BENCH.parse_args(["bench", "renderers", "--quick", mode, "--json", str(out / "rows.json"), "--plot", str(out / "plot.png"), *extra])
     assert args.func(args) == 0
     return json.loads((out / "rows.json").read_text())
 
@@ -215,7 +218,7 @@ def test_the_seed_table_probes_and_films_the_load_and_warp_it_is_given_and_says_
         return scene_setup(*args)
 
     def film(run, *args):
-        filmed.append((run.renderer, run.load))
+        filmed.append((run.config.renderer, run.config.scene_load))
         return film_latency(run, *args)
 
     monkeypatch.setattr(seed_table, "scene_setup", probe)

@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 
 from rig.bench import SUBJECTS
-from rig.bench.contract import Bench, Command, Context, SpecFile
+from rig.bench.contract import Bench, Command, Context, SpecFile, every_one
 from rig.commands import bench as runner
 from rig.errors import RigError
 
@@ -142,7 +142,7 @@ def test_every_registered_subject_and_mode_is_a_command():
         declared = importlib.import_module(f"rig.bench.{module}")
         subjects.append(declared.SUBJECT.name)
         assert parser.parse_args(["bench", declared.SUBJECT.name]).mode is declared.SUBJECT
-        for mode in declared.MODES:
+        for mode in getattr(declared, "MODES", ()):
             assert parser.parse_args(["bench", declared.SUBJECT.name, f"--{mode.name}"]).mode is mode
     assert subjects == ["analyser", "predictors", "renderers", "trackers", "batch", "live", "camera-calibration"]
     with pytest.raises(SystemExit):
@@ -152,6 +152,13 @@ def test_every_registered_subject_and_mode_is_a_command():
 @pytest.mark.parametrize("module", SUBJECTS)
 def test_every_subject_and_mode_loads_a_bench_that_keeps_the_contract(module: str):
     declared = importlib.import_module(f"rig.bench.{module}")
-    for command in (declared.SUBJECT, *declared.MODES):
+    for command in (declared.SUBJECT, *getattr(declared, "MODES", ())):
         assert isinstance(command.bench(), Bench)
     assert (declared.SUBJECT.bench().read_spec is not None) == (declared.SUBJECT.spec_file is not None)
+
+
+def test_every_one_says_so_only_where_every_item_has_a_reason():
+    refused = [{"refused": "too dark"}, {"refused": "no swing"}]
+    assert every_one(refused, "refused", "refused every one of the {count} films") == "refused every one of the 2 films (the first: too dark)"
+    assert every_one([*refused, {"refused": None}], "refused", "{count}") is None
+    assert every_one([], "refused", "{count}") is None

@@ -6,7 +6,6 @@ import math
 from pathlib import Path
 
 from rig.bench import trackers
-from rig.errors import RigError
 
 
 def test_a_clean_pty_case_counts_every_record_sent_and_measures_its_costs(tmp_path: Path) -> None:
@@ -31,7 +30,7 @@ def test_the_table_and_the_plot_show_every_row(tmp_path: Path) -> None:
         "reader_us_per_sample": 20.0, "us_per_sample": 70.0, "wake_floor_us": 18.0, "latency_ms_median": 0.1,
         "latency_ms_p95": 0.4, "stolen_cpu_pct": 2.5,
     }  # fmt: skip
-    failed = trackers.failed_case(trackers.cases(1.0)[3], 1000.0, 2.0, RigError("no LSL stream"))
+    failed = trackers.case_fields(trackers.cases(1.0)[3], 1000.0, 2.0, "no LSL stream")
     lines = trackers.table([row, {**row, "source": "lsl", "stolen_cpu_pct": None}, failed]).splitlines()
     assert len(lines) == 5 and "40.0 (20.0), 70.0 | 18.0 | 2.5 | 0.100, 0.400 |" in lines[2]
     assert "| 18.0 | n/a | 0.100" in lines[3]
@@ -52,7 +51,7 @@ def test_the_cpu_a_host_took_is_its_share_of_the_ticks_between_two_readings() ->
 
 def test_a_case_that_could_not_run_is_a_failed_row_with_its_reason(tmp_path: Path) -> None:
     case = trackers.Case("serial", "tcp", "binary-pose", "none")
-    failed = {**trackers.failed_case(case, 1000.0, 10.0, RigError("the tracker emulator did not start: no pty")), "load_average_1min": 1.0}
+    failed = {**trackers.case_fields(case, 1000.0, 10.0, "the tracker emulator did not start: no pty"), "load_average_1min": 1.0}
     assert trackers.table([failed]).splitlines()[2] == "| serial | tcp | binary-pose | none | failed: the tracker emulator did not start: no pty |"
     assert trackers.targets([failed])["every case ran"] is False
     assert set(trackers.targets([failed]).values()) == {None, False}
