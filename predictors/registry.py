@@ -27,6 +27,7 @@ from predictors.extrapolators import HoldLast, SlerpExtrapolator
 from predictors.kalman import KalmanCA, KalmanCV
 from predictors.params import ParamSet
 from predictors.pose import Pose, PoseSample
+from predictors.rls import RecursiveLeastSquares
 from predictors.split import Split
 
 
@@ -49,7 +50,8 @@ class Predictor(Protocol):
 _PREDICTORS: Mapping[str, Any] = MappingProxyType(
     {
         cls.name: cls
-        for cls in (HoldLast, SlerpExtrapolator, KalmanCV, KalmanCA, DoubleExponentialSmoothing, Auto, Adaptive, Split)
+        for cls in (HoldLast, SlerpExtrapolator, KalmanCV, KalmanCA, DoubleExponentialSmoothing, Auto, Adaptive, Split,
+                    RecursiveLeastSquares)
     }
 )
 

@@ -26,6 +26,8 @@ PREDICTOR_LINES = {
     "adaptive": "Trusts, per horizon, the candidate model whose realised errors on this stream have been smallest "
     "(`adaptive`, the default predictor); see `predictors.adaptive`",
     "split": "Position from `adaptive`, orientation from `kalman-cv`'s filter with a damped angular velocity (`split`)",
+    "rls": "Orientation from coefficients on the recent angular velocities learnt per horizon on the stream, position "
+    "from `adaptive` (`rls`); see `predictors.rls`",
 }
 """Each predictor (`predictors.names()`), in the registry's order."""
 DEFAULT_PREDICTOR = ("default", "adaptive")

@@ -15,7 +15,7 @@ def test_every_public_name_is_the_package_s_own():
 
 
 def test_known_names():
-    assert names() == ("hold", "slerp", "kalman-cv", "kalman-ca", "desp", "auto", "adaptive", "split")
+    assert names() == ("hold", "slerp", "kalman-cv", "kalman-ca", "desp", "auto", "adaptive", "split", "rls")
 
 
 def test_default_is_another_name_for_adaptive():
