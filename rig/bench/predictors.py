@@ -97,14 +97,18 @@ def _has(scores: CorpusScores, part: str, trace: str | None = None) -> bool:
 
 def ratio_table(scores: CorpusScores, part: str, horizons: Sequence[float]) -> str:
     """A Markdown table of one part's ratios to constant velocity: per predictor, each trace's
-    ratios at `horizons` (ms) joined by " / ", their geometric mean and worst, and the median cost."""
-    traces = [t for t in scores.evaluations[scores.candidates[0]] if _has(scores, part, t)]
+    ratios at `horizons` (ms) joined by " / ", their geometric mean and worst, and the median cost.
+    A predictor that failed on a trace has "failed" there, and its mean and worst say over how many
+    of the traces they are."""
+    traces = [t for t in scores.evaluations[scores.baseline] if _has(scores, part, t)]
     head = "| predictor | " + " | ".join(traces) + " | geometric mean | worst | us/update (median) |"
     rows = [head, "|" + "---|" * (len(traces) + 4)]
     for name, on in scores.evaluations.items():
-        cells = [" / ".join(f"{scores.ratio(name, t, part, h):.3f}" for h in horizons) for t in traces]
+        cells = [" / ".join(f"{scores.ratio(name, t, part, h):.3f}" for h in horizons) if t in on else "failed" for t in traces]
+        ran = [t for t in traces if t in on]
+        over_ran = "" if len(ran) == len(traces) else f" ({len(ran)} of {len(traces)} traces)"
         for over in (scores.group_ratio, scores.worst):
-            cells.append(" / ".join(f"{over(name, list(on), part, h):.3f}" for h in horizons))
+            cells.append(" / ".join(f"{over(name, ran, part, h):.3f}" for h in horizons) + over_ran)
         cost = float(np.median([evaluation.us_per_update for evaluation in on.values()]))
         rows.append(f"| {name} | " + " | ".join(cells) + f" | {cost:.1f} |")
     return "\n".join(rows)

@@ -115,3 +115,14 @@ def test_stress_runs_the_stress_streams(tmp_path, capsys):
     assert args.func(args) == 0
     out = capsys.readouterr().out
     assert "| head-1000Hz-noisy | hold |" in out and "| stops-60Hz | slerp |" in out
+
+
+def test_a_predictor_that_failed_on_one_trace_has_failed_there_and_its_mean_says_over_how_many():
+    traces = [head_motion(2.0, 60.0, seed=seed).with_noise(0.001, math.radians(0.3), seed=seed) for seed in (1, 2)]
+    traces = [Trace.from_samples(f"head{k}", t.t, t.position, t.orientation) for k, t in enumerate(traces)]
+    results = predictor_scores.evaluate_all(traces, [("slerp", {}), ("hold", {})], [50.0], 0)
+    scores = predictor_scores.scores_of([r for r in results if (r.predictor, r.trace) != ("hold", "head1")], [50.0])
+    rows = {row.split(" | ")[0].strip("| "): row for row in bench.ratio_table(scores, "angular", [50.0]).splitlines()[2:]}
+    hold_on_head0 = scores.ratio("hold", "head0", "angular", 50.0)
+    assert rows["hold"].startswith(f"| hold | {hold_on_head0:.3f} | failed | {hold_on_head0:.3f} (1 of 2 traces) | ")
+    assert rows["slerp"].startswith("| slerp | 1.000 | 1.000 | 1.000 | 1.000 | ")
