@@ -28,10 +28,11 @@ LOAD_TO_CLIP = np.eye(4)
 
 
 class DirectRenderer:
-    """Draws a bright sphere at the predicted position in front of dim load geometry (`rig.render.scene`).
+    """Draws a bright sphere at the predicted position in front of dim load geometry.
 
-    The sphere is rotation-symmetric, so only the pose's position moves it. A frame's cost is the
-    wall time of its GL work on this machine, from the first draw call until the image is read back.
+    The scene is `rig.render.scene`'s, as the warp renderer's. The sphere is rotation-symmetric, so
+    only the pose's position moves it. A frame's cost is the wall time of its GL work on this
+    machine, from the first draw call until the image is read back.
     """
 
     name = "direct"
