@@ -8,6 +8,8 @@ set -euo pipefail
 runs=${1:-10}
 out=${2:-$(mktemp -d -t rig-self-test-load-XXXXXX)}
 mkdir -p "$out"
+command -v stress-ng > /dev/null || { echo "stress-ng is not installed (Debian: stress-ng)" >&2; exit 2; }
+started=$(date +%s)
 stress-ng --cpu 1 --quiet &
 hog=$!
 trap 'kill "$hog"' EXIT
@@ -20,6 +22,9 @@ for duration in 10 20; do
     echo "$duration $i $status" >>"$out/statuses.txt"
   done
 done
+# The hog's share of a core over the runs: it loaded the machine as said, or the tally means nothing.
+hog_cpu_s=$(ps -o cputimes= --ppid "$hog" | awk '{s += $1} END {print s + 0}')
+echo "CPU hog: $hog_cpu_s s of CPU in $(($(date +%s) - started)) s"
 python - "$out" <<'EOF'
 import json, sys
 from pathlib import Path
