@@ -11,6 +11,7 @@ from typing import Any, Callable, Sequence
 
 from predictors import Evaluation, PredictorError, Trace, evaluate
 from predictors.cross_validation import PARTS, CorpusScores
+from rig import interrupts
 from rig.bench.predictors_settings import BASELINE
 
 
@@ -135,7 +136,8 @@ class HeldOut:
 
 def _held_out(name: str, trace: Trace, others: Sequence[Trace], horizon_ms: float, max_iterations: int) -> HeldOut:
     """`name` tuned on `others` and scored on `trace`, against its defaults and the baseline."""
-    from predictors.tuning import tune  # imports JAX: only when asked
+    with interrupts.deferred():  # an interrupt inside jaxlib's extension init would abort the process
+        from predictors.tuning import tune  # imports JAX: only when asked
 
     horizon = horizon_ms / 1e3
     params = tune(name, others, horizon, max_iterations=max_iterations).params

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 import numpy as np
 
 from predictors import DEFAULT, Trace, evaluate, resolve, write_params
+from rig import interrupts
 from rig.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -155,7 +156,8 @@ def tune(
     """Fit `name` from `start` on `train` at `horizon_s` and score it, its starting parameters, the
     baseline and the default predictor on both parts; `progress(done, total)` follows the fit and
     the scoring."""
-    from predictors.tuning import tune as fit  # imports JAX: only when tuning
+    with interrupts.deferred():  # an interrupt inside jaxlib's extension init would abort the process
+        from predictors.tuning import tune as fit  # imports JAX: only when tuning
 
     scoring_steps = len(PARTS) * 4
     fit_steps = [max_iterations]
