@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from math import exp, log, sqrt
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Sequence
 
 from predictors import scalar_quaternion as squat
 from predictors.checks import horizon, read_sample
@@ -50,6 +50,21 @@ SCORES_PER_SAMPLE = 2
 SCORE_EVERY = 1.0  # a horizon is scored at most once per this many horizons
 _LOG_HORIZONS = tuple(log(h) for h in HORIZONS_S)
 _SCORE_GAPS = tuple(SCORE_EVERY * h for h in HORIZONS_S)
+
+
+def due_horizons(lasts: Sequence[float], t: float, at_most: int) -> list[tuple[float, int]]:
+    """The (at most `at_most`) horizons longest unscored at `t`, each due once per `SCORE_EVERY`
+    horizons since `lasts[k]`, when it was last scored: (last scored, index of the horizon)."""
+    return sorted((last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k])[:at_most]
+
+
+def overtaken(anchors: Sequence[tuple[Any, ...]], i: int, ahead: float, t: float) -> int:
+    """From anchor `i` on, the latest anchor before the newest (each a tuple whose first value is
+    its time) whose prediction `ahead` seconds on the time `t` has passed."""
+    newest = len(anchors) - 1
+    while i + 1 < newest and anchors[i + 1][0] + ahead <= t:
+        i += 1
+    return i
 # History kept beyond the oldest anchor still needed, before the list is trimmed (amortised).
 _TRIM_AFTER = 256
 
@@ -205,7 +220,7 @@ class Adaptive:
         turned by r from the one before) has just overtaken. Each score weighs the seconds since
         its horizon was last scored."""
         lasts = self._last_scored
-        due = sorted((last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k])[:SCORES_PER_SAMPLE]
+        due = due_horizons(lasts, t, SCORES_PER_SAMPLE)
         history = self._history
         newest = len(history) - 1
         t_before, p_before, _, _ = history[newest - 1]
@@ -215,10 +230,7 @@ class Adaptive:
         for last, k in due:
             score = self._scores[k]
             ahead = score.horizon
-            i = self._anchors[k]
-            while i + 1 < newest and history[i + 1][0] + ahead <= t:
-                i += 1
-            self._anchors[k] = i
+            self._anchors[k] = i = overtaken(history, self._anchors[k], ahead, t)
             t_anchor, p_anchor, q_anchor, estimates = history[i]
             target = t_anchor + ahead
             if not t_before < target <= t:

@@ -45,7 +45,7 @@ from operator import mul
 from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
-from predictors.adaptive import GAIN_PRIOR, HORIZONS_S, MARGIN, MEMORY, SCORE_EVERY, Adaptive
+from predictors.adaptive import GAIN_PRIOR, HORIZONS_S, MARGIN, MEMORY, Adaptive, due_horizons, overtaken
 from predictors.checks import horizon, read_sample
 from predictors.errors import PredictorError
 from predictors.extrapolators import MIN_INTERVAL
@@ -55,7 +55,6 @@ from predictors.pose import Pose, PoseSample
 
 Vector = tuple[float, float, float]
 _LOG_HORIZONS = tuple(log(h) for h in HORIZONS_S)
-_SCORE_GAPS = tuple(SCORE_EVERY * h for h in HORIZONS_S)
 _TRIM_AFTER = 256
 SCORES_PER_SAMPLE = 1  # horizons learnt from per sample: adaptive's two cost a third more here for the same errors
 # A floor on the prior's diagonal, relative to A's trace: keeps the solve defined on a stream with
@@ -174,7 +173,7 @@ class RecursiveLeastSquares:
         from an earlier anchor the newest sample (which turned by r from the one before) has just
         overtaken; the truth between the two newest samples as `adaptive` takes it."""
         lasts = self._last_scored
-        due = sorted((last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k])[:SCORES_PER_SAMPLE]
+        due = due_horizons(lasts, t, SCORES_PER_SAMPLE)
         anchors = self._anchors
         newest = len(anchors) - 1
         t_before = anchors[newest - 1][0]
@@ -183,10 +182,7 @@ class RecursiveLeastSquares:
         for last, k in due:
             learnt = self._horizons[k]
             ahead = learnt.horizon
-            i = self._next[k]
-            while i + 1 < newest and anchors[i + 1][0] + ahead <= t:
-                i += 1
-            self._next[k] = i
+            self._next[k] = i = overtaken(anchors, self._next[k], ahead, t)
             t_anchor, q_anchor, features = anchors[i]
             target = t_anchor + ahead
             if features is None or not t_before < target <= t:
