@@ -19,6 +19,7 @@ import select
 import socket
 import time
 import tty
+from abc import ABC, abstractmethod
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
@@ -34,7 +35,7 @@ READER_GRACE_S = 0.1
 POLL_S = 0.02
 
 
-class _ByteSink:
+class _ByteSink(ABC):
     """What a pty and a TCP sink share: records encoded as the profile says, their bytes damaged as the
     faults say, written through an `Outbox` with waits of at most `write_wait_s`."""
 
@@ -47,8 +48,9 @@ class _ByteSink:
         self._write_wait_s = write_wait_s
         self._outbox: Outbox | None = None
 
+    @abstractmethod
     def _reader_gone(self) -> bool:
-        raise NotImplementedError
+        """Whether the reader has gone (a pty's every slave closed, a TCP client disconnected)."""
 
     def send(self, emissions: Sequence[Emission], rate_hz: float) -> tuple[list[bool], float]:
         """Writes the records at once, as many as the port takes: (damaged per record written, the
