@@ -49,7 +49,7 @@ from rig.bench.predictor_scores import (
     FailedEvaluation, HeldOut, cost_ratios, evaluate_all, label, leave_one_out, ratios_record, scores_of,
 )
 from rig.errors import ConfigError
-from rig.service.tune import check_scorable, in_time_order
+from rig.service.tune import check_scorable, read_in_time_order
 from rig.sim.pendulum import Pendulum, PendulumConfig
 from rig.sim.tracker import TrackerConfig, measure
 
@@ -190,12 +190,9 @@ def run(args: argparse.Namespace, context: Context) -> Scores | CorpusRun:
         if args.trace or args.stress or args.leave_one_out:
             raise ConfigError("--corpus runs on the corpus's recordings alone: leave out --trace, --stress and --leave-one-out")
         return corpus_bench.run(args, context)
-    given = []
-    for path in args.trace or []:
-        trace, repaired = in_time_order(read_trace(path), args.repair)
-        given.append(trace)
-        if repaired is not None:
-            context.log(f"repaired {repaired}")
+    given, repaired = read_in_time_order(args.trace or [], args.repair)
+    for note in repaired:
+        context.log(f"repaired {note}")
     check_scorable(given, max(horizons) / 1e3)
     traces = given + (stress_streams(args.duration, args.seed) if args.stress else [])
     traces = traces or default_traces(args.duration, args.seed)

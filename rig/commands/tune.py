@@ -23,23 +23,9 @@ from rig.progress import ProgressBar
 from rig.tune_settings import TuneSettings
 
 if TYPE_CHECKING:
-    from predictors import Trace
     from rig.service import TuneReport
 
 EXIT_NOT_WRITTEN = 1
-
-
-def _read(paths: list[Path], repair: bool) -> tuple[list[Trace], list[str]]:
-    from predictors import read_trace
-    from rig.service.tune import in_time_order
-
-    traces, repaired = [], []
-    for path in paths:
-        trace, note = in_time_order(read_trace(path), repair)
-        traces.append(trace)
-        if note is not None:
-            repaired.append(note)
-    return traces, repaired
 
 
 def _table(report: TuneReport) -> str:
@@ -56,10 +42,10 @@ def _table(report: TuneReport) -> str:
 
 def _run(args: argparse.Namespace) -> int:
     from rig.service import split_traces, tune
-    from rig.service.tune import check_scorable
+    from rig.service.tune import check_scorable, read_in_time_order
 
-    traces, repaired = _read(args.trace, args.repair)
-    held_out, repaired_held_out = _read(args.held_out or [], args.repair)
+    traces, repaired = read_in_time_order(args.trace, args.repair)
+    held_out, repaired_held_out = read_in_time_order(args.held_out or [], args.repair)
     train, validation = split_traces(traces, held_out, args.split)
     check_scorable([*train, *validation], args.horizon_ms / 1e3)
     name, start = args.predictor

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 
-from predictors import DEFAULT, Trace, evaluate, resolve, write_params
+from predictors import DEFAULT, Trace, evaluate, read_trace, resolve, write_params
 from rig import interrupts
 from rig.errors import ConfigError
 
@@ -57,6 +57,17 @@ def in_time_order(trace: Trace, repair: bool) -> tuple[Trace, str | None]:
         )
     repaired = trace.in_time_order()
     return repaired, f"{trace.name}: {what}; sorted by time, {len(trace) - len(repaired)} repeated time(s) dropped"
+
+
+def read_in_time_order(paths: Sequence[Path], repair: bool) -> tuple[list[Trace], list[str]]:
+    """The trace files, each `in_time_order`, and what was repaired in them."""
+    traces, repaired = [], []
+    for path in paths:
+        trace, note = in_time_order(read_trace(path), repair)
+        traces.append(trace)
+        if note is not None:
+            repaired.append(note)
+    return traces, repaired
 
 
 def check_scorable(traces: Sequence[Trace], horizon_s: float) -> None:

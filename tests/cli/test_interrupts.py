@@ -54,7 +54,8 @@ class Run:
         self.folder.mkdir(parents=True, exist_ok=True)
         self._out = open(self.folder.parent / f"{self.folder.name}.stdout", "w")
         self._err = open(self.folder.parent / f"{self.folder.name}.stderr", "w")
-        env = {**os.environ, "PYTHONFAULTHANDLER": "1"}
+        # Unbuffered, so that what the command printed before a signal is in its file at once.
+        env = {**os.environ, "PYTHONFAULTHANDLER": "1", "PYTHONUNBUFFERED": "1"}
         self.process = subprocess.Popen([str(RIG), *self.argv], stdout=self._out, stderr=self._err, env=env)
         _STARTED.append(self)
 
@@ -95,6 +96,11 @@ class Run:
     @property
     def stderr(self) -> str:
         return (self.folder.parent / f"{self.folder.name}.stderr").read_text()
+
+    def printed(self, text: str) -> Callable[[], bool]:
+        """The moment the command has printed `text`: its own code runs, its handlers in place (a
+        signal before that, while a loaded machine still starts Python, is Python's to handle)."""
+        return lambda: text in (self.folder.parent / f"{self.folder.name}.stdout").read_text()
 
 
 def file_with_rows(path: Path, rows: int = 1) -> Callable[[], bool]:
@@ -228,7 +234,7 @@ def test_tune_stopped_while_compiling_or_fitting(wait_s: float, trace: Path, tmp
     out = tmp_path / "tuned" / "params.json"
     run = Run(["tune", "kalman-cv", "--trace", str(trace), "--horizon-ms", "30", "--max-iterations", "400", "--out", str(out)],
               tmp_path / "tuned")  # fmt: skip
-    if not run.wait_for(after(wait_s)):
+    if not run.wait_for(run.printed("tuning kalman-cv")) or not run.wait_for(after(wait_s)):
         pytest.fail(f"rig tune ended within {wait_s} s:\n{run.stderr}")
     code, _ = run.stop()
     assert_stopped_cleanly(run, code)
