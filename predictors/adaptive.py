@@ -58,6 +58,21 @@ def due_horizons(lasts: Sequence[float], t: float, at_most: int) -> list[tuple[f
     return sorted((last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k])[:at_most]
 
 
+def turn_at(
+    q_anchor: squat.Quaternion, q_now: squat.Quaternion, r: tuple[float, float, float], back: float
+) -> tuple[float, float, float]:
+    """The turn (a rotation vector) from the anchor's orientation to the truth at a target `back` of
+    the way from the newest sample towards the one before, the newest having turned by r from it:
+    the turn to the newest less that part of the last step, r + r x turn / 2 to second order."""
+    a0, a1, a2 = squat.rotation_vector_between(q_anchor, q_now)
+    r0, r1, r2 = r
+    return (
+        a0 - back * (r0 + 0.5 * (r1 * a2 - r2 * a1)),
+        a1 - back * (r1 + 0.5 * (r2 * a0 - r0 * a2)),
+        a2 - back * (r2 + 0.5 * (r0 * a1 - r1 * a0)),
+    )
+
+
 def overtaken(anchors: Sequence[tuple[Any, ...]], i: int, ahead: float, t: float) -> int:
     """From anchor `i` on, the latest anchor before the newest (each a tuple whose first value is
     its time) whose prediction `ahead` seconds on the time `t` has passed."""
@@ -225,7 +240,6 @@ class Adaptive:
         newest = len(history) - 1
         t_before, p_before, _, _ = history[newest - 1]
         p_now, q_now = self._position, self._orientation
-        r0, r1, r2 = r
         scored = []
         for last, k in due:
             score = self._scores[k]
@@ -235,15 +249,9 @@ class Adaptive:
             target = t_anchor + ahead
             if not t_before < target <= t:
                 continue
-            # The truth at the target, between the sample before and the newest: the turn from the
-            # anchor to the newest less the rest of the last step, r + r x turn / 2 to second order.
+            # The truth at the target, between the sample before and the newest.
             back = (t - target) / (t - t_before)
-            a0, a1, a2 = squat.rotation_vector_between(q_anchor, q_now)
-            turn = (
-                a0 - back * (r0 + 0.5 * (r1 * a2 - r2 * a1)),
-                a1 - back * (r1 + 0.5 * (r2 * a0 - r0 * a2)),
-                a2 - back * (r2 + 0.5 * (r0 * a1 - r1 * a0)),
-            )
+            turn = turn_at(q_anchor, q_now, r, back)
             moved = (
                 p_now[0] - back * (p_now[0] - p_before[0]) - p_anchor[0],
                 p_now[1] - back * (p_now[1] - p_before[1]) - p_anchor[1],

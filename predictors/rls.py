@@ -45,7 +45,7 @@ from operator import mul
 from typing import Any, ClassVar
 
 from predictors import scalar_quaternion as squat
-from predictors.adaptive import GAIN_PRIOR, HORIZONS_S, MARGIN, MEMORY, Adaptive, due_horizons, overtaken
+from predictors.adaptive import GAIN_PRIOR, HORIZONS_S, MARGIN, MEMORY, Adaptive, due_horizons, overtaken, turn_at
 from predictors.checks import horizon, read_sample
 from predictors.errors import PredictorError
 from predictors.extrapolators import MIN_INTERVAL
@@ -178,7 +178,6 @@ class RecursiveLeastSquares:
         newest = len(anchors) - 1
         t_before = anchors[newest - 1][0]
         q_now = self._orientation
-        r0, r1, r2 = r
         for last, k in due:
             learnt = self._horizons[k]
             ahead = learnt.horizon
@@ -187,13 +186,7 @@ class RecursiveLeastSquares:
             target = t_anchor + ahead
             if features is None or not t_before < target <= t:
                 continue
-            back = (t - target) / (t - t_before)
-            a0, a1, a2 = squat.rotation_vector_between(q_anchor, q_now)
-            turn = (
-                a0 - back * (r0 + 0.5 * (r1 * a2 - r2 * a1)),
-                a1 - back * (r1 + 0.5 * (r2 * a0 - r0 * a2)),
-                a2 - back * (r2 + 0.5 * (r0 * a1 - r1 * a0)),
-            )
+            turn = turn_at(q_anchor, q_now, r, (t - target) / (t - t_before))
             weight = min(t - last, self.max_gap) if last > -math.inf else min(t - t_before, ahead)
             lasts[k] = t
             self._learn(learnt, features, turn, weight)
