@@ -35,7 +35,7 @@ class IdImage:
 
     def read(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(colour (h, w, 4) uint8, object ID (h, w) int, window depth (h, w) float32), OpenGL rows
-        (row 0 at the bottom): the inputs of `rig.render.warp_reference.reference_warp`."""
+        (row 0 at the bottom): the inputs of the tests' numpy reference warp (`tests/rig/render/warp_reference.py`)."""
         w, h = self.size
         colour = np.frombuffer(self.colour.read(), dtype=np.uint8).reshape(h, w, 4)
         ids = np.frombuffer(self.object_id.read(), dtype=np.uint16).reshape(h, w).astype(np.int64)

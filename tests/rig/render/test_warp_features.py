@@ -18,7 +18,7 @@ from rig.render.warp import WarpRenderer
 from rig.render.warp_grid import GRID_TILE, grid_cells
 from rig.render.warp_holes import build_leaves, hole_blocks, leaves_hit
 from rig.render.warp_matrices import translation
-from rig.render.warp_reference import arbitrate_views, depth_slopes, hole_levels, lowpass_fill, reference_warp
+from tests.rig.render.warp_reference import arbitrate_views, depth_slopes, hole_levels, lowpass_fill, reference_warp
 from rig.render.warp_server import BACKGROUND_NDC_Z
 
 WIDTH, HEIGHT = 96, 72

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rig.render.warp_reference import depth_slopes, reference_warp
+from tests.rig.render.warp_reference import depth_slopes, reference_warp
 from rig.render.warp_server import BACKGROUND_NDC_Z
 
 W, H = 12, 10

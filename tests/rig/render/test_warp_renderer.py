@@ -12,7 +12,7 @@ from rig.render import make_renderer
 from rig.render.protocol import AppFrameRequest, DisplayFrameRequest, Renderer, RenderSetup
 from rig.render.warp import WarpRenderer
 from rig.render.image_error import lab_error_percent
-from rig.render.warp_reference import arbitrate_views, reference_warp
+from tests.rig.render.warp_reference import arbitrate_views, reference_warp
 from rig.render.warp_server import BACKGROUND_NDC_Z
 
 WIDTH, HEIGHT = 96, 72
