@@ -27,7 +27,7 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from analysis.options import AnalysisOptions
+from analysis.options import SIDES, AnalysisOptions
 from rig.cli import EXIT_UNTRUSTED, EXIT_WARNINGS
 from rig.commands import choices, options, outputs
 from rig.commands.declared_options import add_declared_options, config_from_args
@@ -193,7 +193,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         help=f"seconds to run (default: {LiveConfig.duration_s:g}; self-test {SELF_TEST_S:g})",
     )  # fmt: skip
     add_declared_options(parser, LiveConfig, {RUN: ""})
-    parser.add_argument("--led-side", choices=("left", "right"), help="which side of the video the LED is on")
+    parser.add_argument("--led-side", choices=SIDES, help="which side of the video the LED is on")
     parser.add_argument("--bench", type=Path, metavar="FILE.toml",
                         help="the bench profile: its camera, display and layout are the video analysis's hints, each checked "
                         "against the video (--led-side and the regions win over it)")  # fmt: skip
