@@ -16,7 +16,7 @@ from rig.commands.board import BlinkOptions, SyncOptions
 from rig.commands.devices import Listing
 from rig.commands.emulate import EmulatorOptions
 from rig.emulator_settings import ReaderWait
-from rig.live.run import LiveConfig
+from rig.live.config import LiveConfig
 from rig.tune_settings import TuneSettings
 from rig.service.bench_profile import BenchProfile
 from rig.service.plan import PlanRequest
@@ -59,7 +59,10 @@ SECTIONS = (
         "A live run",
         LiveConfig,
         True,
-        "`rig measure --duration`; `rig record`, `rig record-tracker` and `rig board record` take the same range.",
+        "`rig measure`'s options (and `--predictor NAME[:key=value,...]`, the predictor with its parameters; "
+        "`--display`, the window and its scan-out; `--no-lsl`, no streams; `--duration S`, `duration_s`, 20 s with "
+        "`--self-test`); `rig record`, `rig record-tracker` and `rig board record` take the same range for their "
+        "`--duration`.",
     ),
     ("Planning", PlanRequest, True, "`rig plan --accuracy-ms`."),
     ("Listing devices", Listing, True, "`rig devices`'s options."),

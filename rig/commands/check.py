@@ -24,12 +24,10 @@ from rig.cli import EXIT_UNTRUSTED, EXIT_WARNINGS
 from rig.commands import choices, options, outputs
 from rig.commands.device_options import add_device_options
 from rig.commands.record import add_accept_camera_settings
+from rig.live.config import LiveConfig
 
 if TYPE_CHECKING:
     from rig.preflight import CheckReport
-
-PLANNED_S = 60.0
-"""The planned run's duration unless given: `rig measure`'s own."""
 
 
 def table(report: CheckReport) -> str:
@@ -77,7 +75,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         epilog=choices.trackers_listing(),
     )
     add_device_options(parser)
-    parser.add_argument("--duration", type=options.positive_float, default=PLANNED_S, metavar="S",
+    parser.add_argument("--duration", type=options.positive_float, default=LiveConfig.duration_s, metavar="S",
                         help="seconds the planned run lasts, for the disk check (default: %(default)g)")  # fmt: skip
     parser.add_argument("--out", type=outputs.output_folder, default=Path("."), metavar="DIR",
                         help="where the run will be written, for the disk check (default: this folder)")  # fmt: skip

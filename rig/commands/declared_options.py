@@ -48,13 +48,13 @@ def declared_type(kind: type, path: str) -> Callable[[str], Any]:
 
 def config_from_args(kind: type[Config], args: argparse.Namespace, error: type[Exception], **given: Any) -> Config:
     """The `kind` the options given make (every setting without an option at its default, and the
-    fields in `given` as given), each value in its setting's unit; `error` is what `kind` raises
-    for a value it does not allow."""
+    fields in `given` as given, their options' values, nested ones' included, left aside), each
+    value in its setting's unit; `error` is what `kind` raises for a value it does not allow."""
     table: dict[str, Any] = dict(given)
     per: list[tuple[Entry, Any]] = []
     for entry in walk(kind):
         flag = entry.setting.flag
-        if flag is None or not hasattr(args, _dest(entry)):
+        if flag is None or not hasattr(args, _dest(entry)) or entry.path.partition(".")[0] in given:
             continue
         value = getattr(args, _dest(entry))
         if flag.per is not None and value is not None:

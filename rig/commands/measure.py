@@ -27,19 +27,21 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from analysis.options import AnalysisOptions
+from analysis.options import SIDES, AnalysisOptions
 from rig.cli import EXIT_UNTRUSTED, EXIT_WARNINGS
 from rig.commands import choices, options, outputs
+from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.commands.device_options import add_device_options
 from rig.commands.record import add_camera_options
 from rig.errors import ConfigError
-from rig.lsl.streams import StreamNames
+from rig.live.config import EXTERNAL, LSL, RENDERER, RUN, LiveConfig
 from rig.progress import ProgressBar
 
 if TYPE_CHECKING:
     from rig.live.measure import MeasureReport
 
 CHECK_SECONDS = 3.0
+SELF_TEST_S = 20.0
 EXIT_DISAGREE = 1
 GUIDE = (
     "1. Set the pendulum swinging (a hand's width to each side) with the tracker and the LED on it.",
@@ -116,7 +118,7 @@ def _print(report: MeasureReport, as_json: bool, kept: bool = True) -> int:
 def _self_test(args: argparse.Namespace) -> int:
     from rig.live.selftest.run import self_test
 
-    duration = args.duration or 20.0
+    duration = args.duration or SELF_TEST_S
     bar = ProgressBar("self-test")
     if args.out is not None:
         return _print(self_test(args.out, duration, external=args.external, overwrite=args.overwrite, progress=bar), args.json)
@@ -148,7 +150,6 @@ def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:
 def _run(args: argparse.Namespace) -> int:
     from rig.devices.window.spec import parse_window_address
     from rig.live.measure import measure
-    from rig.live.run import EXTERNAL, LiveConfig
     from rig.service.bench_profile import read_profile, with_profile
 
     if args.self_test:
@@ -157,12 +158,11 @@ def _run(args: argparse.Namespace) -> int:
     if missing:
         raise ConfigError(f"rig measure needs --{', --'.join(missing)} (or --self-test)")
     settings, scanout = parse_window_address(args.display.removeprefix("window").removeprefix(":"))
-    config = LiveConfig(
-        tracker=args.tracker, renderer=EXTERNAL if args.external else args.renderer, predictor=args.predictor[0],
-        predictor_params=tuple(args.predictor[1].items()),
-        duration_s=args.duration or 60.0, window=settings, scanout_fraction=scanout, photon_target=args.photon_target,
-        streams=None if args.no_lsl else StreamNames(args.pose_stream, args.tracker_stream, args.marker_stream),
-        mirror=args.mirror, until_still=args.until_still,
+    config = config_from_args(
+        LiveConfig, args, ConfigError, tracker=args.tracker, predictor=args.predictor[0],
+        predictor_params=args.predictor[1], duration_s=args.duration or LiveConfig.duration_s, window=settings,
+        scanout_fraction=scanout, **({"renderer": EXTERNAL} if args.external else {}),
+        **({"streams": None} if args.no_lsl else {}),
     )  # fmt: skip
     how = AnalysisOptions(led_roi=args.led_roi, sphere_roi=args.sphere_roi, led_side=args.led_side)
     if args.bench is not None:
@@ -185,26 +185,22 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         listings=lambda: "\n\n".join((choices.trackers_listing(), choices.renderers_listing(), choices.predictors_listing())),
     )
     add_device_options(parser)
-    parser.add_argument("--renderer", default="warp", metavar="NAME",
-                        help="the rig's renderer (listed below), with options as warp:OPTIONS (default: %(default)s)")  # fmt: skip
+    add_declared_options(parser, LiveConfig, {RENDERER: ""})
     parser.add_argument("--predictor", type=options.predictor_spec, default=("default", {}), metavar="NAME[:key=value,...]",
                         help="the pose predictor (listed below), with parameters or a `rig tune` file (default: default)")  # fmt: skip
-    parser.add_argument("--duration", type=options.run_seconds, metavar="S", help="seconds to run (default: 60; self-test 20)")
-    parser.add_argument("--until-still", action="store_true", help="end sooner once the pendulum has stopped swinging")
-    parser.add_argument("--photon-target", choices=("photons", "scanout"), default="photons",
-                        help="what each frame's pose is predicted for (default: %(default)s)")  # fmt: skip
-    parser.add_argument("--mirror", action="store_true", help="mirror the screen's x (when the camera sees the sphere move against the LED)")
-    parser.add_argument("--led-side", choices=("left", "right"), help="which side of the video the LED is on")
+    parser.add_argument(
+        "--duration", type=options.run_seconds, metavar="S",
+        help=f"seconds to run (default: {LiveConfig.duration_s:g}; self-test {SELF_TEST_S:g})",
+    )  # fmt: skip
+    add_declared_options(parser, LiveConfig, {RUN: ""})
+    parser.add_argument("--led-side", choices=SIDES, help="which side of the video the LED is on")
     parser.add_argument("--bench", type=Path, metavar="FILE.toml",
                         help="the bench profile: its camera, display and layout are the video analysis's hints, each checked "
                         "against the video (--led-side and the regions win over it)")  # fmt: skip
     parser.add_argument("--board", metavar="PORT",
                         help="the rig board's serial port or pyserial URL: it records beside the run (DIR/board), and the "
                         "photodiode's latency is given too")  # fmt: skip
-    parser.add_argument("--pose-stream", default=StreamNames.pose, help="LSL name of the rig's pose stream (default: %(default)s)")
-    parser.add_argument("--tracker-stream", default=StreamNames.tracker, help="LSL name of the rig's tracker stream (default: %(default)s)")
-    parser.add_argument("--marker-stream", default=StreamNames.markers,
-                        help="LSL name of an external renderer's marker stream (default: %(default)s)")  # fmt: skip
+    add_declared_options(parser, LiveConfig, {LSL: ""})
     parser.add_argument("--no-lsl", action="store_true", help="publish nothing on LSL (the rig's own renderer only)")
     parser.add_argument("--guided", action="store_true", help="say what to do and check the first seconds of video first")
     parser.add_argument("--self-test", action="store_true", help="run the whole chain with stand-ins under an X display (xvfb-run)")

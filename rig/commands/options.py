@@ -10,6 +10,9 @@ import re
 from pathlib import Path
 from typing import Any, Mapping
 
+from rig.commands.declared_options import declared_type
+from rig.live.config import LiveConfig
+
 
 def _number(kind: type[float] | type[int], text: str) -> Any:
     try:
@@ -48,11 +51,7 @@ def workers(text: str) -> int:
 
 def run_seconds(text: str) -> float:
     """How long a live run or a recording lasts, as a live run's duration is declared
-    (`rig.live.run.LiveConfig`: at most a day); loaded when an option is read, not when the command
-    line is built."""
-    from rig.commands.declared_options import declared_type
-    from rig.live.run import LiveConfig
-
+    (`rig.live.config.LiveConfig`: at most a day)."""
     return declared_type(LiveConfig, "duration_s")(text)
 
 

@@ -19,26 +19,25 @@ from __future__ import annotations
 
 import contextlib
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
 import predictors
-from declared import Flag, Range, check, setting
 from rig.clock import Clock, MonotonicClock
 from rig.devices.protocols import Camera, Display, Instrument, TrackerSource
 from rig.devices.registry import make_tracker
 from rig.devices.tap import TappedTracker
-from rig.devices.window import SWAP_COLUMNS, FrameClock, WindowDisplay, WindowSettings
-from rig.errors import ConfigError, RigError
+from rig.devices.window import SWAP_COLUMNS, FrameClock, WindowDisplay
+from rig.errors import RigError
+from rig.live.config import EXTERNAL, LiveConfig
 from rig.live.files import LIVE_FILE, MARKERS_FILE, PUBLISHED_FILE, SWAPS_FILE
 from rig.live.health import run_health
 from rig.live.still import RunEnded, SwingWatch
 from rig.live.view import View, view_from_positions
 from rig.lsl import MARKER_COLUMNS, PUBLISHED_COLUMNS, ExternalRenderer, LslPublisher, MarkerDisplay, PublishingRenderer
-from rig.lsl import StreamNames
 from rig.writers import CsvRecord
 from rig.render import RenderSetup, make_renderer
 from rig.session import PhotonTarget, RunRecord, Session, SessionParts, cost_model, timing_for
@@ -47,36 +46,6 @@ from rig.session.session import Progress
 FRAMING_S = 2.0
 TRACKER_SILENCE_S = 1.0
 """A tracker silent this long after its link was lost has been unplugged: the run ends."""
-EXTERNAL = "external"
-
-
-@dataclass(frozen=True)
-class LiveConfig:
-    """One live run: which tracker, renderer (EXTERNAL: another program over LSL) and predictor, how
-    long, and how the display's frames are aimed."""
-
-    tracker: str
-    renderer: str = "warp"
-    predictor: str = "default"
-    predictor_params: tuple[tuple[str, Any], ...] = ()
-    duration_s: float = setting(
-        30.0, "seconds", "how long the run lasts, at most a day", Range(0.0, 86400.0, includes_high=True),
-        flag=Flag("--duration", metavar="S"),
-    )  # fmt: skip
-    window: WindowSettings = WindowSettings()
-    scanout_fraction: float = 1.0
-    photon_target: str = "photons"
-    persistence: float = 1.0
-    scene_triangles: int = 0
-    streams: StreamNames | None = StreamNames()
-    mirror: bool = False
-    until_still: bool = False
-    """End when the pendulum has stopped swinging (`rig.live.still`), if before the duration."""
-
-    def __post_init__(self) -> None:
-        check(self, ConfigError)
-        if self.renderer == EXTERNAL and self.streams is None:
-            raise ConfigError("an external renderer is reached through LSL: the run needs its streams")
 
 
 class Watchdog:
@@ -161,7 +130,7 @@ def run_live(
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise RigError(f"cannot make the output folder {out_dir}: {error.strerror}") from None
-    predictor = predictors.make(config.predictor, **dict(config.predictor_params))
+    predictor = predictors.make(config.predictor, **config.predictor_params)
     external = config.renderer == EXTERNAL
     renderer = ExternalRenderer() if external else make_renderer(config.renderer)
     width, height = (640, 480) if external else config.window.size

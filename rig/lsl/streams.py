@@ -24,16 +24,24 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from declared import Flag, setting
+
 POSE_CHANNELS = ("frame", "t_photon", "t_sensor", "px", "py", "pz", "qw", "qx", "qy", "qz")
 POSE_UNITS = ("count", "seconds", "seconds", "metres", "metres", "metres", "normalised", "normalised", "normalised", "normalised")
 MARKER_CHANNELS = ("frame", "t_swap")
 
+LSL = "lsl"
+"""The group of the streams' options among a live run's (`rig.live.config`)."""
+
 
 @dataclass(frozen=True)
 class StreamNames:
-    """The three streams' names (change them to run several rigs on one network)."""
+    """The three streams' names (change them to run several rigs on one network), each declared with
+    its option."""
 
-    pose: str = "RigPose"
-    tracker: str = "RigTracker"
-    markers: str = "RigRendererMarkers"
+    pose: str = setting("RigPose", "", "LSL name of the rig's pose stream", flag=Flag("--pose-stream", group=LSL))
+    tracker: str = setting("RigTracker", "", "LSL name of the rig's tracker stream",
+                           flag=Flag("--tracker-stream", group=LSL))  # fmt: skip
+    markers: str = setting("RigRendererMarkers", "", "LSL name of an external renderer's marker stream",
+                           flag=Flag("--marker-stream", group=LSL))  # fmt: skip
 

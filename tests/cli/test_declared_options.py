@@ -7,15 +7,18 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import re
+from pathlib import Path
 
 import pytest
 
 from analysis import AnalysisError, AnalysisOptions
 from analysis.shutter import ShutterOptions
 from declared import walk
-from rig.cli import main
+from rig.cli import build_parser, main
 from rig.commands.declared_options import add_declared_options, config_from_args
 from rig.commands.simulation_options import add_simulation_options, simulation_config
+from rig.live.config import EXTERNAL, LiveConfig
+from rig.lsl.streams import StreamNames
 from rig.sim.board import SimulatedBoardConfig
 from rig.sim.camera import CameraConfig
 from rig.sim.config import SimulationConfig
@@ -121,3 +124,42 @@ def test_a_simulation_option_outside_its_setting_is_refused_in_the_options_unit(
     with pytest.raises(SystemExit):
         _simulation(*argv)
     assert message in capsys.readouterr().err
+
+
+class _Measured(Exception):
+    """Raised in place of a live run, holding the config `rig measure` built."""
+
+
+def _live_config(monkeypatch: pytest.MonkeyPatch, tmp_path: Path, *argv: str) -> LiveConfig:
+    import rig.live.measure
+
+    def stop(config: LiveConfig, *args: object, **kwargs: object) -> None:
+        raise _Measured(config)
+
+    monkeypatch.setattr(rig.live.measure, "measure", stop)
+    argv = ("measure", "--tracker", "lsl:T", "--camera", "camera:0", "--out", str(tmp_path / "run"), *argv)
+    args = build_parser(argv).parse_args(argv)
+    with pytest.raises(_Measured) as measured:
+        args.func(args)
+    return measured.value.args[0]
+
+
+def test_rig_measure_without_options_runs_the_live_configs_defaults(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    assert _live_config(monkeypatch, tmp_path) == LiveConfig(tracker="lsl:T")
+
+
+def test_rig_measures_options_make_the_live_config(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    config = _live_config(
+        monkeypatch, tmp_path, "--renderer", "direct", "--predictor", "kalman-cv:position_noise=0.01", "--duration", "5",
+        "--until-still", "--photon-target", "scanout", "--mirror", "--pose-stream", "P", "--marker-stream", "M",
+        "--display", "window?scanout=0.5",
+    )  # fmt: skip
+    assert config == LiveConfig(
+        tracker="lsl:T", renderer="direct", predictor="kalman-cv", predictor_params={"position_noise": 0.01}, duration_s=5.0,
+        scanout_fraction=0.5, until_still=True, photon_target="scanout", mirror=True, streams=StreamNames(pose="P", markers="M"),
+    )  # fmt: skip
+
+
+def test_rig_measure_external_and_no_lsl_set_the_renderer_and_the_streams(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    assert _live_config(monkeypatch, tmp_path, "--external", "--renderer", "direct").renderer == EXTERNAL
+    assert _live_config(monkeypatch, tmp_path, "--no-lsl", "--pose-stream", "P").streams is None

@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import contextlib
 import re
-from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, Iterator
 
 import moderngl
 import numpy as np
 
+from rig.devices.window_settings import WindowSettings
 from rig.errors import RigError
 
 BLIT_VERTEX_SHADER = """
@@ -38,18 +38,6 @@ void main() {
     f_colour = vec4(texture(image, v_uv).rgb, 1.0);
 }
 """
-
-
-@dataclass(frozen=True)
-class WindowSettings:
-    """Where and how the window opens: monitor index (0 the primary), full screen or a window of
-    `size` at `position` (pixels; None lets the system place it), the title."""
-
-    monitor: int = 0
-    fullscreen: bool = False
-    size: tuple[int, int] = (640, 480)
-    position: tuple[int, int] | None = None
-    title: str = "latency rig"
 
 
 def _glfw() -> ModuleType:

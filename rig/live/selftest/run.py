@@ -51,7 +51,7 @@ EXAMPLE_LOG = "external_renderer.log"
 
 def self_test(
     out_dir: Path,
-    duration_s: float = 20.0,
+    duration_s: float,
     *,
     renderer: str = "warp",
     external: bool = False,
