@@ -119,11 +119,11 @@ def _self_test(args: argparse.Namespace) -> int:
     from rig.live.selftest.run import self_test
 
     duration = args.duration or SELF_TEST_S
-    bar = ProgressBar("self-test")
+    how = {"renderer": args.renderer, "external": args.external, "progress": ProgressBar("self-test")}
     if args.out is not None:
-        return _print(self_test(args.out, duration, external=args.external, overwrite=args.overwrite, progress=bar), args.json)
+        return _print(self_test(args.out, duration, overwrite=args.overwrite, **how), args.json)
     with tempfile.TemporaryDirectory(prefix="rig-measure-self-test-") as scratch:
-        return _print(self_test(Path(scratch), duration, external=args.external, progress=bar), args.json, kept=False)
+        return _print(self_test(Path(scratch), duration, **how), args.json, kept=False)
 
 
 def _guided_check(args: argparse.Namespace, led_side: str | None) -> None:

@@ -163,3 +163,22 @@ def test_rig_measures_options_make_the_live_config(monkeypatch: pytest.MonkeyPat
 def test_rig_measure_external_and_no_lsl_set_the_renderer_and_the_streams(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     assert _live_config(monkeypatch, tmp_path, "--external", "--renderer", "direct").renderer == EXTERNAL
     assert _live_config(monkeypatch, tmp_path, "--no-lsl", "--pose-stream", "P").streams is None
+
+
+@pytest.mark.parametrize(("argv", "renderer", "external"), [((), "warp", False), (("--renderer", "direct"), "direct", False),
+                                                           (("--external",), "warp", True)])  # fmt: skip
+def test_rig_measure_self_test_runs_the_renderer_asked_for(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, argv: tuple[str, ...], renderer: str, external: bool
+) -> None:
+    import rig.live.selftest.run
+
+    def stop(out_dir: Path, duration_s: float, **kwargs: object) -> None:
+        raise _Measured(duration_s, kwargs)
+
+    monkeypatch.setattr(rig.live.selftest.run, "self_test", stop)
+    argv = ("measure", "--self-test", "--out", str(tmp_path / "run"), *argv)
+    args = build_parser(argv).parse_args(argv)
+    with pytest.raises(_Measured) as measured:
+        args.func(args)
+    duration_s, kwargs = measured.value.args
+    assert (duration_s, kwargs["renderer"], kwargs["external"]) == (20.0, renderer, external)
