@@ -6,9 +6,10 @@
     predictor.update(PoseSample(t_sensor=0.0, t_arrival=0.002, position=p, orientation=q))
     pose = predictor.predict(0.016)
 
-Predictors (`names()`): hold, slerp, kalman-cv, kalman-ca, desp, auto, adaptive, split; each class documents
-its parameters and their units. `make(DEFAULT)` ("default") makes the one to use when none is named:
-`adaptive`, which learns on the stream it is fed which motion model to trust at each horizon. `evaluate` scores one on a `Trace` (`read_trace` reads CSV files);
+Predictors (`names()`): hold, slerp, kalman-cv, kalman-ca, desp, auto, adaptive, split, rls; each class
+documents its parameters and their units. `make(DEFAULT)` ("default") makes the one to use when none is
+named: `rls`, which learns on the stream it is fed how to weigh the angular velocity and its moving
+averages at each horizon, and predicts position as `adaptive` does. `evaluate` scores one on a `Trace` (`read_trace` reads CSV files);
 `SAMPLE_COLUMNS`, `sample_row` and `read_samples` are the one file format of tracker samples.
 `predictors.quaternion` holds the vectorised quaternion maths, (w, x, y, z) Hamilton;
 `predictors.corpus` reads a folder of recordings labelled by device, person and scene and

@@ -135,7 +135,7 @@ class AdaptiveState:
 @declare_params(MEMORY, MARGIN, GAIN_PRIOR, MIN_INTERVAL, MAX_GAP, MAX_HORIZON)
 class Adaptive:
     """Trusts, per horizon, the candidate model whose realised errors on this stream have been
-    smallest (`adaptive`, the default predictor); see `predictors.adaptive`."""
+    smallest (`adaptive`); see `predictors.adaptive`."""
 
     name = "adaptive"
     params: ClassVar[ParamSet]

@@ -56,7 +56,7 @@ _PREDICTORS: Mapping[str, Any] = MappingProxyType(
 )
 
 DEFAULT = "default"
-_DEFAULT_IS = Adaptive.name
+_DEFAULT_IS = RecursiveLeastSquares.name
 
 
 def names() -> tuple[str, ...]:

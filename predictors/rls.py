@@ -114,8 +114,8 @@ class _Horizon:
 
 @declare_params(MEMORY, PRIOR, RLS_MARGIN, GAIN_PRIOR, MIN_INTERVAL, MAX_GAP, MAX_HORIZON)
 class RecursiveLeastSquares:
-    """Orientation from coefficients on the recent angular velocities learnt per horizon on the
-    stream, position from `adaptive` (`rls`); see `predictors.rls`."""
+    """Orientation from coefficients on the angular velocity and its moving averages learnt per
+    horizon on the stream, position from `adaptive` (`rls`, the default predictor); see `predictors.rls`."""
 
     name = "rls"
     params: ClassVar[ParamSet]

@@ -24,13 +24,13 @@ PREDICTOR_LINES = {
     "auto": "Chooses per scene between no prediction, constant velocity and constant acceleration for position, and "
     "whether to filter orientation at all (`auto`)",
     "adaptive": "Trusts, per horizon, the candidate model whose realised errors on this stream have been smallest "
-    "(`adaptive`, the default predictor); see `predictors.adaptive`",
+    "(`adaptive`); see `predictors.adaptive`",
     "split": "Position from `adaptive`, orientation from `kalman-cv`'s filter with a damped angular velocity (`split`)",
-    "rls": "Orientation from coefficients on the recent angular velocities learnt per horizon on the stream, position "
-    "from `adaptive` (`rls`); see `predictors.rls`",
+    "rls": "Orientation from coefficients on the angular velocity and its moving averages learnt per horizon on the "
+    "stream, position from `adaptive` (`rls`, the default predictor); see `predictors.rls`",
 }
 """Each predictor (`predictors.names()`), in the registry's order."""
-DEFAULT_PREDICTOR = ("default", "adaptive")
+DEFAULT_PREDICTOR = ("default", "rls")
 """The name that stands for the default predictor, and the predictor it is (`predictors.resolve`)."""
 TUNABLE = ("kalman-cv", "kalman-ca", "desp", "auto")
 """The predictors `rig tune` fits (`predictors.tuning.TUNABLE`)."""

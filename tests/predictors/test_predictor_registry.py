@@ -18,10 +18,10 @@ def test_known_names():
     assert names() == ("hold", "slerp", "kalman-cv", "kalman-ca", "desp", "auto", "adaptive", "split", "rls")
 
 
-def test_default_is_another_name_for_adaptive():
-    assert predictors.DEFAULT == "default" and predictors.resolve("default") == "adaptive"
+def test_default_is_another_name_for_rls():
+    assert predictors.DEFAULT == "default" and predictors.resolve("default") == "rls"
     assert predictors.resolve("slerp") == "slerp" and "default" not in names()
-    assert type(make("default")) is type(make("adaptive"))
+    assert type(make("default")) is type(make("rls"))
     assert make("default", memory=3.0).memory == 3.0
 
 
@@ -33,7 +33,7 @@ def test_make_returns_fresh_predictors(name):
 
 
 def test_unknown_name_lists_the_known_ones():
-    with pytest.raises(PredictorError, match="unknown predictor 'kalman'; known predictors: hold, slerp, kalman-cv.*'default' is adaptive"):
+    with pytest.raises(PredictorError, match="unknown predictor 'kalman'; known predictors: hold, slerp, kalman-cv.*'default' is rls"):
         make("kalman")
 
 

@@ -28,7 +28,7 @@ def test_tune_writes_parameters_that_simulate_and_make_accept(head_file, tmp_pat
     assert main(["tune", "kalman-cv", "--trace", str(head_file), "--horizon-ms", "50", "--max-iterations", "10", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "training (deg, mm)" in printed and "validation (deg, mm)" in printed
-    for label in ("kalman-cv tuned", "kalman-cv defaults", "slerp (constant velocity)", "default (adaptive)"):
+    for label in ("kalman-cv tuned", "kalman-cv defaults", "slerp (constant velocity)", "default (rls)"):
         assert label in printed
     assert f"wrote {out}" in printed
     name, params = read_params(out)
