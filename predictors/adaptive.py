@@ -55,7 +55,11 @@ _SCORE_GAPS = tuple(SCORE_EVERY * h for h in HORIZONS_S)
 def due_horizons(lasts: Sequence[float], t: float, at_most: int) -> list[tuple[float, int]]:
     """The (at most `at_most`) horizons longest unscored at `t`, each due once per `SCORE_EVERY`
     horizons since `lasts[k]`, when it was last scored: (last scored, index of the horizon)."""
-    return sorted((last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k])[:at_most]
+    due = [(last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k]]
+    if len(due) > 1:  # most samples have one due or none: nothing to sort
+        due.sort()
+    del due[at_most:]
+    return due
 
 
 def turn_at(
@@ -236,39 +240,48 @@ class Adaptive:
         its horizon was last scored."""
         lasts = self._last_scored
         due = due_horizons(lasts, t, SCORES_PER_SAMPLE)
+        if not due:
+            return  # no anchor moved, so none is past the trimming point
         history = self._history
-        newest = len(history) - 1
-        t_before, p_before, _, _ = history[newest - 1]
-        p_now, q_now = self._position, self._orientation
+        t_before, p_before, _, _ = history[-2]
+        (n0, n1, n2), q_now = self._position, self._orientation
+        b0, b1, b2 = n0 - p_before[0], n1 - p_before[1], n2 - p_before[2]
+        position_moved = self._position_moved
+        anchors, scores = self._anchors, self._scores
+        max_gap, memory, gain_prior = self.max_gap, self.memory, self.gain_prior
         scored = []
         for last, k in due:
-            score = self._scores[k]
-            ahead = score.horizon
-            self._anchors[k] = i = overtaken(history, self._anchors[k], ahead, t)
+            ahead = HORIZONS_S[k]
+            anchors[k] = i = overtaken(history, anchors[k], ahead, t)
             t_anchor, p_anchor, q_anchor, estimates = history[i]
             target = t_anchor + ahead
             if not t_before < target <= t:
                 continue
             # The truth at the target, between the sample before and the newest.
             back = (t - target) / (t - t_before)
-            turn = turn_at(q_anchor, q_now, r, back)
-            moved = (
-                p_now[0] - back * (p_now[0] - p_before[0]) - p_anchor[0],
-                p_now[1] - back * (p_now[1] - p_before[1]) - p_anchor[1],
-                p_now[2] - back * (p_now[2] - p_before[2]) - p_anchor[2],
-            ) if self._position_moved else None
-            weight = min(t - last, self.max_gap) if last > -math.inf else min(t - t_before, ahead)
+            if position_moved:
+                moved = (n0 - back * b0 - p_anchor[0], n1 - back * b1 - p_anchor[1], n2 - back * b2 - p_anchor[2])
+            else:
+                moved = None
+            if last > -math.inf:
+                weight = t - last
+                if weight > max_gap:
+                    weight = max_gap
+            else:
+                weight = t - t_before
+                if weight > ahead:
+                    weight = ahead
             lasts[k] = t
-            score.learn(turn, moved, estimates, weight, self.memory, self.gain_prior)
+            scores[k].learn(turn_at(q_anchor, q_now, r, back), moved, estimates, weight, memory, gain_prior)
             scored.append(k)
         if scored:
-            self._trust(tuple(scored))
-        oldest = min(self._anchors)
+            self._trust(scored)
+        oldest = min(anchors)
         if oldest > _TRIM_AFTER:
             del history[:oldest]
-            self._anchors = [i - oldest for i in self._anchors]
+            self._anchors = [i - oldest for i in anchors]
 
-    def _trust(self, scored: tuple[int, ...]) -> None:
+    def _trust(self, scored: list[int]) -> None:
         """Each horizon's choice, shortest first: a ready horizon keeps the next shorter one's
         model (constant velocity for the shortest) unless another beats it there by `margin`; a
         horizon not yet ready takes the next shorter one's choice; before any is ready,

@@ -49,6 +49,8 @@ MIN_SCORED = 1.0  # seconds of scored predictions before a horizon's own choice 
 MODELS: tuple[int, ...] = (0, 0, *range(1, len(NAMES)))
 MODEL_NAMES = ("constant-velocity", "two-sample, learnt gain", *NAMES[1:])
 LEARNT = 1
+# (model, index of its estimate) of the models that take a smoother as it is.
+_SMOOTHED = tuple((model, MODELS[model]) for model in range(LEARNT + 1, len(MODELS)))
 Choice = tuple[tuple[int, float], tuple[int, float]]  # (model, gain) for orientation, for position
 BASELINE: Choice = ((0, 1.0), (0, 1.0))
 COLD_START: Choice = ((2, 1.0), (2, 1.0))
@@ -132,8 +134,8 @@ def _learn(stats: list[list[float]], part: int, h: float, truth: Vector, anchor:
     learnt[_FF] = ff * decay + weight * (f0 * f0 + f1 * f1 + f2 * f2)
     learnt[_FY] = fy * decay + weight * (f0 * y0 + f1 * y1 + f2 * y2)
     learnt[_SSE] = sse * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
-    for model in range(2, len(stats)):
-        a0, a1, a2, w0, w1, w2 = anchor[MODELS[model]][part]
+    for model, estimate in _SMOOTHED:
+        a0, a1, a2, w0, w1, w2 = anchor[estimate][part]
         e0, e1, e2 = t0 - a0 - h * w0, t1 - a1 - h * w1, t2 - a2 - h * w2
         smoothed = stats[model]
         smoothed[_SSE] = smoothed[_SSE] * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
