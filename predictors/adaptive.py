@@ -292,9 +292,9 @@ class Adaptive:
         for k, score in enumerate(self._scores):
             if score.ready:
                 default = choice or BASELINE
-                models = (default[0][0], default[1][0])
-                if k in scored or models != kept[k]:
-                    kept[k] = models
+                (model, _), (position_model, _) = default
+                if k in scored or kept[k] != (model, position_model):
+                    kept[k] = (model, position_model)
                     trusted[k] = score.choose(default, self.gain_prior, self.margin, self._position_moved)
                 choice = trusted[k]
             else:

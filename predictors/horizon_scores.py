@@ -63,11 +63,13 @@ _FF, _FY, _SSE = 0, 1, 2
 class HorizonScore:
     """Scores and learnt gains at one horizon (s), and the choice they make."""
 
-    __slots__ = ("horizon", "scored", "_orientation", "_position")
+    __slots__ = ("horizon", "scored", "ready", "_orientation", "_position")
 
     def __init__(self, horizon: float) -> None:
         self.horizon = horizon
         self.scored = 0.0
+        # Whether enough has been scored here for this horizon's own choice to count.
+        self.ready = False
         self._orientation = [[0.0, 0.0, 0.0] for _ in MODELS]
         self._position = [[0.0, 0.0, 0.0] for _ in MODELS]
 
@@ -79,6 +81,7 @@ class HorizonScore:
         displacement: its position scores stay zero."""
         decay = exp(-weight / memory)
         self.scored = scored = self.scored * decay + weight
+        self.ready = scored >= MIN_SCORED
         prior = gain_prior / scored
         _learn(self._orientation, 0, self.horizon, truth, anchor, weight, decay, prior)
         if truth_position is not None:
@@ -91,11 +94,6 @@ class HorizonScore:
         prior = gain_prior / self.scored
         orientation = _choose(self._orientation, default[0][0], prior, margin)
         return orientation, _choose(self._position, default[1][0], prior, margin) if position else default[1]
-
-    @property
-    def ready(self) -> bool:
-        """Whether enough has been scored here for this horizon's own choice to count."""
-        return self.scored >= MIN_SCORED
 
     def rms_errors(self) -> tuple[list[float], list[float]]:
         """Each model's RMS error at this horizon (rad, m), as scored so far (NaN before any)."""
