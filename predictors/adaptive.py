@@ -33,6 +33,7 @@ sigma^2 = (<d_k.d_k> - <d_k.d_k-1>) / 10 per axis (only reported; the choice nee
 from __future__ import annotations
 
 import math
+from bisect import bisect_left
 from dataclasses import dataclass
 from math import exp, log, sqrt
 from typing import Any, ClassVar, Sequence
@@ -303,30 +304,11 @@ class Adaptive:
     def predict(self, t: float) -> Pose:
         """The pose at t (s): each part blended from the models trusted at the horizons either side
         of t - (newest sample time), at most max_horizon seconds either way."""
-        t, position, turn = self._blended(t)
-        return Pose(t, position, squat.rotated_by(turn[0], turn[1], turn[2], self._orientation))
-
-    def position_at(self, t: float) -> tuple[float, float, float]:
-        """The position `predict(t)` gives, without making the pose (`split` takes only this part)."""
-        return self._blended(t)[1]
-
-    def _blended(self, t: float) -> tuple[float, tuple[float, float, float], tuple[float, float, float]]:
-        """(t, the position, the turn from the newest orientation as a rotation vector) at t (s)."""
         t, h = horizon(t, self._t, self.max_horizon, self.name)
-        trusted = self._trusted
-        if h <= HORIZONS_S[0]:
-            blend: tuple[tuple[Choice, float], ...] = ((trusted[0], 1.0),)
-        elif h >= HORIZONS_S[-1]:
-            blend = ((trusted[-1], 1.0),)
-        else:
-            k = 0
-            while HORIZONS_S[k + 1] < h:
-                k += 1
-            u = (log(h) - _LOG_HORIZONS[k]) / (_LOG_HORIZONS[k + 1] - _LOG_HORIZONS[k])
-            blend = ((trusted[k], 1.0 - u), (trusted[k + 1], u))
-        estimates = self._history[-1][3]
-        d0 = d1 = d2 = m0 = m1 = m2 = 0.0
-        for ((model, gain), (position_model, position_gain)), share in blend:
+        blend = self._blend(h)
+        estimates = self._smoothers.estimates
+        d0 = d1 = d2 = 0.0
+        for ((model, gain), _), share in blend:
             a0, a1, a2, w0, w1, w2 = estimates[MODELS[model]][0]
             # The turn gain h w after the offset a: a + u + u x a / 2 to second order, u = gain h w.
             reach = gain * h
@@ -334,13 +316,37 @@ class Adaptive:
             d0 += share * (a0 + u0 + 0.5 * (u1 * a2 - u2 * a1))
             d1 += share * (a1 + u1 + 0.5 * (u2 * a0 - u0 * a2))
             d2 += share * (a2 + u2 + 0.5 * (u0 * a1 - u1 * a0))
-            a0, a1, a2, w0, w1, w2 = estimates[MODELS[position_model]][1]
-            reach = share * position_gain * h
+        return Pose(t, self._position_after(h, blend), squat.rotated_by(d0, d1, d2, self._orientation))
+
+    def position_at(self, t: float) -> tuple[float, float, float]:
+        """The position `predict(t)` gives, without making the pose or the orientation (`split` and
+        `rls` take only this part)."""
+        _, h = horizon(t, self._t, self.max_horizon, self.name)
+        return self._position_after(h, self._blend(h))
+
+    def _blend(self, h: float) -> tuple[tuple[Choice, float], ...]:
+        """The choices trusted at the scored horizons either side of h (s), each with its share."""
+        trusted = self._trusted
+        if h <= HORIZONS_S[0]:
+            return ((trusted[0], 1.0),)
+        if h >= HORIZONS_S[-1]:
+            return ((trusted[-1], 1.0),)
+        k = bisect_left(HORIZONS_S, h) - 1  # HORIZONS_S[k] < h <= HORIZONS_S[k + 1]
+        u = (log(h) - _LOG_HORIZONS[k]) / (_LOG_HORIZONS[k + 1] - _LOG_HORIZONS[k])
+        return ((trusted[k], 1.0 - u), (trusted[k + 1], u))
+
+    def _position_after(self, h: float, blend: tuple[tuple[Choice, float], ...]) -> tuple[float, float, float]:
+        """The position h seconds after the newest sample, from the position models in `blend`."""
+        estimates = self._smoothers.estimates
+        m0 = m1 = m2 = 0.0
+        for (_, (model, gain)), share in blend:
+            a0, a1, a2, w0, w1, w2 = estimates[MODELS[model]][1]
+            reach = share * gain * h
             m0 += share * a0 + reach * w0
             m1 += share * a1 + reach * w1
             m2 += share * a2 + reach * w2
         p = self._position
-        return t, (p[0] + m0, p[1] + m1, p[2] + m2), (d0, d1, d2)
+        return (p[0] + m0, p[1] + m1, p[2] + m2)
 
     @property
     def state(self) -> AdaptiveState:
