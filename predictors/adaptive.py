@@ -167,7 +167,8 @@ class Adaptive:
         self._older: tuple[float, tuple[float, float, float], squat.Quaternion] | None = None
         self._steps: tuple[float, tuple[float, float, float], tuple[float, float, float]] | None = None
         self._position_moved = False
-        self._second_differences: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
+        # The last second differences of the orientation and the position.
+        self._second_differences: tuple[float, float, float, float, float, float] | None = None
 
     def update(self, sample: PoseSample) -> None:
         """Take one tracker sample (the module docstring gives the order rules)."""
@@ -183,8 +184,9 @@ class Adaptive:
             return
         r = squat.rotation_vector_between(self._orientation, orientation)
         p = self._position
-        rp = (position[0] - p[0], position[1] - p[1], position[2] - p[2])
-        if rp != (0.0, 0.0, 0.0):
+        (x, y, z), (x0, y0, z0) = position, p
+        rp = (x - x0, y - y0, z - z0)
+        if not self._position_moved and rp != (0.0, 0.0, 0.0):
             self._position_moved = True
         if dt < self.min_interval:
             self._replace_newest(t, position, orientation, r, rp)
@@ -217,22 +219,22 @@ class Adaptive:
         self._steps = (dt, r, rp)
         if steps is None:
             return
-        scale = dt / steps[0]
-        before, before_p = steps[1], steps[2]
-        d = (r[0] - scale * before[0], r[1] - scale * before[1], r[2] - scale * before[2])
-        dp = (rp[0] - scale * before_p[0], rp[1] - scale * before_p[1], rp[2] - scale * before_p[2])
-        decay = exp(-dt / self.memory)
-        noise = self._noise
+        dt_before, (c0, c1, c2), (e0, e1, e2) = steps
+        scale = dt / dt_before
+        r0, r1, r2 = r
+        s0, s1, s2 = rp
+        d0, d1, d2 = r0 - scale * c0, r1 - scale * c1, r2 - scale * c2
+        p0, p1, p2 = s0 - scale * e0, s1 - scale * e1, s2 - scale * e2
         previous = self._second_differences
-        self._second_differences = (d, dp)
+        self._second_differences = (d0, d1, d2, p0, p1, p2)
         if previous is None:
             return
-        b, bp = previous
+        b0, b1, b2, q0, q1, q2 = previous
+        decay = exp(-dt / self.memory)
+        noise = self._noise
         noise[0] = decay * noise[0] + dt
-        noise[1] = decay * noise[1] + dt * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - d[0] * b[0] - d[1] * b[1] - d[2] * b[2])
-        noise[2] = decay * noise[2] + dt * (
-            dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2] - dp[0] * bp[0] - dp[1] * bp[1] - dp[2] * bp[2]
-        )
+        noise[1] = decay * noise[1] + dt * (d0 * d0 + d1 * d1 + d2 * d2 - d0 * b0 - d1 * b1 - d2 * b2)
+        noise[2] = decay * noise[2] + dt * (p0 * p0 + p1 * p1 + p2 * p2 - p0 * q0 - p1 * q1 - p2 * q2)
 
     def _score(self, t: float, r: tuple[float, float, float]) -> None:
         """Score the (at most `SCORES_PER_SAMPLE`) horizons longest unscored, each at most once per
