@@ -33,6 +33,7 @@ sigma^2 = (<d_k.d_k> - <d_k.d_k-1>) / 10 per axis (only reported; the choice nee
 from __future__ import annotations
 
 import math
+from bisect import bisect_left
 from dataclasses import dataclass
 from math import exp, log, sqrt
 from typing import Any, ClassVar, Sequence
@@ -55,7 +56,11 @@ _SCORE_GAPS = tuple(SCORE_EVERY * h for h in HORIZONS_S)
 def due_horizons(lasts: Sequence[float], t: float, at_most: int) -> list[tuple[float, int]]:
     """The (at most `at_most`) horizons longest unscored at `t`, each due once per `SCORE_EVERY`
     horizons since `lasts[k]`, when it was last scored: (last scored, index of the horizon)."""
-    return sorted((last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k])[:at_most]
+    due = [(last, k) for k, last in enumerate(lasts) if t - last >= _SCORE_GAPS[k]]
+    if len(due) > 1:  # most samples have one due or none: nothing to sort
+        due.sort()
+    del due[at_most:]
+    return due
 
 
 def turn_at(
@@ -162,7 +167,8 @@ class Adaptive:
         self._older: tuple[float, tuple[float, float, float], squat.Quaternion] | None = None
         self._steps: tuple[float, tuple[float, float, float], tuple[float, float, float]] | None = None
         self._position_moved = False
-        self._second_differences: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
+        # The last second differences of the orientation and the position.
+        self._second_differences: tuple[float, float, float, float, float, float] | None = None
 
     def update(self, sample: PoseSample) -> None:
         """Take one tracker sample (the module docstring gives the order rules)."""
@@ -178,8 +184,9 @@ class Adaptive:
             return
         r = squat.rotation_vector_between(self._orientation, orientation)
         p = self._position
-        rp = (position[0] - p[0], position[1] - p[1], position[2] - p[2])
-        if rp != (0.0, 0.0, 0.0):
+        (x, y, z), (x0, y0, z0) = position, p
+        rp = (x - x0, y - y0, z - z0)
+        if not self._position_moved and rp != (0.0, 0.0, 0.0):
             self._position_moved = True
         if dt < self.min_interval:
             self._replace_newest(t, position, orientation, r, rp)
@@ -212,22 +219,22 @@ class Adaptive:
         self._steps = (dt, r, rp)
         if steps is None:
             return
-        scale = dt / steps[0]
-        before, before_p = steps[1], steps[2]
-        d = (r[0] - scale * before[0], r[1] - scale * before[1], r[2] - scale * before[2])
-        dp = (rp[0] - scale * before_p[0], rp[1] - scale * before_p[1], rp[2] - scale * before_p[2])
-        decay = exp(-dt / self.memory)
-        noise = self._noise
+        dt_before, (c0, c1, c2), (e0, e1, e2) = steps
+        scale = dt / dt_before
+        r0, r1, r2 = r
+        s0, s1, s2 = rp
+        d0, d1, d2 = r0 - scale * c0, r1 - scale * c1, r2 - scale * c2
+        p0, p1, p2 = s0 - scale * e0, s1 - scale * e1, s2 - scale * e2
         previous = self._second_differences
-        self._second_differences = (d, dp)
+        self._second_differences = (d0, d1, d2, p0, p1, p2)
         if previous is None:
             return
-        b, bp = previous
+        b0, b1, b2, q0, q1, q2 = previous
+        decay = exp(-dt / self.memory)
+        noise = self._noise
         noise[0] = decay * noise[0] + dt
-        noise[1] = decay * noise[1] + dt * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - d[0] * b[0] - d[1] * b[1] - d[2] * b[2])
-        noise[2] = decay * noise[2] + dt * (
-            dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2] - dp[0] * bp[0] - dp[1] * bp[1] - dp[2] * bp[2]
-        )
+        noise[1] = decay * noise[1] + dt * (d0 * d0 + d1 * d1 + d2 * d2 - d0 * b0 - d1 * b1 - d2 * b2)
+        noise[2] = decay * noise[2] + dt * (p0 * p0 + p1 * p1 + p2 * p2 - p0 * q0 - p1 * q1 - p2 * q2)
 
     def _score(self, t: float, r: tuple[float, float, float]) -> None:
         """Score the (at most `SCORES_PER_SAMPLE`) horizons longest unscored, each at most once per
@@ -236,39 +243,48 @@ class Adaptive:
         its horizon was last scored."""
         lasts = self._last_scored
         due = due_horizons(lasts, t, SCORES_PER_SAMPLE)
+        if not due:
+            return  # no anchor moved, so none is past the trimming point
         history = self._history
-        newest = len(history) - 1
-        t_before, p_before, _, _ = history[newest - 1]
-        p_now, q_now = self._position, self._orientation
+        t_before, p_before, _, _ = history[-2]
+        (n0, n1, n2), q_now = self._position, self._orientation
+        b0, b1, b2 = n0 - p_before[0], n1 - p_before[1], n2 - p_before[2]
+        position_moved = self._position_moved
+        anchors, scores = self._anchors, self._scores
+        max_gap, memory, gain_prior = self.max_gap, self.memory, self.gain_prior
         scored = []
         for last, k in due:
-            score = self._scores[k]
-            ahead = score.horizon
-            self._anchors[k] = i = overtaken(history, self._anchors[k], ahead, t)
+            ahead = HORIZONS_S[k]
+            anchors[k] = i = overtaken(history, anchors[k], ahead, t)
             t_anchor, p_anchor, q_anchor, estimates = history[i]
             target = t_anchor + ahead
             if not t_before < target <= t:
                 continue
             # The truth at the target, between the sample before and the newest.
             back = (t - target) / (t - t_before)
-            turn = turn_at(q_anchor, q_now, r, back)
-            moved = (
-                p_now[0] - back * (p_now[0] - p_before[0]) - p_anchor[0],
-                p_now[1] - back * (p_now[1] - p_before[1]) - p_anchor[1],
-                p_now[2] - back * (p_now[2] - p_before[2]) - p_anchor[2],
-            ) if self._position_moved else None
-            weight = min(t - last, self.max_gap) if last > -math.inf else min(t - t_before, ahead)
+            if position_moved:
+                moved = (n0 - back * b0 - p_anchor[0], n1 - back * b1 - p_anchor[1], n2 - back * b2 - p_anchor[2])
+            else:
+                moved = None
+            if last > -math.inf:
+                weight = t - last
+                if weight > max_gap:
+                    weight = max_gap
+            else:
+                weight = t - t_before
+                if weight > ahead:
+                    weight = ahead
             lasts[k] = t
-            score.learn(turn, moved, estimates, weight, self.memory, self.gain_prior)
+            scores[k].learn(turn_at(q_anchor, q_now, r, back), moved, estimates, weight, memory, gain_prior)
             scored.append(k)
         if scored:
-            self._trust(tuple(scored))
-        oldest = min(self._anchors)
+            self._trust(scored)
+        oldest = min(anchors)
         if oldest > _TRIM_AFTER:
             del history[:oldest]
-            self._anchors = [i - oldest for i in self._anchors]
+            self._anchors = [i - oldest for i in anchors]
 
-    def _trust(self, scored: tuple[int, ...]) -> None:
+    def _trust(self, scored: list[int]) -> None:
         """Each horizon's choice, shortest first: a ready horizon keeps the next shorter one's
         model (constant velocity for the shortest) unless another beats it there by `margin`; a
         horizon not yet ready takes the next shorter one's choice; before any is ready,
@@ -279,9 +295,9 @@ class Adaptive:
         for k, score in enumerate(self._scores):
             if score.ready:
                 default = choice or BASELINE
-                models = (default[0][0], default[1][0])
-                if k in scored or models != kept[k]:
-                    kept[k] = models
+                (model, _), (position_model, _) = default
+                if k in scored or kept[k] != (model, position_model):
+                    kept[k] = (model, position_model)
                     trusted[k] = score.choose(default, self.gain_prior, self.margin, self._position_moved)
                 choice = trusted[k]
             else:
@@ -290,30 +306,11 @@ class Adaptive:
     def predict(self, t: float) -> Pose:
         """The pose at t (s): each part blended from the models trusted at the horizons either side
         of t - (newest sample time), at most max_horizon seconds either way."""
-        t, position, turn = self._blended(t)
-        return Pose(t, position, squat.rotated_by(turn[0], turn[1], turn[2], self._orientation))
-
-    def position_at(self, t: float) -> tuple[float, float, float]:
-        """The position `predict(t)` gives, without making the pose (`split` takes only this part)."""
-        return self._blended(t)[1]
-
-    def _blended(self, t: float) -> tuple[float, tuple[float, float, float], tuple[float, float, float]]:
-        """(t, the position, the turn from the newest orientation as a rotation vector) at t (s)."""
         t, h = horizon(t, self._t, self.max_horizon, self.name)
-        trusted = self._trusted
-        if h <= HORIZONS_S[0]:
-            blend: tuple[tuple[Choice, float], ...] = ((trusted[0], 1.0),)
-        elif h >= HORIZONS_S[-1]:
-            blend = ((trusted[-1], 1.0),)
-        else:
-            k = 0
-            while HORIZONS_S[k + 1] < h:
-                k += 1
-            u = (log(h) - _LOG_HORIZONS[k]) / (_LOG_HORIZONS[k + 1] - _LOG_HORIZONS[k])
-            blend = ((trusted[k], 1.0 - u), (trusted[k + 1], u))
-        estimates = self._history[-1][3]
-        d0 = d1 = d2 = m0 = m1 = m2 = 0.0
-        for ((model, gain), (position_model, position_gain)), share in blend:
+        blend = self._blend(h)
+        estimates = self._smoothers.estimates
+        d0 = d1 = d2 = 0.0
+        for ((model, gain), _), share in blend:
             a0, a1, a2, w0, w1, w2 = estimates[MODELS[model]][0]
             # The turn gain h w after the offset a: a + u + u x a / 2 to second order, u = gain h w.
             reach = gain * h
@@ -321,13 +318,37 @@ class Adaptive:
             d0 += share * (a0 + u0 + 0.5 * (u1 * a2 - u2 * a1))
             d1 += share * (a1 + u1 + 0.5 * (u2 * a0 - u0 * a2))
             d2 += share * (a2 + u2 + 0.5 * (u0 * a1 - u1 * a0))
-            a0, a1, a2, w0, w1, w2 = estimates[MODELS[position_model]][1]
-            reach = share * position_gain * h
+        return Pose(t, self._position_after(h, blend), squat.rotated_by(d0, d1, d2, self._orientation))
+
+    def position_at(self, t: float) -> tuple[float, float, float]:
+        """The position `predict(t)` gives, without making the pose or the orientation (`split` and
+        `rls` take only this part)."""
+        _, h = horizon(t, self._t, self.max_horizon, self.name)
+        return self._position_after(h, self._blend(h))
+
+    def _blend(self, h: float) -> tuple[tuple[Choice, float], ...]:
+        """The choices trusted at the scored horizons either side of h (s), each with its share."""
+        trusted = self._trusted
+        if h <= HORIZONS_S[0]:
+            return ((trusted[0], 1.0),)
+        if h >= HORIZONS_S[-1]:
+            return ((trusted[-1], 1.0),)
+        k = bisect_left(HORIZONS_S, h) - 1  # HORIZONS_S[k] < h <= HORIZONS_S[k + 1]
+        u = (log(h) - _LOG_HORIZONS[k]) / (_LOG_HORIZONS[k + 1] - _LOG_HORIZONS[k])
+        return ((trusted[k], 1.0 - u), (trusted[k + 1], u))
+
+    def _position_after(self, h: float, blend: tuple[tuple[Choice, float], ...]) -> tuple[float, float, float]:
+        """The position h seconds after the newest sample, from the position models in `blend`."""
+        estimates = self._smoothers.estimates
+        m0 = m1 = m2 = 0.0
+        for (_, (model, gain)), share in blend:
+            a0, a1, a2, w0, w1, w2 = estimates[MODELS[model]][1]
+            reach = share * gain * h
             m0 += share * a0 + reach * w0
             m1 += share * a1 + reach * w1
             m2 += share * a2 + reach * w2
         p = self._position
-        return t, (p[0] + m0, p[1] + m1, p[2] + m2), (d0, d1, d2)
+        return (p[0] + m0, p[1] + m1, p[2] + m2)
 
     @property
     def state(self) -> AdaptiveState:

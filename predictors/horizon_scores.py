@@ -49,6 +49,8 @@ MIN_SCORED = 1.0  # seconds of scored predictions before a horizon's own choice 
 MODELS: tuple[int, ...] = (0, 0, *range(1, len(NAMES)))
 MODEL_NAMES = ("constant-velocity", "two-sample, learnt gain", *NAMES[1:])
 LEARNT = 1
+# (model, index of its estimate) of the models that take a smoother as it is.
+_SMOOTHED = tuple((model, MODELS[model]) for model in range(LEARNT + 1, len(MODELS)))
 Choice = tuple[tuple[int, float], tuple[int, float]]  # (model, gain) for orientation, for position
 BASELINE: Choice = ((0, 1.0), (0, 1.0))
 COLD_START: Choice = ((2, 1.0), (2, 1.0))
@@ -61,11 +63,13 @@ _FF, _FY, _SSE = 0, 1, 2
 class HorizonScore:
     """Scores and learnt gains at one horizon (s), and the choice they make."""
 
-    __slots__ = ("horizon", "scored", "_orientation", "_position")
+    __slots__ = ("horizon", "scored", "ready", "_orientation", "_position")
 
     def __init__(self, horizon: float) -> None:
         self.horizon = horizon
         self.scored = 0.0
+        # Whether enough has been scored here for this horizon's own choice to count.
+        self.ready = False
         self._orientation = [[0.0, 0.0, 0.0] for _ in MODELS]
         self._position = [[0.0, 0.0, 0.0] for _ in MODELS]
 
@@ -77,6 +81,7 @@ class HorizonScore:
         displacement: its position scores stay zero."""
         decay = exp(-weight / memory)
         self.scored = scored = self.scored * decay + weight
+        self.ready = scored >= MIN_SCORED
         prior = gain_prior / scored
         _learn(self._orientation, 0, self.horizon, truth, anchor, weight, decay, prior)
         if truth_position is not None:
@@ -89,11 +94,6 @@ class HorizonScore:
         prior = gain_prior / self.scored
         orientation = _choose(self._orientation, default[0][0], prior, margin)
         return orientation, _choose(self._position, default[1][0], prior, margin) if position else default[1]
-
-    @property
-    def ready(self) -> bool:
-        """Whether enough has been scored here for this horizon's own choice to count."""
-        return self.scored >= MIN_SCORED
 
     def rms_errors(self) -> tuple[list[float], list[float]]:
         """Each model's RMS error at this horizon (rad, m), as scored so far (NaN before any)."""
@@ -132,8 +132,8 @@ def _learn(stats: list[list[float]], part: int, h: float, truth: Vector, anchor:
     learnt[_FF] = ff * decay + weight * (f0 * f0 + f1 * f1 + f2 * f2)
     learnt[_FY] = fy * decay + weight * (f0 * y0 + f1 * y1 + f2 * y2)
     learnt[_SSE] = sse * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)
-    for model in range(2, len(stats)):
-        a0, a1, a2, w0, w1, w2 = anchor[MODELS[model]][part]
+    for model, estimate in _SMOOTHED:
+        a0, a1, a2, w0, w1, w2 = anchor[estimate][part]
         e0, e1, e2 = t0 - a0 - h * w0, t1 - a1 - h * w1, t2 - a2 - h * w2
         smoothed = stats[model]
         smoothed[_SSE] = smoothed[_SSE] * decay + weight * (e0 * e0 + e1 * e1 + e2 * e2)

@@ -69,7 +69,7 @@ class Smoothers:
     """The candidates of `NAMES`, advanced sample by sample; `estimates` is their current estimates,
     in the order of `NAMES`, and `interval` the running mean sample interval (s; 0 before two samples)."""
 
-    __slots__ = ("estimates", "interval", "_filters", "_covariances", "_densities")
+    __slots__ = ("estimates", "interval", "_filters", "_covariances", "_densities", "_moved")
 
     def __init__(self) -> None:
         self.estimates: tuple[Estimate, ...] = (STILL,) * len(NAMES)
@@ -78,6 +78,9 @@ class Smoothers:
         self._filters: list[list[Motion]] = [[STILL[0], STILL[1]] for _ in BANDWIDTHS_HZ]
         self._covariances: list[KinematicCovariance] = []
         self._densities = tuple((2.0 * pi * f) ** 4 for f in BANDWIDTHS_HZ)
+        # Whether any step has moved the position: until one has, every position estimate is
+        # exactly zero (and the update would keep it so), so it is not computed.
+        self._moved = False
 
     def advance(self, dt: float, r: Vector, rp: Vector, two_sample: Estimate) -> None:
         """A new newest sample dt >= 0 s after the last: it turned by r (rad) and moved by rp (m) from
@@ -94,6 +97,7 @@ class Smoothers:
         interval = self.interval
         r0, r1, r2 = r
         s0, s1, s2 = rp
+        moved = self._moved = self._moved or bool(s0 or s1 or s2)
         estimates: list[Estimate] = [two_sample]
         for covariance, density, state in zip(self._covariances, self._densities, self._filters):
             if dt > 0.0:
@@ -101,7 +105,7 @@ class Smoothers:
                 covariance.predict(dt)
             k0, k1 = covariance.update()
             g = 1.0 - k0
-            (a0, a1, a2, w0, w1, w2), (b0, b1, b2, v0, v1, v2) = state
+            (a0, a1, a2, w0, w1, w2), moving = state
             # Time update, then the origin moved to the new sample (rotation vectors composed to
             # second order), then the measurement update at offset zero.
             u0, u1, u2 = dt * w0, dt * w1, dt * w2
@@ -115,10 +119,11 @@ class Smoothers:
                 a1 - r1 - 0.5 * (a2 * r0 - a0 * r2),
                 a2 - r2 - 0.5 * (a0 * r1 - a1 * r0),
             )
-            b0, b1, b2 = b0 + dt * v0 - s0, b1 + dt * v1 - s1, b2 + dt * v2 - s2
-            turning = (g * a0, g * a1, g * a2, w0 - k1 * a0, w1 - k1 * a1, w2 - k1 * a2)
-            moving = (g * b0, g * b1, g * b2, v0 - k1 * b0, v1 - k1 * b1, v2 - k1 * b2)
-            state[0], state[1] = turning, moving
+            state[0] = turning = (g * a0, g * a1, g * a2, w0 - k1 * a0, w1 - k1 * a1, w2 - k1 * a2)
+            if moved:
+                b0, b1, b2, v0, v1, v2 = moving
+                b0, b1, b2 = b0 + dt * v0 - s0, b1 + dt * v1 - s1, b2 + dt * v2 - s2
+                state[1] = moving = (g * b0, g * b1, g * b2, v0 - k1 * b0, v1 - k1 * b1, v2 - k1 * b2)
             estimates.append((turning, moving))
         self.estimates = tuple(estimates)
 

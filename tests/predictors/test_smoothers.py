@@ -71,3 +71,21 @@ def test_a_bandwidth_in_hz_is_the_same_filter_at_any_high_rate(dt):
     w0 = 2 * math.pi * 10.0
     assert k0 / dt == pytest.approx(math.sqrt(2.0) * w0, rel=0.1)
     assert k1 / dt == pytest.approx(w0 * w0, rel=0.1)
+
+
+def test_leaving_a_still_position_unupdated_changes_no_estimate_by_a_bit():
+    """Until the position first moves the smoothers leave it as it is (every position estimate
+    exactly zero): smoothers made to update it from the first sample end with the same estimates,
+    bit for bit (repr tells -0.0 from 0.0), through a still stretch, a step of -0.0, duplicates
+    and motion."""
+    rng = np.random.default_rng(2)
+    skipping, updating = Smoothers(), Smoothers()
+    updating._moved = True
+    for k in range(300):
+        dt = 0.0 if k % 37 == 5 else 0.008 + 0.004 * rng.random()
+        r = tuple(rng.normal(0.0, 0.01, 3).tolist())
+        rp = (0.0, -0.0, 0.0) if k < 150 else tuple(rng.normal(0.0, 0.001, 3).tolist())
+        for smoothers in (skipping, updating):
+            smoothers.advance(dt, r, rp, two_sample(dt or 0.01, r, rp))
+        assert repr(skipping.estimates) == repr(updating.estimates)
+    assert any(moving != (0.0,) * 6 for _, moving in skipping.estimates[1:])
