@@ -23,7 +23,7 @@ from rig.bench.renderer_specs import BenchGrid
 from rig.bench.renderers import plain, with_options
 from rig.session import DEFAULT_SERVER_MS, PHOTON_TARGETS
 
-RESIDUAL_PREDICTORS = ("adaptive", "kalman-ca", "kalman-cv", "desp", "slerp", "hold")
+RESIDUAL_PREDICTORS = ("rls", "adaptive", "kalman-ca", "kalman-cv", "desp", "slerp", "hold")
 RESIDUAL_TRIANGLES = 10_000
 
 
