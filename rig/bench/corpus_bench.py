@@ -1,6 +1,7 @@
 """The predictor bench on a corpus of recordings (`rig bench predictors --corpus DIR`): scores by
 recording, by person, scene and device, and, with `--cross-validate`, each group scored by the
-candidate chosen without it.
+candidate chosen without it; with `--headroom`, how far a linear predictor on the default's
+features, fitted on the other groups, goes on each group (`predictors.headroom`).
 
 The recordings and their labels are `predictors.corpus`'s (file names or a manifest); the scores,
 the choosing and the folds `predictors.cross_validation`'s. Every candidate is run on every
@@ -23,10 +24,12 @@ import numpy as np
 from predictors import DEFAULT, names, resolve
 from predictors.registry import params_of
 from predictors.corpus import GROUPINGS, Recording, read_corpus
-from predictors.cross_validation import REPORTED, CorpusScores, Fold, cross_validate, groups_of, held_out_mean
+from predictors.cross_validation import REPORTED, CorpusScores, Fold, cross_validate, geometric_mean, groups_of, held_out_mean
+from predictors.headroom import FITS, HeadroomFold, corpus_headroom, headroom
 from rig.bench.contract import Context, new_figure
 from rig.bench.predictor_scores import by_horizon, evaluate_all, scores_of
 from rig.bench.predictors_settings import BASELINE
+from rig.errors import ConfigError
 from rig.service.tune import check_scorable, in_time_order
 
 COST_REFERENCE = "kalman-cv"
@@ -48,7 +51,8 @@ def default_candidates(names: Sequence[str]) -> list[tuple[str, dict[str, Any]]]
 class CorpusRun:
     """What the corpus bench found: the recordings, the scores, each candidate's cost over
     kalman-cv's (median over recordings), the folds per grouping (empty without
-    --cross-validate), the default predictor's label and the horizon the plot shows."""
+    --cross-validate), the default predictor's label, the horizon the plot shows, and the headroom
+    folds per grouping (empty without --headroom)."""
 
     recordings: list[Recording]
     scores: CorpusScores
@@ -56,6 +60,7 @@ class CorpusRun:
     folds: dict[str, list[Fold]]
     default: str
     plot_horizon_ms: float
+    headroom: dict[str, list[HeadroomFold]]
 
     @property
     def shown(self) -> tuple[float, ...]:
@@ -86,7 +91,13 @@ def run(args: argparse.Namespace, context: Context) -> CorpusRun:
              for name, by in evaluations.items()}  # fmt: skip
     folds = {by: cross_validate(scores, groups_of(recordings, by)) for by in GROUPINGS} if args.cross_validate else {}
     folds = {by: f for by, f in folds.items() if len(f) > 1}
-    return CorpusRun(recordings, scores, costs, folds, resolve(DEFAULT), args.plot_horizon_ms)
+    traces = {r.name: r.trace for r in recordings}
+    shown = [h for h in args.horizons_ms if h > 0.0]
+    if args.headroom and not shown:
+        raise ConfigError("--headroom fits predictions ahead: give a horizon above 0 in --horizons-ms")
+    fitted = {by: headroom(traces, groups_of(recordings, by), shown) for by in GROUPINGS} if args.headroom else {}
+    fitted = {by: f for by, f in fitted.items() if f}
+    return CorpusRun(recordings, scores, costs, folds, resolve(DEFAULT), args.plot_horizon_ms, fitted)
 
 
 def _cells(values: Sequence[float]) -> str:
@@ -140,9 +151,26 @@ def fold_table(found: CorpusRun, by: str) -> str:
     return f"(ratios to constant velocity at {at} ms)\n" + "\n".join(rows)
 
 
+def headroom_table(found: CorpusRun, by: str) -> str:
+    """Per group held out: each linear fit's ratios there, made on the other groups, and the
+    default's, learnt on the stream; their geometric means over groups last."""
+    folds, shown, scores = found.headroom[by], found.shown, found.scores
+    on_stream = [[scores.group_ratio(found.default, f.recordings, "angular", h) for h in shown] if found.default in scores.evaluations
+                 else [math.nan] * len(shown) for f in folds]  # fmt: skip
+    rows = [f"| held out ({by}) | recordings | " + " | ".join(f"{fit}, fitted on the others" for fit in FITS)
+            + f" | {found.default}, on the stream |", "|" + "---|" * (3 + len(FITS))]  # fmt: skip
+    for fold, default in zip(folds, on_stream):
+        rows.append(f"| {fold.group} | {len(fold.recordings)} | " + " | ".join(_cells([fold.ratios[fit][h] for h in shown]) for fit in FITS)
+                    + f" | {_cells(default)} |")  # fmt: skip
+    means = [_cells([corpus_headroom(folds, fit, h) for h in shown]) for fit in FITS]
+    default_mean = _cells([geometric_mean([row[k] for row in on_stream]) for k in range(len(shown))])
+    rows.append("| geometric mean over groups | | " + " | ".join(means) + f" | {default_mean} |")
+    return "\n".join(rows)
+
+
 def text(found: CorpusRun) -> str:
-    """The recording table, the candidates by person, and each grouping's folds with its
-    cross-validated geometric mean."""
+    """The recording table, the candidates by person, each grouping's folds with its
+    cross-validated geometric mean, and each grouping's headroom."""
     at = " / ".join(f"{h:g}" for h in found.shown)
     lines = [recording_table(found),
              f"\nby person (geometric mean over people; ratios to constant velocity at {at} ms), chosen on all of them: "
@@ -151,6 +179,11 @@ def text(found: CorpusRun) -> str:
         lines += [f"\nleave one {by} out: chosen on the others, scored on the one held out", fold_table(found, by)]
         lines.append(f"cross-validated ({by}): angular RMS / constant velocity at {at} ms: "
                      + _cells([held_out_mean(folds, "angular", h) for h in found.shown]))  # fmt: skip
+    at = " / ".join(f"{h:g}" for h in found.shown)
+    for by in found.headroom:
+        lines += [f"\nheadroom, leave one {by} out: linear predictors on {found.default}'s features fitted with every future "
+                  f"sample known on the other groups (shared: one coefficient per feature; per axis: a matrix in the world "
+                  f"frame), angular RMS / constant velocity at {at} ms on the one held out", headroom_table(found, by)]  # fmt: skip
     return "\n".join(lines)
 
 
@@ -188,6 +221,14 @@ def record(found: CorpusRun) -> dict[str, Any]:
                 "geometric_mean": {part: by_horizon(partial(held_out_mean, folds, part), found.shown) for part in REPORTED},
             }
             for by, folds in found.folds.items()
+        },
+        "headroom": {
+            by: {
+                "folds": [{"group": f.group, "recordings": list(f.recordings),
+                           "ratios": {fit: by_horizon(f.ratios[fit].__getitem__, found.shown) for fit in FITS}} for f in folds],  # fmt: skip
+                "geometric_mean": {fit: by_horizon(partial(corpus_headroom, folds, fit), found.shown) for fit in FITS},
+            }
+            for by, folds in found.headroom.items()
         },
         "results": [e.to_dict() for by in scores.evaluations.values() for e in by.values()],
     }

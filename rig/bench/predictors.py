@@ -184,8 +184,8 @@ def run(args: argparse.Namespace, context: Context) -> Scores | CorpusRun:
     horizons, plot_horizon = args.horizons_ms, args.plot_horizon_ms
     if plot_horizon not in horizons:
         raise ConfigError(f"--plot-horizon-ms {plot_horizon:g} must be one of --horizons-ms {','.join(f'{h:g}' for h in horizons)}")
-    if args.corpus is None and (args.cross_validate or args.manifest is not None):
-        raise ConfigError("--cross-validate and --manifest need --corpus DIR: they group a corpus's recordings")
+    if args.corpus is None and (args.cross_validate or args.headroom or args.manifest is not None):
+        raise ConfigError("--cross-validate, --headroom and --manifest need --corpus DIR: they group a corpus's recordings")
     if args.corpus is not None:
         if args.trace or args.stress or args.leave_one_out:
             raise ConfigError("--corpus runs on the corpus's recordings alone: leave out --trace, --stress and --leave-one-out")

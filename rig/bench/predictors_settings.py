@@ -72,6 +72,9 @@ def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cross-validate", action="store_true",
                         help="with --corpus: choose among the predictors on all groups but one and score the choice on "
                         "that one, for every person, scene and device")  # fmt: skip
+    parser.add_argument("--headroom", action="store_true",
+                        help="with --corpus: fit linear predictors on the default's features on all groups but one, with "
+                        "every future sample known, and score them on that one: how far that family could go")  # fmt: skip
     parser.add_argument("--leave-one-out", type=_tunable, action="append", metavar="NAME",
                         help="tune NAME on all traces but one and score it on that one, for each trace; repeat for several")  # fmt: skip
     add_declared_options(parser, PredictorBenchOptions)

@@ -74,10 +74,31 @@ def test_the_corpus_bench_refuses_other_traces(tmp_path, extra, message):
         run(tmp_path, *extra)
 
 
-def test_cross_validation_needs_a_corpus():
-    args = RIG_BENCH.parse_args(["bench", "predictors", "--cross-validate", "--predictor", "hold"])
+@pytest.mark.parametrize("option", ["--cross-validate", "--headroom"])
+def test_grouping_options_need_a_corpus(option):
+    args = RIG_BENCH.parse_args(["bench", "predictors", option, "--predictor", "hold"])
     with pytest.raises(ConfigError, match="need --corpus DIR"):
         args.func(args)
+
+
+def test_the_headroom_is_fitted_on_the_other_groups_and_reported_beside_the_default(tmp_path, capsys):
+    assert run(tmp_path, "--predictor", "rls", "--headroom", "--json", str(tmp_path / "out.json")) == 0
+    out = capsys.readouterr().out
+    assert "headroom, leave one person out: linear predictors on rls's features" in out
+    assert "| held out (person) | recordings | shared, fitted on the others | per axis, fitted on the others | rls, on the stream |" in out
+    headroom = json.loads((tmp_path / "out.json").read_text())["headroom"]
+    assert set(headroom) == {"person", "scene", "device"}
+    folds = headroom["person"]["folds"]
+    assert [f["group"] for f in folds] == ["hmd/user9", "walk/user1", "walk/user2", "walk/user3"]
+    for fit in ("shared", "per axis"):
+        ratios = [f["ratios"][fit]["50"] for f in folds]
+        assert all(0.0 < r < 2.0 for r in ratios)
+        assert headroom["person"]["geometric_mean"][fit]["50"] == pytest.approx(math.exp(sum(map(math.log, ratios)) / len(ratios)))
+
+
+def test_the_headroom_needs_a_horizon_ahead(tmp_path):
+    with pytest.raises(ConfigError, match="--headroom fits predictions ahead"):
+        run(tmp_path, "--headroom", "--horizons-ms", "0", "--plot-horizon-ms", "0")
 
 
 def test_a_manifest_given_labels_the_corpus(tmp_path, capsys):
