@@ -237,7 +237,8 @@ def record(found: CorpusRun) -> dict[str, Any]:
 def plot(found: CorpusRun, path: Path) -> None:
     """Left: each candidate's geometric mean over people of angular RMS / constant velocity at the
     plot horizon against its cost over kalman-cv's. Right: per person held out, the chosen
-    candidate's angular ratio at each horizon (or, without folds, the default's)."""
+    candidate's angular ratio at each horizon (or, without folds, the default's), and with
+    --headroom the linear fits made on the other people, at the plot horizon."""
     figure, (left, right) = new_figure((13.0, 5.0), nrows=1, ncols=2)
     scores, groups, h = found.scores, found.groups("person"), found.plot_horizon_ms
     ratios = {c: scores.corpus_ratio(c, groups, "angular", h) for c in scores.candidates}
@@ -258,6 +259,13 @@ def plot(found: CorpusRun, path: Path) -> None:
                   else [scores.group_ratio(found.default, groups[g], "angular", horizon) for g in names])  # fmt: skip
         right.bar(np.arange(len(names)) + k * width, values, width, label=f"{horizon:g} ms")
         heights += values
+    fitted = {f.group: f for f in found.headroom.get("person", [])}
+    if fitted and h in found.shown:
+        at = np.arange(len(names)) + found.shown.index(h) * width
+        for fit, marker in zip(FITS, ("_", "x")):
+            values = [fitted[g].ratios[fit][h] if g in fitted else math.nan for g in names]
+            right.scatter(at, values, marker=marker, s=120, color="black", zorder=3, label=f"{fit} linear fit, {h:g} ms")
+            heights += values
     right.axhline(1.0, color="grey", linewidth=0.8)
     heights = [v for v in heights if math.isfinite(v)]
     right.set_ylim(0.95 * min([*heights, 1.0]), 1.02 * max([*heights, 1.0]))

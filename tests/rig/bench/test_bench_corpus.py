@@ -82,7 +82,7 @@ def test_grouping_options_need_a_corpus(option):
 
 
 def test_the_headroom_is_fitted_on_the_other_groups_and_reported_beside_the_default(tmp_path, capsys):
-    assert run(tmp_path, "--predictor", "rls", "--headroom", "--json", str(tmp_path / "out.json")) == 0
+    assert run(tmp_path, "--predictor", "rls", "--headroom", "--json", str(tmp_path / "out.json"), "--plot", str(tmp_path / "out.png")) == 0
     out = capsys.readouterr().out
     assert "headroom, leave one person out: linear predictors on rls's features" in out
     assert "| held out (person) | recordings | shared, fitted on the others | per axis, fitted on the others | rls, on the stream |" in out
@@ -94,6 +94,7 @@ def test_the_headroom_is_fitted_on_the_other_groups_and_reported_beside_the_defa
         ratios = [f["ratios"][fit]["50"] for f in folds]
         assert all(0.0 < r < 2.0 for r in ratios)
         assert headroom["person"]["geometric_mean"][fit]["50"] == pytest.approx(math.exp(sum(map(math.log, ratios)) / len(ratios)))
+    assert (tmp_path / "out.png").stat().st_size > 10_000
 
 
 def test_the_headroom_needs_a_horizon_ahead(tmp_path):
