@@ -6,13 +6,17 @@ differences of its moving averages, w - m1, m1 - m2, m2 - m3) shared by the thre
 those coefficients by least squares on other people's recordings, with every future sample known,
 and scoring them on the person left out, estimates what a better-fitted linear predictor on the same
 features could gain there: this family's headroom, not a predictor (it needs the other people's
-recordings, and it does not adapt to the one it is scored on). Two fits, per horizon:
+recordings, and it does not adapt to the one it is scored on). Three fits, per horizon:
 
 * `shared`: one coefficient per feature, the same on every axis. This is what `rls` can represent,
   and it does not depend on the tracker's frame: turning every recording by one rotation changes
   nothing.
-* `per axis`: a 3 x 3 matrix per feature, in the recordings' world frame. It can weigh yaw apart
-  from pitch, so it is a bound only for trackers whose world frames agree (up the same axis).
+* `yaw/tilt`: one coefficient per feature for the part along a recording's own principal axis of
+  turning (the axis of the angular velocity's largest variance over the whole recording, which is
+  the vertical for a person turning their head), and one for the part across it. It weighs yaw
+  apart from tilt without being told the tracker's frame: turning a recording changes nothing.
+* `per axis`: a 3 x 3 matrix per feature, in the recordings' world frame. It can weigh every axis
+  apart, so it is a bound only for trackers whose world frames agree (up the same axis).
 
 Each anchor is a sample with a velocity: not the first after a start or a gap longer than
 `max_gap`, and a sample older than the one before or less than `min_interval` after it (a repeated
@@ -39,7 +43,7 @@ from predictors.params import MAX_GAP
 from predictors.rls import TIME_CONSTANTS_S
 from predictors.trace import Trace
 
-FITS = ("shared", "per axis")
+FITS = ("shared", "yaw/tilt", "per axis")
 FEATURES = 4  # w, w - m1, m1 - m2, m2 - m3
 _RIDGE = 1e-9  # relative to the normal matrix's mean diagonal: keeps collinear features solvable
 
@@ -92,43 +96,59 @@ def _turn(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class _Examples:
-    """One recording's anchors at one horizon: features (N, 4, 3), targets (N, 3), and constant
-    velocity's mean squared error there."""
+    """One recording's anchors at one horizon: features (N, 4, 3), targets (N, 3), constant
+    velocity's mean squared error there, and the recording's principal axis of turning (3,)."""
 
     features: np.ndarray
     targets: np.ndarray
     baseline: float
+    axis: np.ndarray
 
     @property
     def usable(self) -> bool:
         return len(self.targets) > 0 and self.baseline > 0.0
 
 
-def _examples(trace: Trace, anchors: Anchors, horizon_s: float) -> _Examples:
+def principal_axis(anchors: Anchors) -> np.ndarray:
+    """The unit axis of the angular velocity's largest variance (about zero) over the anchors; its
+    sign is arbitrary."""
+    w = anchors.features[:, 0]
+    _, vectors = np.linalg.eigh(w.T @ w)
+    return vectors[:, -1]
+
+
+def _examples(trace: Trace, anchors: Anchors, axis: np.ndarray, horizon_s: float) -> _Examples:
     y, known = targets(trace, anchors, horizon_s)
     x = anchors.features[known]
     baseline = float(np.mean(np.sum((x[:, 0] - y) ** 2, axis=1))) if len(y) else 0.0
-    return _Examples(x, y, baseline)
+    return _Examples(x, y, baseline, axis)
 
 
-def _design(x: np.ndarray, fit: str) -> np.ndarray:
-    """Rows of the least-squares problem: (3N, 4) for `shared` (axes stacked), (N, 12) for `per axis`."""
-    return x.transpose(0, 2, 1).reshape(-1, FEATURES) if fit == "shared" else x.reshape(len(x), -1)
+def _design(examples: _Examples, fit: str) -> np.ndarray:
+    """Rows of the least-squares problem: (3N, 4) for `shared` (axes stacked), (3N, 8) for
+    `yaw/tilt` (the features along the axis, then across it), (N, 12) for `per axis`."""
+    x = examples.features
+    if fit == "per axis":
+        return x.reshape(len(x), -1)
+    if fit == "yaw/tilt":
+        along = (x @ examples.axis)[:, :, None] * examples.axis
+        x = np.concatenate([along, x - along], axis=1)
+    return x.transpose(0, 2, 1).reshape(len(x) * 3, -1)
 
 
 def _rhs(y: np.ndarray, fit: str) -> np.ndarray:
-    return y.reshape(-1, 1) if fit == "shared" else y
+    return y if fit == "per axis" else y.reshape(-1, 1)
 
 
 def _fit(training: Sequence[Sequence[_Examples]], fit: str) -> np.ndarray | None:
     """Least-squares coefficients over groups of recordings' examples, each group and, within it,
-    each recording weighing the same: (4, 1) for `shared`, (12, 3) for `per axis`; None where no
-    training recording turns."""
+    each recording weighing the same: (4, 1) for `shared`, (8, 1) for `yaw/tilt`, (12, 3) for
+    `per axis`; None where no training recording turns."""
     terms = []
     for group in training:
         kept = [e for e in group if e.usable]
         for e in kept:
-            design, weight = _design(e.features, fit), 1.0 / (len(e.targets) * e.baseline * len(kept))
+            design, weight = _design(e, fit), 1.0 / (len(e.targets) * e.baseline * len(kept))
             terms.append((weight * design.T @ design, weight * design.T @ _rhs(e.targets, fit)))
     if not terms:
         return None
@@ -144,7 +164,7 @@ def _ratio(examples: _Examples, coefficients: np.ndarray | None, fit: str) -> fl
     where either is undefined)."""
     if coefficients is None or not examples.usable:
         return math.nan
-    predicted = (_design(examples.features, fit) @ coefficients).reshape(examples.targets.shape)
+    predicted = (_design(examples, fit) @ coefficients).reshape(examples.targets.shape)
     return math.sqrt(float(np.mean(np.sum((predicted - examples.targets) ** 2, axis=1))) / examples.baseline)
 
 
@@ -159,14 +179,15 @@ class HeadroomFold:
 
 
 def headroom(traces: Mapping[str, Trace], groups: Mapping[str, Sequence[str]], horizons_ms: Sequence[float]) -> list[HeadroomFold]:
-    """For every group: both fits made on all the other groups, scored on that one (an empty list
+    """For every group: each of `FITS` made on all the other groups, scored on that one (an empty list
     for fewer than two groups)."""
     if len(groups) < 2:
         return []
     anchors = {name: anchors_of(traces[name]) for members in groups.values() for name in members}
+    axes = {name: principal_axis(a) for name, a in anchors.items()}
     ratios: dict[str, dict[str, dict[float, float]]] = {g: {fit: {} for fit in FITS} for g in groups}
     for h in horizons_ms:
-        examples = {name: _examples(traces[name], a, h / 1e3) for name, a in anchors.items()}
+        examples = {name: _examples(traces[name], a, axes[name], h / 1e3) for name, a in anchors.items()}
         for held, members in groups.items():
             training = [[examples[n] for n in others] for g, others in groups.items() if g != held]
             for fit in FITS:

@@ -182,8 +182,9 @@ def text(found: CorpusRun) -> str:
     at = " / ".join(f"{h:g}" for h in found.shown)
     for by in found.headroom:
         lines += [f"\nheadroom, leave one {by} out: linear predictors on {found.default}'s features fitted with every future "
-                  f"sample known on the other groups (shared: one coefficient per feature; per axis: a matrix in the world "
-                  f"frame), angular RMS / constant velocity at {at} ms on the one held out", headroom_table(found, by)]  # fmt: skip
+                  f"sample known on the other groups (shared: one coefficient per feature; yaw/tilt: one along each "
+                  f"recording's principal axis of turning, one across it; per axis: a matrix in the world frame), angular RMS / "
+                  f"constant velocity at {at} ms on the one held out", headroom_table(found, by)]  # fmt: skip
     return "\n".join(lines)
 
 
@@ -262,7 +263,7 @@ def plot(found: CorpusRun, path: Path) -> None:
     fitted = {f.group: f for f in found.headroom.get("person", [])}
     if fitted and h in found.shown:
         at = np.arange(len(names)) + found.shown.index(h) * width
-        for fit, marker in zip(FITS, ("_", "x")):
+        for fit, marker in zip(FITS, ("_", "+", "x")):
             values = [fitted[g].ratios[fit][h] if g in fitted else math.nan for g in names]
             right.scatter(at, values, marker=marker, s=120, color="black", zorder=3, label=f"{fit} linear fit, {h:g} ms")
             heights += values

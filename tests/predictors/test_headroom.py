@@ -40,9 +40,10 @@ def test_a_turn_dying_away_is_predicted_almost_exactly_by_a_fit_on_other_people(
     folds = headroom(traces, groups, HORIZONS_MS)
     assert [f.group for f in folds] == ["a", "b", "c"]
     for fold in folds:
-        # Constant velocity overshoots by about a sixth of the turn at 100 ms; the shared fit, learnt
-        # on the other two, is off only by the averages' start-up.
-        assert fold.ratios["shared"][100.0] < 0.02, fold.group
+        # Constant velocity overshoots by about a sixth of the turn at 100 ms; the frame-free fits,
+        # learnt on the other two, are off only by the averages' start-up.
+        for fit in ("shared", "yaw/tilt"):
+            assert fold.ratios[fit][100.0] < 0.02, (fold.group, fit)
     # A matrix per feature learnt on turns about two axes knows nothing of the third person's axis.
     assert folds[0].ratios["per axis"][100.0] > 1.0
 
@@ -53,14 +54,36 @@ def test_noise_on_a_head_is_smoothed_better_than_constant_velocity():
     assert 0.2 < corpus_headroom(folds, "shared", 20.0) < 0.8
 
 
-def test_turning_every_recording_by_one_rotation_leaves_the_shared_fit_unchanged():
+def test_turning_every_recording_by_one_rotation_leaves_the_frame_free_fits_unchanged():
     turn = quaternion.from_rotation_vector([0.4, -1.1, 0.7])
     heads = noisy_heads()
     turned = [Trace.from_samples(h.name, h.t, h.position, quaternion.multiply(turn, h.orientation)) for h in heads]
     before = headroom(*people([Trace.from_samples(h.name, h.t, h.position, h.orientation) for h in heads]), HORIZONS_MS)
     after = headroom(*people(turned), HORIZONS_MS)
     for a, b in zip(before, after):
-        assert b.ratios["shared"] == pytest.approx(a.ratios["shared"], rel=1e-7)
+        for fit in ("shared", "yaw/tilt"):
+            assert b.ratios[fit] == pytest.approx(a.ratios[fit], rel=1e-7)
+
+
+def yaw_and_tilt(name: str, yaw_axis, tilt_axis, yaw_speed: float, tilt_speed: float) -> Trace:
+    """A turn about `yaw_axis` dying away as exp(-t) and a tilt across it dying away as exp(-10 t)."""
+    t = np.arange(181) / 60.0
+    yaw, tilt = yaw_speed * (1.0 - np.exp(-t)), tilt_speed / 10.0 * (1.0 - np.exp(-10.0 * t))
+    a = np.asarray(yaw_axis, float) / np.linalg.norm(yaw_axis)
+    b = np.asarray(tilt_axis, float) - (np.dot(tilt_axis, a)) * a
+    orientation = quaternion.multiply(quaternion.from_rotation_vector(yaw[:, None] * a),
+                                      quaternion.from_rotation_vector(tilt[:, None] * b / np.linalg.norm(b)))  # fmt: skip
+    return Trace.from_samples(name, t, np.zeros((len(t), 3)), orientation)
+
+
+def test_a_yaw_and_a_tilt_dying_away_at_different_rates_are_weighed_apart():
+    traces, groups = people([yaw_and_tilt("a", (0, 1, 0), (1, 0, 0), 2.0, 1.0), yaw_and_tilt("b", (0.3, 1, 0), (0, 0, 1), 1.5, 0.8),
+                             yaw_and_tilt("c", (0, 0.2, 1), (1, 0, 0), 2.5, 1.2)])  # fmt: skip
+    for fold in headroom(traces, groups, HORIZONS_MS):
+        for h in HORIZONS_MS:
+            assert fold.ratios["yaw/tilt"][h] < 0.75 * fold.ratios["shared"][h], (fold.group, h)
+        # The three people turn about three different axes in the world frame.
+        assert fold.ratios["per axis"][100.0] > 1.0
 
 
 def test_a_person_recorded_twice_the_same_weighs_as_once():

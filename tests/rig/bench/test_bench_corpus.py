@@ -85,12 +85,13 @@ def test_the_headroom_is_fitted_on_the_other_groups_and_reported_beside_the_defa
     assert run(tmp_path, "--predictor", "rls", "--headroom", "--json", str(tmp_path / "out.json"), "--plot", str(tmp_path / "out.png")) == 0
     out = capsys.readouterr().out
     assert "headroom, leave one person out: linear predictors on rls's features" in out
-    assert "| held out (person) | recordings | shared, fitted on the others | per axis, fitted on the others | rls, on the stream |" in out
+    assert ("| held out (person) | recordings | shared, fitted on the others | yaw/tilt, fitted on the others | per axis, fitted on the "
+            "others | rls, on the stream |") in out
     headroom = json.loads((tmp_path / "out.json").read_text())["headroom"]
     assert set(headroom) == {"person", "scene", "device"}
     folds = headroom["person"]["folds"]
     assert [f["group"] for f in folds] == ["hmd/user9", "walk/user1", "walk/user2", "walk/user3"]
-    for fit in ("shared", "per axis"):
+    for fit in ("shared", "yaw/tilt", "per axis"):
         ratios = [f["ratios"][fit]["50"] for f in folds]
         assert all(0.0 < r < 2.0 for r in ratios)
         assert headroom["person"]["geometric_mean"][fit]["50"] == pytest.approx(math.exp(sum(map(math.log, ratios)) / len(ratios)))
