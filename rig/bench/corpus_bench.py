@@ -273,6 +273,6 @@ def plot(found: CorpusRun, path: Path) -> None:
     right.set_xticks(np.arange(len(names)) + 0.4 - width / 2, names, rotation=60, ha="right", fontsize="small")
     right.set(ylabel="angular RMS / constant velocity",
               title="held out: chosen on the other people" if folds else f"{found.default} per person")  # fmt: skip
-    right.legend(fontsize="small")
+    right.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.0, 1.0))
     figure.tight_layout()
     figure.savefig(path, dpi=100)
