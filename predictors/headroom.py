@@ -97,16 +97,16 @@ def _turn(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class _Examples:
     """One recording's anchors at one horizon: features (N, 4, 3), targets (N, 3), constant
-    velocity's mean squared error there, and the recording's principal axis of turning (3,)."""
+    velocity's mean squared error there, the recording's principal axis of turning (3,), and per
+    fit its normal equations (the design's Gram matrix and its product with the targets) over the
+    anchors and that error, so that every recording weighs the same (empty where it cannot: no
+    anchors, or constant velocity exact)."""
 
     features: np.ndarray
     targets: np.ndarray
     baseline: float
     axis: np.ndarray
-
-    @property
-    def usable(self) -> bool:
-        return len(self.targets) > 0 and self.baseline > 0.0
+    equations: dict[str, tuple[np.ndarray, np.ndarray]]
 
 
 def principal_axis(anchors: Anchors) -> np.ndarray:
@@ -117,27 +117,28 @@ def principal_axis(anchors: Anchors) -> np.ndarray:
     return vectors[:, -1]
 
 
-def _examples(trace: Trace, anchors: Anchors, axis: np.ndarray, horizon_s: float) -> _Examples:
-    y, known = targets(trace, anchors, horizon_s)
-    x = anchors.features[known]
-    baseline = float(np.mean(np.sum((x[:, 0] - y) ** 2, axis=1))) if len(y) else 0.0
-    return _Examples(x, y, baseline, axis)
-
-
-def _design(examples: _Examples, fit: str) -> np.ndarray:
-    """Rows of the least-squares problem: (3N, 4) for `shared` (axes stacked), (3N, 8) for
-    `yaw/tilt` (the features along the axis, then across it), (N, 12) for `per axis`."""
-    x = examples.features
+def _design(x: np.ndarray, axis: np.ndarray, fit: str) -> np.ndarray:
+    """Rows of the least-squares problem for features x (N, 4, 3): (3N, 4) for `shared` (axes
+    stacked), (3N, 8) for `yaw/tilt` (the features along the axis, then across it), (N, 12) for
+    `per axis`."""
     if fit == "per axis":
         return x.reshape(len(x), -1)
     if fit == "yaw/tilt":
-        along = (x @ examples.axis)[:, :, None] * examples.axis
+        along = (x @ axis)[:, :, None] * axis
         x = np.concatenate([along, x - along], axis=1)
     return x.transpose(0, 2, 1).reshape(len(x) * 3, -1)
 
 
-def _rhs(y: np.ndarray, fit: str) -> np.ndarray:
-    return y if fit == "per axis" else y.reshape(-1, 1)
+def _examples(trace: Trace, anchors: Anchors, axis: np.ndarray, horizon_s: float) -> _Examples:
+    y, known = targets(trace, anchors, horizon_s)
+    x = anchors.features[known]
+    baseline = float(np.mean(np.sum((x[:, 0] - y) ** 2, axis=1))) if len(y) else 0.0
+    equations = {}
+    if baseline > 0.0:
+        for fit in FITS:
+            design, scale = _design(x, axis, fit), 1.0 / (len(y) * baseline)
+            equations[fit] = (scale * design.T @ design, scale * design.T @ (y if fit == "per axis" else y.reshape(-1, 1)))
+    return _Examples(x, y, baseline, axis, equations)
 
 
 def _fit(training: Sequence[Sequence[_Examples]], fit: str) -> np.ndarray | None:
@@ -146,10 +147,8 @@ def _fit(training: Sequence[Sequence[_Examples]], fit: str) -> np.ndarray | None
     `per axis`; None where no training recording turns."""
     terms = []
     for group in training:
-        kept = [e for e in group if e.usable]
-        for e in kept:
-            design, weight = _design(e, fit), 1.0 / (len(e.targets) * e.baseline * len(kept))
-            terms.append((weight * design.T @ design, weight * design.T @ _rhs(e.targets, fit)))
+        kept = [e.equations[fit] for e in group if e.equations]
+        terms += [(normal / len(kept), cross / len(kept)) for normal, cross in kept]
     if not terms:
         return None
     normal, cross = sum(n for n, _ in terms), sum(c for _, c in terms)
@@ -162,9 +161,9 @@ def _fit(training: Sequence[Sequence[_Examples]], fit: str) -> np.ndarray | None
 def _ratio(examples: _Examples, coefficients: np.ndarray | None, fit: str) -> float:
     """RMS angle of the fit's error over constant velocity's, on one recording at one horizon (NaN
     where either is undefined)."""
-    if coefficients is None or not examples.usable:
+    if coefficients is None or not examples.equations:
         return math.nan
-    predicted = (_design(examples, fit) @ coefficients).reshape(examples.targets.shape)
+    predicted = (_design(examples.features, examples.axis, fit) @ coefficients).reshape(examples.targets.shape)
     return math.sqrt(float(np.mean(np.sum((predicted - examples.targets) ** 2, axis=1))) / examples.baseline)
 
 
