@@ -90,8 +90,8 @@ def targets(trace: Trace, anchors: Anchors, horizon_s: float) -> tuple[np.ndarra
 
 
 def _turn(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The world-frame rotation vector from a to b, the short way (either sign of either)."""
-    return quaternion.to_rotation_vector(quaternion.canonical(quaternion.multiply(b, quaternion.conjugate(a))))
+    """The world-frame rotation vector from a to b (`to_rotation_vector` takes the short way, so either sign of either)."""
+    return quaternion.to_rotation_vector(quaternion.multiply(b, quaternion.conjugate(a)))
 
 
 @dataclass(frozen=True)
